@@ -1,0 +1,17 @@
+# All dependencies are Debian bookworm packages (see deploy/install-deps.sh).
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+find_package(SQLite3 REQUIRED)
+find_package(spdlog REQUIRED)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(OpenSSL REQUIRED)  # SHA-256 of recipes
+find_package(Threads REQUIRED)
+find_package(ZLIB REQUIRED)       # compressed raw curves in the store
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
+pkg_check_modules(MODBUS REQUIRED IMPORTED_TARGET libmodbus)
+# cpp-httplib 0.11 is compiled; its .pc carries the defines that fix its class layout.
+pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
+if(EOL_WITH_ALSA)
+  find_package(ALSA REQUIRED)
+endif()

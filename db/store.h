@@ -1,0 +1,76 @@
+// Durable store of test records in one SQLite file.
+//
+// Contract (the station relies on every line):
+// - Open() creates or migrates the schema (versioned with PRAGMA user_version), turns on WAL
+//   and synchronous=FULL, and marks every test left unfinished by a crash as ABORTED.
+// - BeginTest() writes a row for a test that has started; until FinishTest() it is RUNNING,
+//   which no query ever reports as PASS (queries skip running rows; after a crash they are
+//   ABORTED).
+// - FinishTest() writes the whole record in one transaction and returns only once it is
+//   committed durably: the verdict may be published after it returns, never before.
+// - Retests: a test of a serial that already has tests links to the first one (retest_of).
+// - All SQL is parameterised. Errors throw StoreError naming the file and the operation.
+// Not thread-safe: one Store per thread (SQLite connections are cheap).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "db/test_record.h"
+
+struct sqlite3;
+
+namespace eol::db {
+
+class StoreError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct TestQuery {
+  std::optional<std::string> from;  // ISO 8601, inclusive, on started_at
+  std::optional<std::string> to;    // ISO 8601, exclusive
+  std::optional<analysis::Outcome> outcome;
+  std::optional<std::string> serial;
+  int limit = 100;
+  bool with_curves = false;
+};
+
+class Store {
+ public:
+  static constexpr int kSchemaVersion = 1;
+
+  static std::unique_ptr<Store> Open(const std::string& path);
+  ~Store();
+  Store(const Store&) = delete;
+  Store& operator=(const Store&) = delete;
+
+  const std::string& path() const { return path_; }
+  // How many unfinished tests Open() found and marked ABORTED.
+  int aborted_on_open() const { return aborted_on_open_; }
+
+  // Sets record.id and record.retest_of; writes serial, station, recipe, times.
+  void BeginTest(TestRecord& record);
+  // record.id must come from BeginTest. Durable when it returns.
+  void FinishTest(const TestRecord& record);
+  // BeginTest + FinishTest, for records made elsewhere (imports, tests).
+  void Insert(TestRecord& record);
+
+  // Finished (and aborted) tests of a serial, newest first.
+  std::vector<TestRecord> TestsOfSerial(const std::string& serial, bool with_curves = false);
+  std::optional<TestRecord> LatestOfSerial(const std::string& serial);
+  std::optional<TestRecord> Test(std::int64_t id, bool with_curves = true);
+  std::vector<TestRecord> Tests(const TestQuery& query);
+
+ private:
+  explicit Store(std::string path);
+  std::string path_;
+  sqlite3* db_ = nullptr;
+  int aborted_on_open_ = 0;
+};
+
+}  // namespace eol::db

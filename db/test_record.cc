@@ -1,0 +1,126 @@
+#include "db/test_record.h"
+
+#include <cmath>
+#include <limits>
+
+namespace eol::analysis {
+namespace {
+// JSON has no NaN: unknown numbers are null.
+nlohmann::json Num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+double NumOr(const nlohmann::json& j, const char* key) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return std::numeric_limits<double>::quiet_NaN();
+  return it->get<double>();
+}
+}  // namespace
+
+void to_json(nlohmann::json& j, const Limit& l) {
+  j = nlohmann::json::object();
+  j["lo"] = l.lo ? nlohmann::json(*l.lo) : nlohmann::json();
+  j["hi"] = l.hi ? nlohmann::json(*l.hi) : nlohmann::json();
+  j["marginal"] = l.marginal;
+}
+
+void from_json(const nlohmann::json& j, Limit& l) {
+  l = Limit{};
+  if (j.contains("lo") && !j.at("lo").is_null()) l.lo = j.at("lo").get<double>();
+  if (j.contains("hi") && !j.at("hi").is_null()) l.hi = j.at("hi").get<double>();
+  l.marginal = j.value("marginal", 0.0);
+}
+
+void to_json(nlohmann::json& j, const Measurement& m) {
+  j = {{"name", m.name},       {"unit", m.unit},   {"doc", m.doc},
+       {"value", Num(m.value)}, {"sigma", Num(m.sigma)}, {"limit", m.limit},
+       {"outcome", ToString(m.outcome)}, {"marginal", m.marginal}};
+}
+
+void from_json(const nlohmann::json& j, Measurement& m) {
+  m.name = j.at("name").get<std::string>();
+  m.unit = j.value("unit", "");
+  m.doc = j.value("doc", "");
+  m.value = NumOr(j, "value");
+  m.sigma = NumOr(j, "sigma");
+  m.limit = j.value("limit", Limit{});
+  const std::string o = j.value("outcome", "UNSET");
+  m.outcome = o == "PASS" ? MeasurementOutcome::kPass
+              : o == "FAIL" ? MeasurementOutcome::kFail
+                            : MeasurementOutcome::kUnset;
+  m.marginal = j.value("marginal", false);
+}
+}  // namespace eol::analysis
+
+namespace eol::db {
+
+void to_json(nlohmann::json& j, const Curve& c) {
+  j = {{"name", c.name}, {"unit", c.unit}, {"freq_hz", c.freq_hz},
+       {"re", c.re},     {"im", c.im},     {"sigma", c.sigma}};
+}
+
+void from_json(const nlohmann::json& j, Curve& c) {
+  c.name = j.at("name").get<std::string>();
+  c.unit = j.value("unit", "");
+  c.freq_hz = j.at("freq_hz").get<std::vector<double>>();
+  c.re = j.at("re").get<std::vector<double>>();
+  c.im = j.at("im").get<std::vector<double>>();
+  c.sigma = j.value("sigma", std::vector<double>{});
+}
+
+void to_json(nlohmann::json& j, const StateEntry& s) {
+  j = {{"state", s.state}, {"t_ms", s.t_ms}, {"detail", s.detail}};
+}
+
+void from_json(const nlohmann::json& j, StateEntry& s) {
+  s.state = j.at("state").get<std::string>();
+  s.t_ms = j.value("t_ms", 0.0);
+  s.detail = j.value("detail", "");
+}
+
+void to_json(nlohmann::json& j, const TestRecord& r) {
+  j = {{"id", r.id},
+       {"serial", r.serial},
+       {"station_id", r.station_id},
+       {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}},
+       {"software_version", r.software_version},
+       {"started_at", r.started_at},
+       {"finished_at", r.finished_at},
+       {"retest_of", r.retest_of ? nlohmann::json(*r.retest_of) : nlohmann::json()},
+       {"outcome", analysis::ToString(r.outcome)},
+       {"reasons", r.reasons},
+       {"measurements", r.measurements},
+       {"conditions", r.conditions},
+       {"calibration", r.calibration},
+       {"fit", r.fit},
+       {"curves", r.curves},
+       {"trace", r.trace}};
+}
+
+void from_json(const nlohmann::json& j, TestRecord& r) {
+  r.id = j.value("id", std::int64_t{0});
+  r.serial = j.at("serial").get<std::string>();
+  r.station_id = j.value("station_id", "");
+  const nlohmann::json& recipe = j.at("recipe");
+  r.recipe_id = recipe.at("id").get<std::string>();
+  r.recipe_version = recipe.value("version", 0);
+  r.recipe_hash = recipe.value("hash", "");
+  r.software_version = j.value("software_version", "");
+  r.started_at = j.value("started_at", "");
+  r.finished_at = j.value("finished_at", "");
+  r.retest_of.reset();
+  if (j.contains("retest_of") && !j.at("retest_of").is_null())
+    r.retest_of = j.at("retest_of").get<std::int64_t>();
+  const std::string outcome = j.at("outcome").get<std::string>();
+  const auto parsed = analysis::ParseOutcome(outcome);
+  if (!parsed)
+    throw nlohmann::json::other_error::create(501, "outcome: unknown value '" + outcome + "'",
+                                              &j);
+  r.outcome = *parsed;
+  r.reasons = j.value("reasons", std::vector<std::string>{});
+  r.measurements = j.value("measurements", std::vector<analysis::Measurement>{});
+  r.conditions = j.value("conditions", nlohmann::json::object());
+  r.calibration = j.value("calibration", nlohmann::json::object());
+  r.fit = j.value("fit", nlohmann::json::object());
+  r.curves = j.value("curves", std::vector<Curve>{});
+  r.trace = j.value("trace", std::vector<StateEntry>{});
+}
+
+}  // namespace eol::db

@@ -1,0 +1,75 @@
+// The full record of one test: what the store writes, the API serves and the display shows.
+// Everything needed to re-judge or audit a test later is here: identity, recipe hash,
+// software version, times, conditions, calibration, every measurement with its limits,
+// the fit, the verdict with reasons, the raw curves and the sequencer's state trace.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/qc/measurement.h"
+
+namespace eol::db {
+
+// A curve over frequency (the measured impedance with its sigma, a limit mask, ...).
+struct Curve {
+  std::string name;  // "impedance", "model", ...
+  std::string unit;  // of re/im: "ohm"
+  std::vector<double> freq_hz;
+  std::vector<double> re;
+  std::vector<double> im;
+  std::vector<double> sigma;  // may be empty
+};
+
+// One sequencer state entered, with the time (ms since the test started) and a detail line.
+struct StateEntry {
+  std::string state;
+  double t_ms = 0.0;
+  std::string detail;
+};
+
+struct TestRecord {
+  std::int64_t id = 0;  // assigned by the store
+  std::string serial;
+  std::string station_id;
+  std::string recipe_id;
+  int recipe_version = 0;
+  std::string recipe_hash;  // SHA-256 of the recipe's canonical JSON
+  std::string software_version;
+  std::string started_at;   // ISO 8601 UTC, millisecond precision
+  std::string finished_at;  // empty while the test runs
+  std::optional<std::int64_t> retest_of;  // id of the first test of this serial, if any
+
+  analysis::Outcome outcome = analysis::Outcome::kError;
+  std::vector<std::string> reasons;
+  std::vector<analysis::Measurement> measurements;
+
+  // Conditions and context, free-form but with unit-carrying keys:
+  // {"clamp_pressure_bar": 5.1, "phase_pair": 0, "excitation_peak_v": 2.0, ...}
+  nlohmann::json conditions = nlohmann::json::object();
+  nlohmann::json calibration = nlohmann::json::object();
+  nlohmann::json fit = nlohmann::json::object();  // the fit summary
+  std::vector<Curve> curves;
+  std::vector<StateEntry> trace;
+};
+
+void to_json(nlohmann::json& j, const Curve& c);
+void from_json(const nlohmann::json& j, Curve& c);
+void to_json(nlohmann::json& j, const StateEntry& s);
+void from_json(const nlohmann::json& j, StateEntry& s);
+void to_json(nlohmann::json& j, const TestRecord& r);
+// Throws nlohmann::json::exception naming the field when the JSON is not a record.
+void from_json(const nlohmann::json& j, TestRecord& r);
+
+}  // namespace eol::db
+
+namespace eol::analysis {
+void to_json(nlohmann::json& j, const Limit& l);
+void from_json(const nlohmann::json& j, Limit& l);
+void to_json(nlohmann::json& j, const Measurement& m);
+void from_json(const nlohmann::json& j, Measurement& m);
+}  // namespace eol::analysis
