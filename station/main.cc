@@ -1,2 +1,21 @@
-// Placeholder until the CLI lands.
-int main() { return 0; }
+// eol: the end-of-line test station for permanent-magnet motors.
+#include <CLI/CLI.hpp>
+#include <clocale>
+
+#include "station/cli/commands.h"
+#include "station/version.h"
+
+int main(int argc, char** argv) {
+  std::setlocale(LC_ALL, "C");  // numbers in files and JSON never depend on the locale
+  CLI::App app{
+      "eol - end-of-line test station for permanent-magnet motors.\n"
+      "Clamps the shaft, excites a stator phase pair with a multisine, estimates the impedance\n"
+      "Z(f), fits the clamped rotor's torsional resonance and judges it against the recipe."};
+  app.set_version_flag("--version", eol::station::SoftwareVersion());
+  app.require_subcommand(1);
+  eol::station::cli::AddDemoCommand(app);
+  eol::station::cli::AddStationCommand(app);
+  eol::station::cli::AddFixtureSimCommand(app);
+  CLI11_PARSE(app, argc, argv);
+  return 0;
+}

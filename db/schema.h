@@ -1,0 +1,74 @@
+// The store's SQL schema, compiled into the binary (the station needs no files at run time).
+//
+// Each constant here is the SQL of one migration step; the ordered list of steps is
+// kMigrations in store.cc. A shipped step is never edited: a schema change is a new step
+// (and Store::kSchemaVersion + 1), so every station file, whatever version wrote it,
+// migrates along the same path.
+#pragma once
+
+namespace eol::db::schema {
+
+// Identifies a file as an EOL test store (PRAGMA application_id, "EOLS").
+inline constexpr int kApplicationId = 0x454F4C53;
+
+// Version 0 -> 1: the initial schema.
+//
+// tests: one row per test. The columns are authoritative for identity, outcome, times,
+//   reasons and retest_of; `record` holds the rest of the TestRecord as JSON (measurements
+//   with doc lines, conditions, calibration, fit, trace), without the curves, and is NULL
+//   until the test is finished. A row is RUNNING from BeginTest until FinishTest; a RUNNING
+//   row found when the store is opened was interrupted and becomes ABORTED.
+//   Times are ISO 8601 UTC strings of one format (millisecond precision, 'Z'), so string
+//   order is time order.
+// measurements: a copy of the record's measurements for SQL queries (yield, trends, Cpk).
+//   Values that were not finite are NULL; lo/hi are NULL where the limit is open.
+// curves: each raw curve as the zlib (RFC 1950) stream of its UTF-8 JSON, with the JSON's
+//   size in bytes; rows of one test are in the record's order (by id).
+inline constexpr const char kSchemaV1[] = R"sql(
+CREATE TABLE tests (
+  id               INTEGER PRIMARY KEY,
+  serial           TEXT    NOT NULL,
+  station_id       TEXT    NOT NULL,
+  recipe_id        TEXT    NOT NULL,
+  recipe_version   INTEGER NOT NULL,
+  recipe_hash      TEXT    NOT NULL,
+  software_version TEXT    NOT NULL,
+  started_at       TEXT    NOT NULL,
+  finished_at      TEXT,
+  outcome          TEXT    NOT NULL
+                   CHECK (outcome IN ('RUNNING', 'PASS', 'FAIL', 'ERROR', 'ABORTED')),
+  retest_of        INTEGER REFERENCES tests(id),
+  reasons          TEXT    NOT NULL DEFAULT '[]',
+  record           TEXT
+);
+CREATE INDEX tests_serial_started ON tests(serial, started_at);
+CREATE INDEX tests_started ON tests(started_at);
+-- Open() looks for RUNNING rows every time; this keeps that independent of the table size.
+CREATE INDEX tests_running ON tests(id) WHERE outcome = 'RUNNING';
+
+CREATE TABLE measurements (
+  id       INTEGER PRIMARY KEY,
+  test_id  INTEGER NOT NULL REFERENCES tests(id) ON DELETE CASCADE,
+  name     TEXT    NOT NULL,
+  value    REAL,
+  sigma    REAL,
+  unit     TEXT    NOT NULL,
+  lo       REAL,
+  hi       REAL,
+  outcome  TEXT    NOT NULL CHECK (outcome IN ('PASS', 'FAIL', 'UNSET')),
+  marginal INTEGER NOT NULL CHECK (marginal IN (0, 1))
+);
+CREATE INDEX measurements_name ON measurements(name);
+CREATE INDEX measurements_test ON measurements(test_id);
+
+CREATE TABLE curves (
+  id       INTEGER PRIMARY KEY,
+  test_id  INTEGER NOT NULL REFERENCES tests(id) ON DELETE CASCADE,
+  name     TEXT    NOT NULL,
+  raw_size INTEGER NOT NULL,
+  data     BLOB    NOT NULL
+);
+CREATE INDEX curves_test ON curves(test_id);
+)sql";
+
+}  // namespace eol::db::schema

@@ -1,0 +1,96 @@
+#include "drivers/factory.h"
+
+#include "drivers/fixture/sim_fixture.h"
+
+namespace eol::drivers {
+
+analysis::MotorPopulation ParsePopulation(const JsonObject& o) {
+  analysis::MotorPopulation p;
+  p.inertia_kg_m2 = o.Number("inertia_kg_m2", p.inertia_kg_m2);
+  p.f_rigid_hz = o.Number("f_rigid_hz", p.f_rigid_hz);
+  p.f_rigid_defect_hz = o.Number("f_rigid_defect_hz", p.f_rigid_defect_hz);
+  p.f_fixture_hz = o.Number("f_fixture_hz", p.f_fixture_hz);
+  p.q_good = o.Number("q_good", p.q_good);
+  p.q_defect = o.Number("q_defect", p.q_defect);
+  p.r_ohm = o.Number("r_ohm", p.r_ohm);
+  p.l_h = o.Number("l_h", p.l_h);
+  p.transmission_nm_per_a = o.Number("transmission_nm_per_a", p.transmission_nm_per_a);
+  p.spread_inertia = o.Number("spread_inertia", p.spread_inertia);
+  p.spread_k_rotor = o.Number("spread_k_rotor", p.spread_k_rotor);
+  p.spread_k_fixture = o.Number("spread_k_fixture", p.spread_k_fixture);
+  p.spread_q = o.Number("spread_q", p.spread_q);
+  p.spread_r = o.Number("spread_r", p.spread_r);
+  p.spread_l = o.Number("spread_l", p.spread_l);
+  p.spread_transmission = o.Number("spread_transmission", p.spread_transmission);
+  p.defect_share = o.Number("defect_share", p.defect_share);
+  p.seed = static_cast<std::uint64_t>(o.Integer("seed", static_cast<int>(p.seed)));
+  o.RejectUnknown();
+  std::string why;
+  if (!p.IsValid(&why)) throw ConfigError(o.path() + ": " + why);
+  return p;
+}
+
+SimBenchSettings ParseSimBenchSettings(const JsonObject& o) {
+  SimBenchSettings s;
+  if (auto pop = o.OptionalObject("population")) s.population = ParsePopulation(*pop);
+  s.clamp_close_s = o.Number("clamp_close_s", s.clamp_close_s);
+  s.clamp_open_s = o.Number("clamp_open_s", s.clamp_open_s);
+  s.clamp_pressure_bar = o.Number("clamp_pressure_bar", s.clamp_pressure_bar);
+  s.heartbeat_period_s = o.Number("heartbeat_period_s", s.heartbeat_period_s);
+  s.load_part_on_serial = o.Bool("load_part_on_serial", s.load_part_on_serial);
+  o.Require(s.clamp_close_s > 0 && s.clamp_close_s < 10, "clamp_close_s", "must be in (0, 10) s");
+  o.Require(s.clamp_open_s > 0 && s.clamp_open_s < 10, "clamp_open_s", "must be in (0, 10) s");
+  o.Require(s.heartbeat_period_s > 0 && s.heartbeat_period_s <= 0.5, "heartbeat_period_s",
+            "must be in (0, 0.5] s");
+  o.RejectUnknown();
+  return s;
+}
+
+SimDaqSettings ParseSimDaqSettings(const JsonObject& o) {
+  SimDaqSettings s;
+  s.time_scale = o.Number("time_scale", s.time_scale);
+  s.voltage_noise_v = o.Number("voltage_noise_v", s.voltage_noise_v);
+  s.current_noise_a = o.Number("current_noise_a", s.current_noise_a);
+  s.voltage_full_scale_v = o.Number("voltage_full_scale_v", s.voltage_full_scale_v);
+  s.current_full_scale_a = o.Number("current_full_scale_a", s.current_full_scale_a);
+  s.seed = static_cast<std::uint64_t>(o.Integer("seed", static_cast<int>(s.seed)));
+  o.Require(s.time_scale >= 0.0, "time_scale", "must not be negative");
+  o.Require(s.voltage_noise_v >= 0.0, "voltage_noise_v", "must not be negative");
+  o.Require(s.current_noise_a >= 0.0, "current_noise_a", "must not be negative");
+  o.Require(s.voltage_full_scale_v > 0.0, "voltage_full_scale_v", "must be positive");
+  o.Require(s.current_full_scale_a > 0.0, "current_full_scale_a", "must be positive");
+  o.RejectUnknown();
+  return s;
+}
+
+DriverSet MakeDrivers(const nlohmann::json& station_config) {
+  const JsonObject root(station_config, "");
+  const JsonObject fixture = root.Object("fixture");
+  const JsonObject daq = root.Object("daq");
+  const std::string fixture_driver = fixture.RequiredString("driver");
+  const std::string daq_driver = daq.RequiredString("driver");
+
+  DriverSet set;
+  if (fixture_driver == "sim" || daq_driver == "sim") {
+    const auto sim = root.OptionalObject("sim");
+    set.bench = std::make_shared<SimBench>(sim ? ParseSimBenchSettings(*sim) : SimBenchSettings{});
+  }
+
+  if (fixture_driver == "sim") {
+    fixture.RejectUnknown();
+    set.fixture = std::make_unique<SimFixture>(set.bench);
+  } else {
+    throw ConfigError(fixture.PathOf("driver") + ": unknown fixture driver '" + fixture_driver +
+                      "' (known: sim)");
+  }
+
+  if (daq_driver == "sim") {
+    set.daq = std::make_unique<SimDaq>(set.bench, ParseSimDaqSettings(daq));
+  } else {
+    throw ConfigError(daq.PathOf("driver") + ": unknown daq driver '" + daq_driver +
+                      "' (known: sim)");
+  }
+  return set;
+}
+
+}  // namespace eol::drivers

@@ -1,0 +1,37 @@
+// The one place that lists the drivers and makes them from configuration (STYLE.md 1).
+//
+//   "fixture": {"driver": "sim"}                    in-process simulated bench
+//   "daq":     {"driver": "sim", "time_scale": 0, "voltage_noise_v": 0.002, ...}
+//   "sim":     {"population": {...}, "clamp_close_s": 0.15, ...}   the simulated bench
+//
+// A simulator is chosen exactly as real hardware is. A driver that was not compiled in, or
+// an unknown name, fails with a ConfigError naming the path and the known drivers.
+#pragma once
+
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "drivers/daq/daq.h"
+#include "drivers/daq/sim_daq.h"
+#include "drivers/fixture/fixture.h"
+#include "drivers/json_config.h"
+#include "drivers/sim/sim_bench.h"
+
+namespace eol::drivers {
+
+struct DriverSet {
+  std::shared_ptr<SimBench> bench;  // set when any driver is simulated
+  std::unique_ptr<Fixture> fixture;
+  std::unique_ptr<Daq> daq;
+};
+
+// `station_config` is the whole station config; its "fixture", "daq" and optional "sim"
+// objects are read. Throws ConfigError.
+DriverSet MakeDrivers(const nlohmann::json& station_config);
+
+SimBenchSettings ParseSimBenchSettings(const JsonObject& sim);
+analysis::MotorPopulation ParsePopulation(const JsonObject& population);
+SimDaqSettings ParseSimDaqSettings(const JsonObject& daq);
+
+}  // namespace eol::drivers

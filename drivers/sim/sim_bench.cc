@@ -1,0 +1,197 @@
+#include "drivers/sim/sim_bench.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace eol::drivers {
+
+const char* ToString(SimFault f) {
+  switch (f) {
+    case SimFault::kStopsAnswering:
+      return "stops_answering";
+    case SimFault::kClampDrops:
+      return "clamp_drops";
+    case SimFault::kPressureLow:
+      return "pressure_low";
+    case SimFault::kDoorOpens:
+      return "door_opens";
+    case SimFault::kEstop:
+      return "estop";
+    case SimFault::kHeartbeatFreezes:
+      return "heartbeat_freezes";
+    case SimFault::kDaqFails:
+      return "daq_fails";
+  }
+  return "unknown";
+}
+
+std::optional<SimFault> ParseSimFault(const std::string& s) {
+  for (SimFault f : {SimFault::kStopsAnswering, SimFault::kClampDrops, SimFault::kPressureLow,
+                     SimFault::kDoorOpens, SimFault::kEstop, SimFault::kHeartbeatFreezes,
+                     SimFault::kDaqFails})
+    if (s == ToString(f)) return f;
+  return std::nullopt;
+}
+
+SimBench::SimBench(SimBenchSettings settings) : settings_(std::move(settings)) {}
+
+void SimBench::LoadPart(const std::string& serial) {
+  LoadUnit(analysis::DrawUnit(settings_.population, serial));
+}
+
+void SimBench::LoadUnit(const analysis::SimUnit& unit) {
+  std::lock_guard<std::mutex> lock(mu_);
+  part_ = unit;
+}
+
+void SimBench::RemovePart() {
+  std::lock_guard<std::mutex> lock(mu_);
+  part_.reset();
+}
+
+std::optional<analysis::SimUnit> SimBench::part() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return part_;
+}
+
+bool SimBench::FaultActiveLocked(SimFault fault, Clock::time_point now) const {
+  if (!fault_ || fault_->fault != fault) return false;
+  if (!fault_->on_excitation) return now >= fault_->armed_at + fault_->delay;
+  return excitation_on_at_ && *excitation_on_at_ >= fault_->armed_at &&
+         now >= *excitation_on_at_ + fault_->delay;
+}
+
+void SimBench::CheckAnsweringLocked(Clock::time_point now) const {
+  if (FaultActiveLocked(SimFault::kStopsAnswering, now))
+    throw DeviceError("no answer from the fixture controller (simulated: stops_answering)");
+}
+
+FixtureInputs SimBench::ReadInputs() {
+  std::lock_guard<std::mutex> lock(mu_);
+  const auto now = Clock::now();
+  CheckAnsweringLocked(now);
+  FixtureInputs in;
+  const double since_cmd = std::chrono::duration<double>(now - clamp_cmd_at_).count();
+  const bool dropped = FaultActiveLocked(SimFault::kClampDrops, now);
+  if (clamp_cmd_) {
+    in.clamped = part_.has_value() && since_cmd >= settings_.clamp_close_s && !dropped;
+    in.released = false;
+    // Pressure ramps up over the closing time, with a small ripple.
+    const double ramp = std::clamp(since_cmd / settings_.clamp_close_s, 0.0, 1.0);
+    in.clamp_pressure_bar = part_ ? settings_.clamp_pressure_bar * ramp : 0.0;
+    in.clamp_pressure_bar += 0.02 * std::sin(since_cmd * 37.0) * ramp;
+  } else {
+    in.clamped = false;
+    in.released = since_cmd >= settings_.clamp_open_s;
+    in.clamp_pressure_bar = 0.0;
+  }
+  if (dropped) in.clamp_pressure_bar = 0.0;
+  if (FaultActiveLocked(SimFault::kPressureLow, now)) in.clamp_pressure_bar = 1.0;
+  in.part_present = part_.has_value();
+  in.door_closed = !FaultActiveLocked(SimFault::kDoorOpens, now);
+  in.estop_ok = !FaultActiveLocked(SimFault::kEstop, now);
+  const double alive_s = std::chrono::duration<double>(now - born_).count();
+  const auto beat = static_cast<std::uint32_t>(alive_s / settings_.heartbeat_period_s);
+  if (FaultActiveLocked(SimFault::kHeartbeatFreezes, now)) {
+    in.heartbeat = frozen_heartbeat_;
+  } else {
+    in.heartbeat = beat;
+    frozen_heartbeat_ = beat;
+  }
+  return in;
+}
+
+void SimBench::Write(FixtureOutput output, bool on) {
+  std::lock_guard<std::mutex> lock(mu_);
+  const auto now = Clock::now();
+  // A dead controller cannot act on a command, except that its outputs drop to safe on their
+  // own: a real PLC's excitation relay is wired fail-safe.
+  if (FaultActiveLocked(SimFault::kStopsAnswering, now)) {
+    if (excitation_) {
+      excitation_ = false;
+      excitation_off_at_ = now;
+    }
+    throw DeviceError(std::string("no answer from the fixture controller writing ") +
+                      ToString(output) + " (simulated: stops_answering)");
+  }
+  switch (output) {
+    case FixtureOutput::kClampCmd:
+      if (on != clamp_cmd_) {
+        clamp_cmd_ = on;
+        clamp_cmd_at_ = now;
+      }
+      break;
+    case FixtureOutput::kExcitationEnable:
+      if (on && !excitation_) excitation_on_at_ = now;
+      if (!on && excitation_) excitation_off_at_ = now;
+      excitation_ = on;
+      break;
+    case FixtureOutput::kLampPass:
+      lamp_pass_ = on;
+      break;
+    case FixtureOutput::kLampFail:
+      lamp_fail_ = on;
+      break;
+  }
+}
+
+void SimBench::SelectPhasePair(PhasePair pair) {
+  std::lock_guard<std::mutex> lock(mu_);
+  CheckAnsweringLocked(Clock::now());
+  pair_ = pair;
+}
+
+bool SimBench::output(FixtureOutput o) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  switch (o) {
+    case FixtureOutput::kClampCmd:
+      return clamp_cmd_;
+    case FixtureOutput::kExcitationEnable:
+      return excitation_;
+    case FixtureOutput::kLampPass:
+      return lamp_pass_;
+    case FixtureOutput::kLampFail:
+      return lamp_fail_;
+  }
+  return false;
+}
+
+PhasePair SimBench::phase_pair() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return pair_;
+}
+
+bool SimBench::excitation_connected() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return excitation_;
+}
+
+std::optional<SimBench::Clock::time_point> SimBench::last_excitation_off() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return excitation_off_at_;
+}
+
+void SimBench::InjectFault(SimFault fault, std::chrono::milliseconds delay, bool on_excitation) {
+  std::lock_guard<std::mutex> lock(mu_);
+  fault_ = PendingFault{fault, delay, on_excitation, Clock::now()};
+}
+
+void SimBench::ClearFaults() {
+  std::lock_guard<std::mutex> lock(mu_);
+  fault_.reset();
+}
+
+bool SimBench::FaultActive(SimFault fault) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return FaultActiveLocked(fault, Clock::now());
+}
+
+std::optional<SimBench::Clock::time_point> SimBench::fault_visible_at() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (!fault_) return std::nullopt;
+  if (!fault_->on_excitation) return fault_->armed_at + fault_->delay;
+  if (!excitation_on_at_ || *excitation_on_at_ < fault_->armed_at) return std::nullopt;
+  return *excitation_on_at_ + fault_->delay;
+}
+
+}  // namespace eol::drivers

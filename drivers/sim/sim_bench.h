@@ -1,0 +1,102 @@
+// The simulated test bench: the physical world behind the sim drivers and `eol fixture-sim`.
+//
+// It holds the part in the fixture (a simulated motor drawn from a population), the clamp
+// with realistic timing and pressure, the door, the emergency stop, the excitation relay,
+// the phase-pair relay, the lamps and the controller heartbeat, plus injectable faults.
+// The sim fixture driver reads and writes it directly; `eol fixture-sim` serves it over
+// Modbus/CAN; the sim DAQ asks it which motor is connected and whether the relay is closed.
+// Thread-safe.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "analysis/sim/population.h"
+#include "drivers/fixture/fixture.h"
+
+namespace eol::drivers {
+
+struct SimBenchSettings {
+  analysis::MotorPopulation population;
+  double clamp_close_s = 0.15;          // command to clamped sensor
+  double clamp_open_s = 0.10;           // command to released sensor
+  double clamp_pressure_bar = 5.5;      // steady pressure when closed
+  double heartbeat_period_s = 0.2;
+  bool load_part_on_serial = true;      // the simulated operator loads a part per serial
+};
+
+enum class SimFault {
+  kStopsAnswering,   // every fixture call fails (controller off the bus)
+  kClampDrops,       // clamped sensor drops, pressure falls to 0
+  kPressureLow,      // pressure falls to 1 bar (out of any sane window)
+  kDoorOpens,
+  kEstop,            // emergency-stop chain opens
+  kHeartbeatFreezes,
+  kDaqFails,         // the acquisition device fails mid-stream
+};
+const char* ToString(SimFault f);
+std::optional<SimFault> ParseSimFault(const std::string& s);
+
+class SimBench {
+ public:
+  using Clock = std::chrono::steady_clock;
+  explicit SimBench(SimBenchSettings settings);
+
+  const SimBenchSettings& settings() const { return settings_; }
+
+  // The simulated operator puts a part in (drawn from the population by serial) and takes it
+  // out. A new part resets nothing else.
+  void LoadPart(const std::string& serial);
+  void LoadUnit(const analysis::SimUnit& unit);
+  void RemovePart();
+  std::optional<analysis::SimUnit> part() const;
+
+  // Fixture side. ReadInputs throws DeviceError while kStopsAnswering is active.
+  FixtureInputs ReadInputs();
+  void Write(FixtureOutput output, bool on);
+  void SelectPhasePair(PhasePair pair);
+  bool output(FixtureOutput o) const;
+  PhasePair phase_pair() const;
+  // True while the relay connects the amplifier to the motor: commanded on and not yet cut.
+  bool excitation_connected() const;
+  // When the excitation relay last opened (for reaction-time measurements).
+  std::optional<Clock::time_point> last_excitation_off() const;
+
+  // A fault becomes active `delay` after the next excitation-enable edge (or now, when
+  // `on_excitation` is false) and stays until ClearFaults().
+  void InjectFault(SimFault fault, std::chrono::milliseconds delay, bool on_excitation = true);
+  void ClearFaults();
+  bool FaultActive(SimFault fault) const;
+  // When the injected fault became visible (for reaction-time measurements).
+  std::optional<Clock::time_point> fault_visible_at() const;
+
+ private:
+  bool FaultActiveLocked(SimFault fault, Clock::time_point now) const;
+  void CheckAnsweringLocked(Clock::time_point now) const;
+
+  SimBenchSettings settings_;
+  mutable std::mutex mu_;
+  std::optional<analysis::SimUnit> part_;
+  bool clamp_cmd_ = false;
+  Clock::time_point clamp_cmd_at_{};
+  bool excitation_ = false;
+  bool lamp_pass_ = false, lamp_fail_ = false;
+  PhasePair pair_ = PhasePair::kUV;
+  std::optional<Clock::time_point> excitation_on_at_;
+  std::optional<Clock::time_point> excitation_off_at_;
+  const Clock::time_point born_ = Clock::now();
+
+  struct PendingFault {
+    SimFault fault;
+    std::chrono::milliseconds delay;
+    bool on_excitation;
+    Clock::time_point armed_at;
+  };
+  std::optional<PendingFault> fault_;
+  std::uint32_t frozen_heartbeat_ = 0;
+};
+
+}  // namespace eol::drivers

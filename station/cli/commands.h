@@ -1,0 +1,14 @@
+// The `eol` subcommands. Each Add*Command registers one subcommand on the app with its
+// options and a callback; main.cc lists them all in one place. A callback reports failure
+// by throwing CLI::RuntimeError(exit_code) after printing the reason to stderr.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace eol::station::cli {
+
+void AddDemoCommand(CLI::App& app);
+void AddStationCommand(CLI::App& app);
+void AddFixtureSimCommand(CLI::App& app);
+
+}  // namespace eol::station::cli
