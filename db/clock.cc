@@ -18,7 +18,7 @@ std::string UtcIso8601(std::chrono::system_clock::time_point t) {
   std::tm tm{};
   if (gmtime_r(&secs, &tm) == nullptr)
     throw std::out_of_range("UtcIso8601: time outside the range of struct tm");
-  char buf[40];
+  char buf[96];  // room for any int the compiler can imagine in each field
   std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
                 tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, millis);
   return buf;

@@ -44,7 +44,12 @@ class Store {
  public:
   static constexpr int kSchemaVersion = 1;
 
-  static std::unique_ptr<Store> Open(const std::string& path);
+  // kWriter: the station's one connection; recovers unfinished tests as ABORTED.
+  // kReader: further connections (the HTTP API, queries, exports) that must never touch a
+  // test another connection is running; they migrate a new file but recover nothing.
+  enum class Role { kWriter, kReader };
+
+  static std::unique_ptr<Store> Open(const std::string& path, Role role = Role::kWriter);
   ~Store();
   Store(const Store&) = delete;
   Store& operator=(const Store&) = delete;
@@ -62,8 +67,12 @@ class Store {
 
   // Finished (and aborted) tests of a serial, newest first.
   std::vector<TestRecord> TestsOfSerial(const std::string& serial, bool with_curves = false);
+  // The newest finished (or aborted) test of a serial, with its curves.
   std::optional<TestRecord> LatestOfSerial(const std::string& serial);
+  // Empty for an unknown id and for a test still RUNNING.
   std::optional<TestRecord> Test(std::int64_t id, bool with_curves = true);
+  // Newest first; limit is clamped to 1..10000. from/to compare as strings, which is time
+  // order for the store's one timestamp format (db/clock.h); a date "2024-05-01" also works.
   std::vector<TestRecord> Tests(const TestQuery& query);
 
  private:

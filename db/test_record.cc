@@ -56,13 +56,27 @@ void to_json(nlohmann::json& j, const Curve& c) {
        {"re", c.re},     {"im", c.im},     {"sigma", c.sigma}};
 }
 
+namespace {
+// JSON has no NaN: a sample that was not finite is written as null and reads back as NaN.
+std::vector<double> Samples(const nlohmann::json& j, const char* key) {
+  const nlohmann::json& a = j.at(key);
+  if (!a.is_array())
+    throw nlohmann::json::type_error::create(302, std::string(key) + ": must be an array", &a);
+  std::vector<double> out;
+  out.reserve(a.size());
+  for (const nlohmann::json& v : a)
+    out.push_back(v.is_null() ? std::numeric_limits<double>::quiet_NaN() : v.get<double>());
+  return out;
+}
+}  // namespace
+
 void from_json(const nlohmann::json& j, Curve& c) {
   c.name = j.at("name").get<std::string>();
   c.unit = j.value("unit", "");
-  c.freq_hz = j.at("freq_hz").get<std::vector<double>>();
-  c.re = j.at("re").get<std::vector<double>>();
-  c.im = j.at("im").get<std::vector<double>>();
-  c.sigma = j.value("sigma", std::vector<double>{});
+  c.freq_hz = Samples(j, "freq_hz");
+  c.re = Samples(j, "re");
+  c.im = Samples(j, "im");
+  c.sigma = j.contains("sigma") ? Samples(j, "sigma") : std::vector<double>{};
 }
 
 void to_json(nlohmann::json& j, const StateEntry& s) {

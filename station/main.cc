@@ -1,4 +1,7 @@
 // eol: the end-of-line test station for permanent-magnet motors.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
 #include <CLI/CLI.hpp>
 #include <clocale>
 
@@ -7,6 +10,8 @@
 
 int main(int argc, char** argv) {
   std::setlocale(LC_ALL, "C");  // numbers in files and JSON never depend on the locale
+  // Logs go to stderr: stdout carries results (unit lines, JSON summaries).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("eol"));
   CLI::App app{
       "eol - end-of-line test station for permanent-magnet motors.\n"
       "Clamps the shaft, excites a stator phase pair with a multisine, estimates the impedance\n"

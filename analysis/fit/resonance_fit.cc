@@ -1,0 +1,438 @@
+#include "analysis/fit/resonance_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <locale>
+#include <numbers>
+#include <sstream>
+#include <unsupported/Eigen/NonLinearOptimization>
+
+#include "analysis/fit/motional_jacobian.h"
+
+namespace eol::analysis {
+namespace {
+
+using Cplx = std::complex<double>;
+
+constexpr int kMinLinesPerParam = 2;
+constexpr int kRefineSteps = 21;   // points per axis of each local refinement grid
+constexpr int kRefinePasses = 2;   // successive refinements around the best cell
+constexpr double kLmFtol = 1e-12;  // MINPACK relative reduction of chi2
+constexpr double kLmXtol = 1e-10;  // MINPACK relative step in scaled theta
+// Residual given to MINPACK for a trial step where the model overflows: the step is rejected.
+constexpr double kRejectResidual = 1e100;
+
+std::ostringstream Stream() {
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os.precision(6);
+  return os;
+}
+
+// Log-spaced points from lo to hi inclusive (n >= 2).
+std::vector<double> LogSpace(double lo, double hi, int n) {
+  std::vector<double> v(static_cast<std::size_t>(n));
+  const double step = std::log(hi / lo) / (n - 1);
+  for (int i = 0; i < n; ++i) v[static_cast<std::size_t>(i)] = lo * std::exp(step * i);
+  v.back() = hi;
+  return v;
+}
+
+// R, L, Rp of the weighted linear least-squares solution at one (f0, Q) grid point.
+struct GridPoint {
+  bool ok = false;  // solved and R, L, Rp > 0
+  double f0_hz = 0.0;
+  double q = 0.0;
+  double r_ohm = 0.0;
+  double l_h = 0.0;
+  double rp_ohm = 0.0;
+  double chi2 = std::numeric_limits<double>::infinity();
+};
+
+// Variable projection over (f0, Q). For fixed f0, Q the model is linear in (R, L, Rp) with
+// complex basis 1, j w, 1/D, and 1/D = g (1 - j Q x), g = 1 / (1 + Q^2 x^2). With weights
+// c_k = s_k^2 = 2 / sigma_k^2, v_k = w_k / w_ref (L' = L w_ref keeps the system scaled) and
+// Z_k = a_k + j b_k, the real normal equations are
+//   [ sum c      0            S0    ] [R ]   [ sum c a       ]
+//   [ 0          sum c v^2   -Q S1  ] [L'] = [ sum c v b     ]
+//   [ S0        -Q S1         S0    ] [Rp]   [ S2 - Q S3     ]
+// with S0 = sum c g, S1 = sum c v x g, S2 = sum c a g, S3 = sum c x b g, solved by eliminating
+// R and L' (Schur complement). chi2 = sum c |Z|^2 - p . rhs at the solution.
+class VarProGrid {
+ public:
+  VarProGrid(const std::vector<double>& freq_hz, const std::vector<Cplx>& z,
+             const std::vector<double>& scale)
+      : f_(freq_hz) {
+    const std::size_t n = f_.size();
+    w_ref_ = 2.0 * std::numbers::pi * f_.back();
+    c_.resize(n);
+    v_.resize(n);
+    a_.resize(n);
+    b_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      c_[k] = scale[k] * scale[k];
+      v_[k] = 2.0 * std::numbers::pi * f_[k] / w_ref_;
+      a_[k] = z[k].real();
+      b_[k] = z[k].imag();
+      n11_ += c_[k];
+      n22_ += c_[k] * v_[k] * v_[k];
+      rhs1_ += c_[k] * a_[k];
+      rhs2_ += c_[k] * v_[k] * b_[k];
+      zz_ += c_[k] * std::norm(z[k]);
+    }
+  }
+
+  // Solves every Q of `qs` at f0; out[i] belongs to qs[i].
+  void Row(double f0_hz, const std::vector<double>& qs, std::vector<GridPoint>* out) {
+    const std::size_t n = f_.size();
+    const std::size_t nq = qs.size();
+    q2_.resize(nq);
+    s0_.assign(nq, 0.0);
+    s1_.assign(nq, 0.0);
+    s2_.assign(nq, 0.0);
+    s3_.assign(nq, 0.0);
+    for (std::size_t i = 0; i < nq; ++i) q2_[i] = qs[i] * qs[i];
+    // Lines outer, Q inner: independent accumulators per Q let the compiler vectorise.
+    for (std::size_t k = 0; k < n; ++k) {
+      const double x = f_[k] / f0_hz - f0_hz / f_[k];
+      const double x2 = x * x;
+      const double c0 = c_[k];
+      const double c1 = c_[k] * v_[k] * x;
+      const double c2 = c_[k] * a_[k];
+      const double c3 = c_[k] * x * b_[k];
+      for (std::size_t i = 0; i < nq; ++i) {
+        const double g = 1.0 / (1.0 + q2_[i] * x2);
+        s0_[i] += c0 * g;
+        s1_[i] += c1 * g;
+        s2_[i] += c2 * g;
+        s3_[i] += c3 * g;
+      }
+    }
+    out->resize(nq);
+    for (std::size_t i = 0; i < nq; ++i) {
+      GridPoint& p = (*out)[i];
+      p = GridPoint{};
+      p.f0_hz = f0_hz;
+      p.q = qs[i];
+      const double s0 = s0_[i];
+      const double n23 = -qs[i] * s1_[i];
+      const double rhs3 = s2_[i] - qs[i] * s3_[i];
+      const double schur = s0 - s0 * s0 / n11_ - n23 * n23 / n22_;
+      // The peak column is (numerically) a combination of the R and L columns: no peak here.
+      if (!(schur > 1e-12 * s0)) continue;
+      const double rp = (rhs3 - s0 * rhs1_ / n11_ - n23 * rhs2_ / n22_) / schur;
+      const double r = (rhs1_ - s0 * rp) / n11_;
+      const double l_scaled = (rhs2_ - n23 * rp) / n22_;
+      if (!(r > 0.0 && l_scaled > 0.0 && rp > 0.0)) continue;
+      p.ok = true;
+      p.r_ohm = r;
+      p.l_h = l_scaled / w_ref_;
+      p.rp_ohm = rp;
+      p.chi2 = zz_ - (r * rhs1_ + l_scaled * rhs2_ + rp * rhs3);
+    }
+  }
+
+  // Best valid point over the grid f0s x qs; *best_i, *best_j are its indices.
+  GridPoint Search(const std::vector<double>& f0s, const std::vector<double>& qs, int* best_i,
+                   int* best_j) {
+    GridPoint best;
+    std::vector<GridPoint> row;
+    for (std::size_t i = 0; i < f0s.size(); ++i) {
+      Row(f0s[i], qs, &row);
+      for (std::size_t j = 0; j < row.size(); ++j) {
+        if (row[j].ok && row[j].chi2 < best.chi2) {
+          best = row[j];
+          *best_i = static_cast<int>(i);
+          *best_j = static_cast<int>(j);
+        }
+      }
+    }
+    return best;
+  }
+
+ private:
+  const std::vector<double>& f_;
+  std::vector<double> c_, v_, a_, b_;
+  double w_ref_ = 1.0;
+  double n11_ = 0.0, n22_ = 0.0, rhs1_ = 0.0, rhs2_ = 0.0, zz_ = 0.0;
+  std::vector<double> q2_, s0_, s1_, s2_, s3_;
+};
+
+// Levenberg-Marquardt functor (Eigen NonLinearOptimization) on theta = ln(R, L, Rp, f0, Q).
+struct MotionalFunctor {
+  using Scalar = double;
+  enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
+  using InputType = Eigen::VectorXd;
+  using ValueType = Eigen::VectorXd;
+  using JacobianType = Eigen::MatrixXd;
+
+  const std::vector<double>& freq_hz;
+  const std::vector<Cplx>& value;
+  const std::vector<double>& scale;
+
+  int inputs() const { return kMotionalParamCount; }
+  int values() const { return static_cast<int>(2 * freq_hz.size()); }
+
+  int operator()(const Eigen::VectorXd& theta, Eigen::VectorXd& r) const {
+    if (!theta.allFinite()) {
+      r.setConstant(values(), kRejectResidual);
+      return 0;
+    }
+    MotionalResidual(FromLogParams(theta), freq_hz, value, scale, &r);
+    if (!r.allFinite()) r.setConstant(kRejectResidual);
+    return 0;
+  }
+
+  int df(const Eigen::VectorXd& theta, Eigen::MatrixXd& jacobian) const {
+    MotionalJacobian(FromLogParams(theta), freq_hz, scale, &jacobian);
+    return jacobian.allFinite() ? 0 : -1;
+  }
+};
+
+FitSummary Invalid(const std::string& why) {
+  FitSummary s;
+  s.usable = false;
+  s.termination = "invalid_input";
+  s.message = "invalid input: " + why;
+  return s;
+}
+
+}  // namespace
+
+bool ResonanceFitOptions::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& msg) {
+    if (why) *why = msg;
+    return false;
+  };
+  const bool auto_range = f0_min_hz == 0.0 && f0_max_hz == 0.0;
+  if (!auto_range && !(std::isfinite(f0_min_hz) && std::isfinite(f0_max_hz) && f0_min_hz > 0.0 &&
+                       f0_max_hz > f0_min_hz))
+    return fail(
+        "f0_min_hz and f0_max_hz must both be 0 (the data's band) or satisfy "
+        "0 < f0_min_hz < f0_max_hz");
+  if (!(std::isfinite(q_min) && std::isfinite(q_max) && q_min > 0.0 && q_max > q_min))
+    return fail("q_min and q_max must satisfy 0 < q_min < q_max");
+  if (grid_f0 < 3) return fail("grid_f0 must be at least 3");
+  if (grid_q < 2) return fail("grid_q must be at least 2");
+  if (max_iterations < 1) return fail("max_iterations must be at least 1");
+  if (!(min_rp_significance >= 0.0)) return fail("min_rp_significance must not be negative");
+  return true;
+}
+
+const FittedParameter* FitSummary::Find(std::string_view name) const {
+  for (const FittedParameter& p : params)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+MotionalImpedance FitSummary::Model() const {
+  auto value = [&](int i) {
+    const FittedParameter* p = Find(kMotionalParamNames[static_cast<std::size_t>(i)]);
+    return p ? p->value : 0.0;
+  };
+  MotionalImpedance m;
+  m.r_ohm = value(kParamR);
+  m.l_h = value(kParamL);
+  m.rp_ohm = value(kParamRp);
+  m.f0_hz = value(kParamF0);
+  m.q = value(kParamQ);
+  return m;
+}
+
+FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) return Invalid("options: " + why);
+  if (!z.Validate(&why)) return Invalid(why);
+  if (z.quantity != Quantity::kImpedanceOhm)
+    return Invalid(std::string("quantity is ") + ToString(z.quantity) + ", the fit needs " +
+                   ToString(Quantity::kImpedanceOhm));
+  const std::size_t k_lines = z.size();
+  const std::size_t min_lines = kMinLinesPerParam * kMotionalParamCount;
+  if (k_lines < min_lines)
+    return Invalid(std::to_string(k_lines) + " lines, the fit needs at least " +
+                   std::to_string(min_lines) + " (2 per parameter)");
+
+  const bool auto_range = options.f0_min_hz == 0.0 && options.f0_max_hz == 0.0;
+  const double f0_lo = auto_range ? z.freq_hz.front() : options.f0_min_hz;
+  const double f0_hi = auto_range ? z.freq_hz.back() : options.f0_max_hz;
+  if (!(f0_lo < z.freq_hz.back() && f0_hi > z.freq_hz.front())) {
+    std::ostringstream os = Stream();
+    os << "f0 search range [" << f0_lo << ", " << f0_hi << "] Hz does not overlap the data band ["
+       << z.freq_hz.front() << ", " << z.freq_hz.back() << "] Hz";
+    return Invalid(os.str());
+  }
+  if (!(f0_hi > f0_lo)) return Invalid("the data band is a single frequency");
+
+  FitSummary s;
+  s.sigma_estimated = !z.has_sigma();
+  std::vector<double> scale(k_lines, std::numbers::sqrt2);
+  if (z.has_sigma())
+    for (std::size_t k = 0; k < k_lines; ++k) scale[k] = std::numbers::sqrt2 / z.sigma[k];
+  s.dof = static_cast<int>(2 * k_lines) - kMotionalParamCount;
+
+  auto no_resonance = [&]() {
+    std::ostringstream os = Stream();
+    os << "no resonance found between " << f0_lo << " and " << f0_hi << " Hz";
+    return os.str();
+  };
+
+  // Start: coarse grid, then local refinements around the best cell.
+  VarProGrid grid(z.freq_hz, z.value, scale);
+  std::vector<double> f0s = LogSpace(f0_lo, f0_hi, options.grid_f0);
+  std::vector<double> qs = LogSpace(options.q_min, options.q_max, options.grid_q);
+  const double coarse_log_step = std::log(f0_hi / f0_lo) / (options.grid_f0 - 1);
+  int bi = -1, bj = -1;
+  GridPoint start = grid.Search(f0s, qs, &bi, &bj);
+  if (!start.ok) {
+    s.termination = "failed";
+    s.message = no_resonance() + ": no (f0, Q) grid point gives positive R, L and Rp";
+    return s;
+  }
+  for (int pass = 0; pass < kRefinePasses; ++pass) {
+    const double f_a = f0s[static_cast<std::size_t>(std::max(bi - 1, 0))];
+    const double f_b =
+        f0s[static_cast<std::size_t>(std::min(bi + 1, static_cast<int>(f0s.size()) - 1))];
+    const double q_a = qs[static_cast<std::size_t>(std::max(bj - 1, 0))];
+    const double q_b =
+        qs[static_cast<std::size_t>(std::min(bj + 1, static_cast<int>(qs.size()) - 1))];
+    f0s = LogSpace(f_a, f_b, kRefineSteps);
+    qs = LogSpace(q_a, q_b, kRefineSteps);
+    int ri = -1, rj = -1;
+    const GridPoint refined = grid.Search(f0s, qs, &ri, &rj);
+    if (!refined.ok || !(refined.chi2 < start.chi2)) break;
+    start = refined;
+    bi = ri;
+    bj = rj;
+  }
+
+  // Finish: Levenberg-Marquardt in theta = ln p.
+  MotionalImpedance p0;
+  p0.r_ohm = start.r_ohm;
+  p0.l_h = start.l_h;
+  p0.rp_ohm = start.rp_ohm;
+  p0.f0_hz = start.f0_hz;
+  p0.q = start.q;
+  Eigen::VectorXd theta = ToLogParams(p0);
+  MotionalFunctor functor{z.freq_hz, z.value, scale};
+  Eigen::LevenbergMarquardt<MotionalFunctor> lm(functor);
+  lm.parameters.ftol = kLmFtol;
+  lm.parameters.xtol = kLmXtol;
+  // Iterations are bounded below; this only stops a step search that never succeeds.
+  lm.parameters.maxfev = 20 * (options.max_iterations + 10);
+  using Eigen::LevenbergMarquardtSpace::Status;
+  Status status = lm.minimizeInit(theta);
+  if (status == Status::NotStarted) {
+    do {
+      status = lm.minimizeOneStep(theta);
+    } while (status == Status::Running && lm.iter - 1 < options.max_iterations);
+  }
+  s.iterations = static_cast<int>(lm.iter > 0 ? lm.iter - 1 : 0);
+  bool converged = false;
+  switch (status) {
+    case Status::RelativeReductionTooSmall:
+    case Status::RelativeErrorTooSmall:
+    case Status::RelativeErrorAndReductionTooSmall:
+    case Status::CosinusTooSmall:
+    // Tolerances below machine precision: no further improvement is possible, a solution.
+    case Status::FtolTooSmall:
+    case Status::XtolTooSmall:
+    case Status::GtolTooSmall:
+      s.termination = "converged";
+      converged = true;
+      break;
+    case Status::Running:
+    case Status::TooManyFunctionEvaluation:
+      s.termination = "max_iterations";
+      break;
+    default:
+      s.termination = "failed";
+      break;
+  }
+
+  const MotionalImpedance fit = FromLogParams(theta);
+  Eigen::VectorXd r;
+  Eigen::MatrixXd jacobian;
+  MotionalResidual(fit, z.freq_hz, z.value, scale, &r);
+  MotionalJacobian(fit, z.freq_hz, scale, &jacobian);
+  const double chi2_raw = r.squaredNorm();
+
+  // Noise scale: 1 with known sigma; estimated from the residual otherwise.
+  double noise_var = 1.0;
+  if (s.sigma_estimated) {
+    noise_var = chi2_raw / s.dof;
+    s.estimated_sigma = std::sqrt(noise_var);
+  }
+  s.chi2 = noise_var > 0.0 ? chi2_raw / noise_var : chi2_raw;
+  s.chi2_per_dof = s.chi2 / s.dof;
+
+  MotionalMatrix c_log = MotionalMatrix::Constant(std::numeric_limits<double>::quiet_NaN());
+  bool covariance_ok = false;
+  if (r.allFinite() && jacobian.allFinite()) {
+    const MotionalMatrix jtj = jacobian.transpose() * jacobian;
+    MotionalMatrix inverse;
+    if (InvertInformation(jtj, &inverse)) {
+      c_log = inverse * noise_var;
+      covariance_ok = c_log.allFinite();
+    }
+  }
+  const MotionalMatrix c_nat = LogToNaturalCovariance(fit, c_log);
+  const MotionalVector values = ToNaturalVector(fit);
+  s.params.resize(kMotionalParamCount);
+  for (int i = 0; i < kMotionalParamCount; ++i) {
+    FittedParameter& p = s.params[static_cast<std::size_t>(i)];
+    p.name = kMotionalParamNames[static_cast<std::size_t>(i)];
+    p.unit = kMotionalParamUnits[static_cast<std::size_t>(i)];
+    p.value = values[i];
+    p.sigma = covariance_ok ? std::sqrt(c_nat(i, i)) : std::numeric_limits<double>::quiet_NaN();
+  }
+  if (covariance_ok) s.covariance = c_nat;
+
+  std::ostringstream os = Stream();
+  if (!converged) {
+    os << (s.termination == "max_iterations" ? "Levenberg-Marquardt did not converge in "
+                                             : "Levenberg-Marquardt failed after ")
+       << s.iterations << " iterations (MINPACK status " << static_cast<int>(status)
+       << "); started from the grid at f0 = " << start.f0_hz << " Hz, Q = " << start.q;
+    s.message = os.str();
+    return s;
+  }
+  if (!covariance_ok || !values.allFinite()) {
+    os << "covariance is not finite at f0 = " << fit.f0_hz
+       << " Hz: the Jacobian is singular there, the parameters are not determined by the data";
+    s.message = os.str();
+    return s;
+  }
+  const double edge_lo = f0_lo * std::exp(coarse_log_step);
+  const double edge_hi = f0_hi * std::exp(-coarse_log_step);
+  if (!(fit.f0_hz >= edge_lo && fit.f0_hz <= edge_hi)) {
+    os << no_resonance() << ": the fit ended at f0 = " << fit.f0_hz
+       << " Hz, at or beyond the edge of the search range";
+    s.message = os.str();
+    return s;
+  }
+  const double rp_sigma = s.params[kParamRp].sigma;
+  if (!(fit.rp_ohm >= options.min_rp_significance * rp_sigma)) {
+    os << no_resonance() << ": the motional peak Rp = " << fit.rp_ohm << " +- " << rp_sigma
+       << " ohm is below " << options.min_rp_significance << " standard deviations";
+    s.message = os.str();
+    return s;
+  }
+
+  s.usable = true;
+  os << "converged in " << s.iterations << " iterations: f0 = " << fit.f0_hz << " +- "
+     << s.params[kParamF0].sigma << " Hz, Q = " << fit.q << " +- " << s.params[kParamQ].sigma
+     << ", chi2/dof = " << s.chi2_per_dof << " (dof " << s.dof << ")";
+  if (s.sigma_estimated) {
+    os << ". The frequency response carried no sigma: noise estimated from the residual as "
+       << s.estimated_sigma << " ohm per line (complex std), covariance scaled by it";
+  } else if (s.chi2_per_dof > 1.0 + 5.0 * std::sqrt(2.0 / s.dof)) {
+    os << ". chi2/dof is well above 1: the model does not explain the data within sigma "
+          "(an unmodelled effect, NOTES.md 5, or sigma underestimated)";
+  }
+  s.message = os.str();
+  return s;
+}
+
+}  // namespace eol::analysis

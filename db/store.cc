@@ -1,0 +1,532 @@
+#include "db/store.h"
+
+#include <sqlite3.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string_view>
+#include <utility>
+
+#include "db/clock.h"
+#include "db/schema.h"
+
+namespace eol::db {
+namespace {
+
+// How long a writer waits for another connection's lock before the operation fails.
+constexpr int kBusyTimeoutMs = 5000;
+constexpr int kMaxQueryLimit = 10000;
+// A curve's JSON beyond this size is a corrupt raw_size, not data (100k points are ~10 MB).
+constexpr sqlite3_int64 kMaxCurveJsonBytes = sqlite3_int64{1} << 30;
+constexpr const char* kInterruptedReason = "interrupted: station stopped before the test finished";
+
+std::string Message(const std::string& path, const std::string& op, const std::string& detail) {
+  return "store '" + path + "': " + op + ": " + detail;
+}
+
+// The connection's last error; for a lock, also how long SQLite was allowed to wait for it.
+[[noreturn]] void ThrowSqlite(sqlite3* db, const std::string& path, const std::string& op) {
+  std::string detail = sqlite3_errmsg(db);
+  const int rc = sqlite3_extended_errcode(db);
+  detail += " (sqlite code " + std::to_string(rc) + ")";
+  if ((rc & 0xff) == SQLITE_BUSY || (rc & 0xff) == SQLITE_LOCKED)
+    detail += "; busy timeout " + std::to_string(kBusyTimeoutMs) + " ms";
+  throw StoreError(Message(path, op, detail));
+}
+
+// Runs SQL without parameters (PRAGMAs with constant values, transaction control, DDL).
+void Exec(sqlite3* db, const std::string& path, const char* sql, const std::string& op) {
+  if (sqlite3_exec(db, sql, nullptr, nullptr, nullptr) != SQLITE_OK) ThrowSqlite(db, path, op);
+}
+
+// One prepared statement, finalised when it goes out of scope. Errors name `op`.
+class Statement {
+ public:
+  Statement(sqlite3* db, const std::string& path, std::string_view sql, std::string op)
+      : db_(db), path_(path), op_(std::move(op)) {
+    if (sqlite3_prepare_v2(db_, sql.data(), static_cast<int>(sql.size()), &stmt_, nullptr) !=
+        SQLITE_OK)
+      ThrowSqlite(db_, path_, op_);
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+
+  void BindNull(int i) { Check(sqlite3_bind_null(stmt_, i)); }
+  void BindInt(int i, std::int64_t v) { Check(sqlite3_bind_int64(stmt_, i, v)); }
+  // Not finite -> NULL, as in the record's JSON.
+  void BindReal(int i, double v) {
+    if (std::isfinite(v))
+      Check(sqlite3_bind_double(stmt_, i, v));
+    else
+      BindNull(i);
+  }
+  void BindReal(int i, const std::optional<double>& v) {
+    if (v)
+      BindReal(i, *v);
+    else
+      BindNull(i);
+  }
+  void BindText(int i, std::string_view v) {
+    // A null pointer would bind NULL; an empty string must stay an empty string.
+    Check(sqlite3_bind_text64(stmt_, i, v.data() != nullptr ? v.data() : "", v.size(),
+                              SQLITE_TRANSIENT, SQLITE_UTF8));
+  }
+  void BindBlob(int i, const void* data, std::size_t size) {
+    Check(sqlite3_bind_blob64(stmt_, i, data, size, SQLITE_TRANSIENT));
+  }
+
+  // True when a row is ready, false when the statement is done.
+  bool Step() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    ThrowSqlite(db_, path_, op_);
+  }
+  void Run() {
+    while (Step()) {
+    }
+  }
+  void Reset() {
+    sqlite3_reset(stmt_);
+    sqlite3_clear_bindings(stmt_);
+  }
+
+  bool IsNull(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_NULL; }
+  std::int64_t Int(int c) const { return sqlite3_column_int64(stmt_, c); }
+  std::optional<std::int64_t> OptInt(int c) const {
+    return IsNull(c) ? std::nullopt : std::optional<std::int64_t>(Int(c));
+  }
+  // NULL -> "".
+  std::string Text(int c) const {
+    const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(stmt_, c));
+    const int n = sqlite3_column_bytes(stmt_, c);
+    return p != nullptr ? std::string(p, static_cast<std::size_t>(n)) : std::string();
+  }
+  std::string_view Blob(int c) const {
+    const auto* p = static_cast<const char*>(sqlite3_column_blob(stmt_, c));
+    const int n = sqlite3_column_bytes(stmt_, c);
+    return p != nullptr ? std::string_view(p, static_cast<std::size_t>(n)) : std::string_view();
+  }
+
+ private:
+  void Check(int rc) {
+    if (rc != SQLITE_OK) ThrowSqlite(db_, path_, op_);
+  }
+
+  sqlite3* db_;
+  const std::string& path_;
+  std::string op_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+// BEGIN IMMEDIATE (takes the write lock now, so the transaction cannot fail half-way for a
+// lock); rolled back unless committed.
+class Transaction {
+ public:
+  Transaction(sqlite3* db, const std::string& path, std::string op)
+      : db_(db), path_(path), op_(std::move(op)) {
+    Exec(db_, path_, "BEGIN IMMEDIATE", op_ + ": begin transaction");
+  }
+  ~Transaction() {
+    if (!committed_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  }
+  Transaction(const Transaction&) = delete;
+  Transaction& operator=(const Transaction&) = delete;
+
+  // Durable when it returns (WAL with synchronous=FULL syncs the log on commit).
+  void Commit() {
+    Exec(db_, path_, "COMMIT", op_ + ": commit");
+    committed_ = true;
+  }
+
+ private:
+  sqlite3* db_;
+  const std::string& path_;
+  std::string op_;
+  bool committed_ = false;
+};
+
+// ---- Schema ------------------------------------------------------------------------------
+
+// kMigrations[n] takes the schema from user_version n to n + 1, inside the caller's
+// transaction. Append, never edit: see db/schema.h.
+using Migration = void (*)(sqlite3* db, const std::string& path);
+
+void MigrateTo1(sqlite3* db, const std::string& path) {
+  Exec(db, path, schema::kSchemaV1, "migrate the schema to version 1");
+}
+
+constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {&MigrateTo1};
+
+std::int64_t PragmaInt(sqlite3* db, const std::string& path, const char* sql,
+                       const std::string& op) {
+  Statement s(db, path, sql, op);
+  if (!s.Step()) throw StoreError(Message(path, op, "no result"));
+  return s.Int(0);
+}
+
+void Configure(sqlite3* db, const std::string& path) {
+  sqlite3_extended_result_codes(db, 1);
+  sqlite3_busy_timeout(db, kBusyTimeoutMs);
+  {
+    // The first statement reads the file: a file that is not a database fails here.
+    const std::string op = "open (PRAGMA journal_mode = WAL)";
+    Statement s(db, path, "PRAGMA journal_mode = WAL", op);
+    const std::string mode = s.Step() ? s.Text(0) : std::string();
+    if (mode != "wal")
+      throw StoreError(Message(path, op, "the journal mode stayed '" + mode + "', not 'wal'"));
+  }
+  Exec(db, path, "PRAGMA synchronous = FULL", "open (PRAGMA synchronous = FULL)");
+  Exec(db, path, "PRAGMA foreign_keys = ON", "open (PRAGMA foreign_keys = ON)");
+  if (PragmaInt(db, path, "PRAGMA foreign_keys", "open (PRAGMA foreign_keys)") != 1)
+    throw StoreError(Message(path, "open", "this SQLite cannot enforce foreign keys"));
+}
+
+// Refuses files that are not ours or were written by newer software.
+void CheckSchemaVersion(sqlite3* db, const std::string& path, std::int64_t version) {
+  const std::int64_t app_id =
+      PragmaInt(db, path, "PRAGMA application_id", "open (read the application id)");
+  if ((version > 0 && app_id != schema::kApplicationId) ||
+      (version == 0 && app_id != 0 && app_id != schema::kApplicationId))
+    throw StoreError(Message(path, "open",
+                             "not an EOL test store (application_id " + std::to_string(app_id) +
+                                 ", user_version " + std::to_string(version) + ")"));
+  if (version > Store::kSchemaVersion)
+    throw StoreError(Message(path, "open",
+                             "the file has schema version " + std::to_string(version) +
+                                 ", newer than this software knows (version " +
+                                 std::to_string(Store::kSchemaVersion) +
+                                 "); update the station software to use it"));
+}
+
+void Migrate(sqlite3* db, const std::string& path) {
+  constexpr const char* kReadVersion = "PRAGMA user_version";
+  const std::string op_read = "open (read the schema version)";
+  std::int64_t version = PragmaInt(db, path, kReadVersion, op_read);
+  CheckSchemaVersion(db, path, version);
+  if (version == Store::kSchemaVersion) return;
+
+  Transaction tx(db, path, "migrate the schema");
+  // Another connection may have migrated between the read above and the lock.
+  version = PragmaInt(db, path, kReadVersion, op_read);
+  CheckSchemaVersion(db, path, version);
+  if (version == Store::kSchemaVersion) return;
+  if (version == 0 &&
+      PragmaInt(db, path, "SELECT count(*) FROM sqlite_schema", "open (list the tables)") != 0)
+    throw StoreError(
+        Message(path, "open", "not an EOL test store (it has tables but no schema version)"));
+  for (std::int64_t v = version; v < Store::kSchemaVersion; ++v)
+    kMigrations[static_cast<std::size_t>(v)](db, path);
+  // PRAGMA values cannot be bound; both are compile-time constants.
+  const std::string set_ids = "PRAGMA application_id = " + std::to_string(schema::kApplicationId) +
+                              "; PRAGMA user_version = " + std::to_string(Store::kSchemaVersion);
+  Exec(db, path, set_ids.c_str(), "migrate the schema (set the version)");
+  tx.Commit();
+}
+
+int AbortUnfinished(sqlite3* db, const std::string& path) {
+  Statement s(db, path,
+              "UPDATE tests SET outcome = 'ABORTED', finished_at = ?1, reasons = ?2 "
+              "WHERE outcome = 'RUNNING'",
+              "open (mark unfinished tests ABORTED)");
+  s.BindText(1, UtcNowIso8601());
+  s.BindText(2, nlohmann::json::array({kInterruptedReason}).dump());
+  s.Run();
+  return sqlite3_changes(db);
+}
+
+// ---- Writing -----------------------------------------------------------------------------
+
+// Invalid UTF-8 in a string (a garbled barcode, a device's reply) must not lose the record.
+std::string Dump(const nlohmann::json& j) {
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+std::string Compress(const std::string& raw, const std::string& path, const std::string& op) {
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::string out(size, '\0');
+  const int rc = compress2(reinterpret_cast<Bytef*>(out.data()), &size,
+                           reinterpret_cast<const Bytef*>(raw.data()),
+                           static_cast<uLong>(raw.size()), Z_DEFAULT_COMPRESSION);
+  if (rc != Z_OK) throw StoreError(Message(path, op, std::string("zlib: ") + zError(rc)));
+  out.resize(size);
+  return out;
+}
+
+void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
+  const std::string op = "begin the test of serial '" + record.serial + "'";
+  if (record.serial.empty()) throw StoreError(Message(path, op, "record.serial is empty"));
+  if (record.started_at.empty()) throw StoreError(Message(path, op, "record.started_at is empty"));
+  Statement s(db, path, R"sql(
+    INSERT INTO tests (serial, station_id, recipe_id, recipe_version, recipe_hash,
+                       software_version, started_at, outcome, retest_of)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, 'RUNNING',
+            (SELECT min(id) FROM tests WHERE serial = ?1))
+    RETURNING id, retest_of)sql",
+              op);
+  s.BindText(1, record.serial);
+  s.BindText(2, record.station_id);
+  s.BindText(3, record.recipe_id);
+  s.BindInt(4, record.recipe_version);
+  s.BindText(5, record.recipe_hash);
+  s.BindText(6, record.software_version);
+  s.BindText(7, record.started_at);
+  if (!s.Step()) throw StoreError(Message(path, op, "the insert returned no id"));
+  const std::int64_t id = s.Int(0);
+  const std::optional<std::int64_t> retest_of = s.OptInt(1);
+  s.Run();  // completes the statement (and, outside a transaction, commits it)
+  record.id = id;
+  record.retest_of = retest_of;
+}
+
+// The caller holds the transaction.
+void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record) {
+  const std::string op = "finish test " + std::to_string(record.id);
+  if (record.finished_at.empty())
+    throw StoreError(Message(path, op, "record.finished_at is empty"));
+  nlohmann::json j = record;
+  j.erase("curves");  // stored compressed, one row each
+  {
+    Statement s(db, path,
+                "UPDATE tests SET outcome = ?2, finished_at = ?3, reasons = ?4, record = ?5 "
+                "WHERE id = ?1 AND outcome = 'RUNNING'",
+                op);
+    s.BindInt(1, record.id);
+    s.BindText(2, analysis::ToString(record.outcome));
+    s.BindText(3, record.finished_at);
+    s.BindText(4, Dump(nlohmann::json(record.reasons)));
+    s.BindText(5, Dump(j));
+    s.Run();
+  }
+  if (sqlite3_changes(db) != 1) {
+    Statement s(db, path, "SELECT outcome FROM tests WHERE id = ?1", op);
+    s.BindInt(1, record.id);
+    throw StoreError(Message(
+        path, op,
+        s.Step() ? "the test is " + s.Text(0) + ", not RUNNING (a test is finished only once)"
+                 : std::string("no such test (record.id must come from BeginTest)")));
+  }
+
+  Statement m(db, path, R"sql(
+    INSERT INTO measurements (test_id, name, value, sigma, unit, lo, hi, outcome, marginal)
+    VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9))sql",
+              op + " (write measurements)");
+  for (const analysis::Measurement& x : record.measurements) {
+    m.Reset();
+    m.BindInt(1, record.id);
+    m.BindText(2, x.name);
+    m.BindReal(3, x.value);
+    m.BindReal(4, x.sigma);
+    m.BindText(5, x.unit);
+    m.BindReal(6, x.limit.lo);
+    m.BindReal(7, x.limit.hi);
+    m.BindText(8, analysis::ToString(x.outcome));
+    m.BindInt(9, x.marginal ? 1 : 0);
+    m.Run();
+  }
+
+  const std::string curves_op = op + " (write curves)";
+  Statement c(db, path,
+              "INSERT INTO curves (test_id, name, raw_size, data) VALUES (?1, ?2, ?3, ?4)",
+              curves_op);
+  for (const Curve& curve : record.curves) {
+    const std::string raw = Dump(nlohmann::json(curve));
+    const std::string packed = Compress(raw, path, curves_op);
+    c.Reset();
+    c.BindInt(1, record.id);
+    c.BindText(2, curve.name);
+    c.BindInt(3, static_cast<std::int64_t>(raw.size()));
+    c.BindBlob(4, packed.data(), packed.size());
+    c.Run();
+  }
+}
+
+// ---- Reading -----------------------------------------------------------------------------
+
+constexpr std::string_view kSelectTests =
+    "SELECT id, serial, station_id, recipe_id, recipe_version, recipe_hash, software_version, "
+    "started_at, finished_at, outcome, retest_of, reasons, record FROM tests ";
+
+TestRecord RowToRecord(const Statement& s, const std::string& path) {
+  const std::int64_t id = s.Int(0);
+  const std::string op = "read test " + std::to_string(id);
+  TestRecord r;
+  try {
+    // An aborted test has no record JSON: its columns are all there is.
+    if (!s.IsNull(12)) r = nlohmann::json::parse(s.Text(12)).get<TestRecord>();
+    r.reasons = nlohmann::json::parse(s.Text(11)).get<std::vector<std::string>>();
+  } catch (const nlohmann::json::exception& e) {
+    throw StoreError(Message(path, op, std::string("stored JSON is not a record: ") + e.what()));
+  }
+  r.id = id;
+  r.serial = s.Text(1);
+  r.station_id = s.Text(2);
+  r.recipe_id = s.Text(3);
+  r.recipe_version = static_cast<int>(s.Int(4));
+  r.recipe_hash = s.Text(5);
+  r.software_version = s.Text(6);
+  r.started_at = s.Text(7);
+  r.finished_at = s.Text(8);
+  const std::string outcome = s.Text(9);
+  const std::optional<analysis::Outcome> parsed = analysis::ParseOutcome(outcome);
+  if (!parsed) throw StoreError(Message(path, op, "unknown outcome '" + outcome + "'"));
+  r.outcome = *parsed;
+  r.retest_of = s.OptInt(10);
+  r.curves.clear();
+  return r;
+}
+
+std::string Decompress(std::string_view packed, std::int64_t raw_size, const std::string& path,
+                       const std::string& op) {
+  if (raw_size < 0 || raw_size > kMaxCurveJsonBytes)
+    throw StoreError(Message(path, op, "implausible raw_size " + std::to_string(raw_size)));
+  std::string raw(static_cast<std::size_t>(raw_size), '\0');
+  uLongf size = static_cast<uLongf>(raw_size);
+  const int rc =
+      uncompress(reinterpret_cast<Bytef*>(raw.data()), &size,
+                 reinterpret_cast<const Bytef*>(packed.data()), static_cast<uLong>(packed.size()));
+  if (rc != Z_OK)
+    throw StoreError(
+        Message(path, op, std::string("corrupt curve data (zlib: ") + zError(rc) + ")"));
+  if (size != static_cast<uLongf>(raw_size))
+    throw StoreError(Message(path, op,
+                             "corrupt curve data (" + std::to_string(size) +
+                                 " bytes, raw_size says " + std::to_string(raw_size) + ")"));
+  return raw;
+}
+
+void LoadCurves(Statement& c, const std::string& path, TestRecord& r) {
+  c.Reset();
+  c.BindInt(1, r.id);
+  while (c.Step()) {
+    const std::string op = "read curve '" + c.Text(0) + "' of test " + std::to_string(r.id);
+    const std::string raw = Decompress(c.Blob(2), c.Int(1), path, op);
+    try {
+      r.curves.push_back(nlohmann::json::parse(raw).get<Curve>());
+    } catch (const nlohmann::json::exception& e) {
+      throw StoreError(Message(path, op, std::string("stored JSON is not a curve: ") + e.what()));
+    }
+  }
+}
+
+// Steps `s` (a kSelectTests query with its parameters bound) to the end.
+std::vector<TestRecord> ReadTests(sqlite3* db, const std::string& path, Statement& s,
+                                  bool with_curves) {
+  std::vector<TestRecord> out;
+  while (s.Step()) out.push_back(RowToRecord(s, path));
+  if (with_curves && !out.empty()) {
+    Statement c(db, path, "SELECT name, raw_size, data FROM curves WHERE test_id = ?1 ORDER BY id",
+                "read curves");
+    for (TestRecord& r : out) LoadCurves(c, path, r);
+  }
+  return out;
+}
+
+}  // namespace
+
+Store::Store(std::string path) : path_(std::move(path)) {}
+
+Store::~Store() { sqlite3_close_v2(db_); }
+
+std::unique_ptr<Store> Store::Open(const std::string& path, Role role) {
+  std::unique_ptr<Store> store(new Store(path));
+  const int rc = sqlite3_open_v2(path.c_str(), &store->db_,
+                                 SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  if (rc != SQLITE_OK) {
+    const std::string detail =
+        store->db_ != nullptr ? sqlite3_errmsg(store->db_) : sqlite3_errstr(rc);
+    throw StoreError(Message(path, "open", detail + " (sqlite code " + std::to_string(rc) + ")"));
+  }
+  // SQLite falls back to read-only when the file is write-protected; the station must write.
+  if (sqlite3_db_readonly(store->db_, "main") == 1)
+    throw StoreError(Message(path, "open", "the file is read-only"));
+  Configure(store->db_, path);
+  Migrate(store->db_, path);
+  if (role == Role::kWriter) store->aborted_on_open_ = AbortUnfinished(store->db_, path);
+  return store;
+}
+
+void Store::BeginTest(TestRecord& record) { InsertTestRow(db_, path_, record); }
+
+void Store::FinishTest(const TestRecord& record) {
+  Transaction tx(db_, path_, "finish test " + std::to_string(record.id));
+  WriteFinish(db_, path_, record);
+  tx.Commit();
+}
+
+void Store::Insert(TestRecord& record) {
+  // One transaction: an import is either fully there or not at all (never left RUNNING).
+  Transaction tx(db_, path_, "insert the test of serial '" + record.serial + "'");
+  const std::int64_t id = record.id;
+  const std::optional<std::int64_t> retest_of = record.retest_of;
+  try {
+    InsertTestRow(db_, path_, record);
+    WriteFinish(db_, path_, record);
+    tx.Commit();
+  } catch (...) {
+    // Rolled back: the record must not carry an id that is not in the file.
+    record.id = id;
+    record.retest_of = retest_of;
+    throw;
+  }
+}
+
+std::vector<TestRecord> Store::TestsOfSerial(const std::string& serial, bool with_curves) {
+  Statement s(db_, path_,
+              std::string(kSelectTests) +
+                  "WHERE serial = ?1 AND outcome <> 'RUNNING' ORDER BY started_at DESC, id DESC",
+              "tests of serial '" + serial + "'");
+  s.BindText(1, serial);
+  return ReadTests(db_, path_, s, with_curves);
+}
+
+std::optional<TestRecord> Store::LatestOfSerial(const std::string& serial) {
+  Statement s(db_, path_,
+              std::string(kSelectTests) +
+                  "WHERE serial = ?1 AND outcome <> 'RUNNING' "
+                  "ORDER BY started_at DESC, id DESC LIMIT 1",
+              "latest test of serial '" + serial + "'");
+  s.BindText(1, serial);
+  std::vector<TestRecord> found = ReadTests(db_, path_, s, /*with_curves=*/true);
+  if (found.empty()) return std::nullopt;
+  return std::move(found.front());
+}
+
+std::optional<TestRecord> Store::Test(std::int64_t id, bool with_curves) {
+  Statement s(db_, path_, std::string(kSelectTests) + "WHERE id = ?1 AND outcome <> 'RUNNING'",
+              "read test " + std::to_string(id));
+  s.BindInt(1, id);
+  std::vector<TestRecord> found = ReadTests(db_, path_, s, with_curves);
+  if (found.empty()) return std::nullopt;
+  return std::move(found.front());
+}
+
+std::vector<TestRecord> Store::Tests(const TestQuery& query) {
+  // Only fixed clauses are appended; every value is a bound parameter.
+  std::string sql = std::string(kSelectTests) + "WHERE outcome <> 'RUNNING'";
+  int n = 0;
+  const int from_i = query.from ? ++n : 0;
+  if (from_i) sql += " AND started_at >= ?" + std::to_string(from_i);
+  const int to_i = query.to ? ++n : 0;
+  if (to_i) sql += " AND started_at < ?" + std::to_string(to_i);
+  const int outcome_i = query.outcome ? ++n : 0;
+  if (outcome_i) sql += " AND outcome = ?" + std::to_string(outcome_i);
+  const int serial_i = query.serial ? ++n : 0;
+  if (serial_i) sql += " AND serial = ?" + std::to_string(serial_i);
+  const int limit_i = ++n;
+  sql += " ORDER BY started_at DESC, id DESC LIMIT ?" + std::to_string(limit_i);
+
+  Statement s(db_, path_, sql, "query tests");
+  if (from_i) s.BindText(from_i, *query.from);
+  if (to_i) s.BindText(to_i, *query.to);
+  if (outcome_i) s.BindText(outcome_i, analysis::ToString(*query.outcome));
+  if (serial_i) s.BindText(serial_i, *query.serial);
+  s.BindInt(limit_i, std::clamp(query.limit, 1, kMaxQueryLimit));
+  return ReadTests(db_, path_, s, query.with_curves);
+}
+
+}  // namespace eol::db

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Quick start 2: install what is missing (with the test peers), build with warnings as
+# errors, and run the whole test suite with CTest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash deploy/install-deps.sh --tests
+bash deploy/build.sh -DEOL_WERROR=ON
+cd build
+ctest --output-on-failure -j "$(nproc)" --timeout 900

@@ -1,0 +1,75 @@
+// `eol station --config FILE`: the station as a long-running daemon. Serials arrive over
+// HTTP (POST /api/tests) or, with "serial_from_stdin", from a scanner typing into stdin.
+// SIGTERM/SIGINT abort the test in flight safely (excitation off, safe state, stored as
+// ABORTED) and stop the daemon.
+#include <signal.h>
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+#include <thread>
+
+#include "station/cli/commands.h"
+#include "station/cli/common.h"
+#include "station/serial_number.h"
+#include "station/station.h"
+
+namespace eol::station::cli {
+namespace {
+
+int RunStation(const std::string& config_path, std::string web_root) {
+  // Block the stop signals in every thread; one thread waits for them with sigwait.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+
+  Station station(LoadStationConfig(config_path));
+  if (web_root.empty()) web_root = DefaultWebRoot();
+  station.StartHttp(web_root);
+  std::cout << "eol station: " << station.config().station_id << " ready, recipe "
+            << station.recipe().id << " v" << station.recipe().version << ", http://"
+            << station.config().http_listen << ":" << station.http_port() << "/" << std::endl;
+
+  std::thread signal_thread([&] {
+    int sig = 0;
+    sigwait(&stop_signals, &sig);
+    spdlog::warn("received {}: stopping (test in flight is aborted safely)",
+                 sig == SIGTERM ? "SIGTERM" : "SIGINT");
+    station.RequestStop(sig == SIGTERM ? "station stopping (SIGTERM)" : "station stopping (SIGINT)");
+  });
+  if (station.config().serial_from_stdin) {
+    std::thread([&station] {
+      std::string line;
+      while (std::getline(std::cin, line)) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        std::string why;
+        if (!ValidSerial(line, &why) || !station.Enqueue(line, &why))
+          spdlog::warn("serial '{}' refused: {}", line, why);
+      }
+    }).detach();
+  }
+  station.Serve();
+  // Serve() only returns after RequestStop(), i.e. after the signal thread ran.
+  signal_thread.join();
+  std::cout << "eol station: stopped" << std::endl;
+  return 0;
+}
+
+}  // namespace
+
+void AddStationCommand(CLI::App& app) {
+  auto config = std::make_shared<std::string>();
+  auto web_root = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand(
+      "station",
+      "Run the station as a daemon with the JSON config FILE (see deploy/station.json): serve\n"
+      "the HTTP API and operator page, test each serial that arrives, stop cleanly on SIGTERM.");
+  cmd->add_option("--config", *config, "Station config JSON")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--web-root", *web_root, "Folder of the operator page (default: built in)");
+  cmd->callback([config, web_root] {
+    RunGuarded("station", [&] { return RunStation(*config, *web_root); });
+  });
+}
+
+}  // namespace eol::station::cli

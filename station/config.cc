@@ -1,0 +1,68 @@
+#include "station/config.h"
+
+#include <filesystem>
+
+#include "drivers/json_config.h"
+
+namespace eol::station {
+namespace {
+
+std::string Resolve(const std::string& base_dir, const std::string& p) {
+  if (p.empty() || std::filesystem::path(p).is_absolute() || base_dir.empty()) return p;
+  return (std::filesystem::path(base_dir) / p).lexically_normal().string();
+}
+
+}  // namespace
+
+StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,
+                                 const std::string& base_dir) {
+  using drivers::JsonObject;
+  try {
+    const JsonObject root(j, "");
+    StationConfig c;
+    c.station_id = root.String("station_id", c.station_id);
+    c.recipe_path = Resolve(base_dir, root.RequiredString("recipe"));
+    c.db_path = Resolve(base_dir, root.RequiredString("db"));
+    if (auto http = root.OptionalObject("http")) {
+      c.http_listen = http->String("listen", c.http_listen);
+      c.http_port = http->Integer("port", c.http_port);
+      http->Require(c.http_port >= 0 && c.http_port <= 65535, "port", "must be in [0, 65535]");
+      if (auto tokens = http->OptionalObject("tokens")) {
+        c.operator_token = tokens->String("operator", "");
+        c.engineer_token = tokens->String("engineer", "");
+        tokens->RejectUnknown();
+      }
+      http->RejectUnknown();
+    }
+    if (auto s = root.OptionalObject("safety")) {
+      c.safety.watchdog_period_ms = s->Number("watchdog_period_ms", c.safety.watchdog_period_ms);
+      c.safety.heartbeat_timeout_ms =
+          s->Number("heartbeat_timeout_ms", c.safety.heartbeat_timeout_ms);
+      c.safety.poll_period_ms = s->Number("poll_period_ms", c.safety.poll_period_ms);
+      s->Require(c.safety.watchdog_period_ms >= 1 && c.safety.watchdog_period_ms <= 50,
+                 "watchdog_period_ms", "must be in [1, 50] ms (the reaction target is 50 ms)");
+      s->Require(c.safety.heartbeat_timeout_ms >= 600, "heartbeat_timeout_ms",
+                 "must be at least 600 ms (the heartbeat increments every 500 ms)");
+      s->Require(c.safety.poll_period_ms >= 1 && c.safety.poll_period_ms <= 500,
+                 "poll_period_ms", "must be in [1, 500] ms");
+      s->RejectUnknown();
+    }
+    c.serial_from_stdin = root.Bool("serial_from_stdin", false);
+    // The driver sections are validated by drivers::MakeDrivers; mark them known here.
+    c.drivers["fixture"] = root.Raw("fixture");
+    c.drivers["daq"] = root.Raw("daq");
+    if (root.Has("sim")) c.drivers["sim"] = root.Raw("sim");
+    root.RejectUnknown();
+    return c;
+  } catch (const drivers::ConfigError& e) {
+    throw drivers::ConfigError("config " + source + ": " + e.what());
+  }
+}
+
+StationConfig LoadStationConfig(const std::string& path) {
+  const nlohmann::json j = drivers::ReadJsonFile(path);
+  const std::string dir = std::filesystem::absolute(path).parent_path().string();
+  return ParseStationConfig(j, path, dir);
+}
+
+}  // namespace eol::station

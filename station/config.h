@@ -1,0 +1,47 @@
+// The station's configuration: one JSON file (deploy/station.json is the default).
+//
+// {
+//   "station_id": "eol-1",
+//   "recipe": "../recipes/pmsm-10pole.json",     relative paths are relative to this file
+//   "db": "/var/lib/eol/eol.sqlite",
+//   "http": {"listen": "127.0.0.1", "port": 8080,
+//            "tokens": {"operator": "...", "engineer": "..."}},   optional; writes need one
+//   "fixture": {"driver": "sim" | ...},              see drivers/factory.h
+//   "daq": {"driver": "sim" | ...},
+//   "sim": {...},                                    the simulated bench, when a driver is sim
+//   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500},
+//   "serial_from_stdin": false                       a scanner typing serials into stdin
+// }
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace eol::station {
+
+struct SafetyOptions {
+  double watchdog_period_ms = 5.0;     // interlock poll period during excitation
+  double heartbeat_timeout_ms = 1500;  // controller heartbeat must change within this
+  double poll_period_ms = 10.0;        // clamp/release confirmation polling
+};
+
+struct StationConfig {
+  std::string station_id = "eol-1";
+  std::string recipe_path;
+  std::string db_path;
+  std::string http_listen = "127.0.0.1";
+  int http_port = 8080;
+  std::string operator_token;  // empty: no token required
+  std::string engineer_token;
+  SafetyOptions safety;
+  bool serial_from_stdin = false;
+  nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}
+};
+
+// Throws drivers::ConfigError naming the file and the JSON path.
+StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,
+                                 const std::string& base_dir);
+StationConfig LoadStationConfig(const std::string& path);
+
+}  // namespace eol::station

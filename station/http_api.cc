@@ -1,0 +1,203 @@
+#include "station/http_api.h"
+
+#include <httplib.h>
+#include <spdlog/spdlog.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "db/store.h"
+#include "station/serial_number.h"
+
+namespace eol::station {
+namespace {
+
+constexpr std::size_t kMaxBody = 64 * 1024;
+
+void SendJson(httplib::Response& res, int status, const nlohmann::json& body) {
+  res.status = status;
+  res.set_content(body.dump(), "application/json");
+}
+
+void SendError(httplib::Response& res, int status, const std::string& code,
+               const std::string& message) {
+  SendJson(res, status, {{"error", {{"code", code}, {"message", message}}}});
+}
+
+std::string BearerToken(const httplib::Request& req) {
+  const std::string auth = req.get_header_value("Authorization");
+  const std::string prefix = "Bearer ";
+  return auth.rfind(prefix, 0) == 0 ? auth.substr(prefix.size()) : "";
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "";
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+HttpApi::HttpApi(StatusBoard& board, HttpOptions options, StartTest start_test)
+    : board_(board), options_(std::move(options)), start_test_(std::move(start_test)) {}
+
+HttpApi::~HttpApi() { Stop(); }
+
+void HttpApi::Start() {
+  db_ = db::Store::Open(options_.db_path, db::Store::Role::kReader);
+  server_ = std::make_unique<httplib::Server>();
+  server_->set_payload_max_length(kMaxBody);
+  server_->set_read_timeout(5, 0);
+  server_->set_write_timeout(5, 0);
+  Routes();
+  if (options_.port == 0) {
+    port_ = server_->bind_to_any_port(options_.listen.c_str());
+  } else {
+    port_ = server_->bind_to_port(options_.listen.c_str(), options_.port) ? options_.port : -1;
+  }
+  if (port_ <= 0)
+    throw std::runtime_error("http: cannot listen on " + options_.listen + ":" +
+                             std::to_string(options_.port) + " (address in use or not local)");
+  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  spdlog::info("http: serving on http://{}:{}/", options_.listen, port_);
+}
+
+void HttpApi::Stop() {
+  if (server_) server_->stop();
+  if (thread_.joinable()) thread_.join();
+}
+
+void HttpApi::Routes() {
+  httplib::Server& s = *server_;
+
+  s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
+    SendJson(res, 200, board_.Snapshot());
+  });
+
+  s.Get(R"(/api/units/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
+    const std::string serial = req.matches[1];
+    std::string why;
+    if (!ValidSerial(serial, &why)) return SendError(res, 400, "bad_serial", why);
+    std::vector<db::TestRecord> tests;
+    {
+      std::lock_guard<std::mutex> lock(db_mu_);
+      tests = db_->TestsOfSerial(serial, false);
+    }
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& t : tests) list.push_back(t);
+    SendJson(res, 200, {{"serial", serial}, {"tests", list}});
+  });
+
+  s.Get(R"(/api/tests/(\d+))", [this](const httplib::Request& req, httplib::Response& res) {
+    std::int64_t id = 0;
+    try {
+      id = std::stoll(req.matches[1]);
+    } catch (const std::exception&) {
+      return SendError(res, 400, "bad_id", "test id is not a number");
+    }
+    std::optional<db::TestRecord> t;
+    {
+      std::lock_guard<std::mutex> lock(db_mu_);
+      t = db_->Test(id, true);
+    }
+    if (!t) return SendError(res, 404, "not_found", "no finished test with id " + std::to_string(id));
+    SendJson(res, 200, *t);
+  });
+
+  s.Get("/api/tests", [this](const httplib::Request& req, httplib::Response& res) {
+    db::TestQuery q;
+    if (req.has_param("from")) q.from = req.get_param_value("from");
+    if (req.has_param("to")) q.to = req.get_param_value("to");
+    if (req.has_param("serial")) q.serial = req.get_param_value("serial");
+    if (req.has_param("verdict")) {
+      q.outcome = analysis::ParseOutcome(req.get_param_value("verdict"));
+      if (!q.outcome)
+        return SendError(res, 400, "bad_verdict", "verdict must be PASS, FAIL, ERROR or ABORTED");
+    }
+    if (req.has_param("limit")) {
+      try {
+        q.limit = std::stoi(req.get_param_value("limit"));
+      } catch (const std::exception&) {
+        return SendError(res, 400, "bad_limit", "limit must be a whole number");
+      }
+      if (q.limit < 1 || q.limit > 10000)
+        return SendError(res, 400, "bad_limit", "limit must be in [1, 10000]");
+    }
+    std::vector<db::TestRecord> tests;
+    {
+      std::lock_guard<std::mutex> lock(db_mu_);
+      tests = db_->Tests(q);
+    }
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& t : tests) list.push_back(t);
+    SendJson(res, 200, {{"tests", list}});
+  });
+
+  s.Post("/api/tests", [this](const httplib::Request& req, httplib::Response& res) {
+    if (!options_.operator_token.empty() || !options_.engineer_token.empty()) {
+      const std::string token = BearerToken(req);
+      const bool ok = !token.empty() &&
+                      (token == options_.operator_token || token == options_.engineer_token);
+      if (!ok) return SendError(res, 401, "unauthorized", "a valid bearer token is required");
+    }
+    nlohmann::json body;
+    try {
+      body = nlohmann::json::parse(req.body);
+    } catch (const std::exception&) {
+      return SendError(res, 400, "bad_json", "request body is not JSON");
+    }
+    if (!body.is_object() || !body.contains("serial") || !body["serial"].is_string())
+      return SendError(res, 400, "bad_serial", "body must be {\"serial\": \"...\"}");
+    const std::string serial = body["serial"].get<std::string>();
+    std::string why;
+    if (!ValidSerial(serial, &why)) return SendError(res, 400, "bad_serial", why);
+    if (!start_test_ || !start_test_(serial, &why)) return SendError(res, 409, "busy", why);
+    SendJson(res, 202, {{"serial", serial}, {"accepted", true}});
+  });
+
+  s.Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
+    auto last = std::make_shared<std::uint64_t>(board_.last_event());
+    res.set_header("Cache-Control", "no-cache");
+    res.set_chunked_content_provider(
+        "text/event-stream", [this, last](std::size_t, httplib::DataSink& sink) {
+          const auto events = board_.EventsAfter(*last, std::chrono::milliseconds(1000));
+          if (events.empty()) {
+            const std::string ping = ": keep-alive\n\n";
+            return sink.write(ping.data(), ping.size());
+          }
+          for (const auto& [seq, e] : events) {
+            const std::string msg = "id: " + std::to_string(seq) + "\nevent: " +
+                                    e.value("type", "message") + "\ndata: " + e.dump() + "\n\n";
+            if (!sink.write(msg.data(), msg.size())) return false;
+            *last = seq;
+          }
+          return true;
+        });
+  });
+
+  s.Get("/", [this](const httplib::Request&, httplib::Response& res) {
+    std::string page;
+    if (!options_.web_root.empty()) page = ReadFile(options_.web_root + "/index.html");
+    if (page.empty())
+      page = "<!doctype html><title>EOL station</title><h1>EOL station</h1>"
+             "<p>The operator page is not installed; see <a href=\"/api/status\">/api/status</a>.";
+    res.set_content(page, "text/html; charset=utf-8");
+  });
+  if (!options_.web_root.empty()) s.set_mount_point("/static", options_.web_root);
+
+  s.set_exception_handler([](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+    std::string what = "unknown";
+    try {
+      std::rethrow_exception(ep);
+    } catch (const std::exception& e) {
+      what = e.what();
+    } catch (...) {
+    }
+    spdlog::error("http: {} {}: {}", req.method, req.path, what);
+    SendError(res, 500, "internal", what);
+  });
+}
+
+}  // namespace eol::station

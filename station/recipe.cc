@@ -1,0 +1,160 @@
+#include "station/recipe.h"
+
+#include <openssl/evp.h>
+
+#include <algorithm>
+#include <cstdio>
+
+#include "analysis/qc/measurement_names.h"
+#include "drivers/json_config.h"
+
+namespace eol::station {
+namespace {
+
+using drivers::ConfigError;
+using drivers::JsonObject;
+
+void ParseExcitation(const JsonObject& e, Recipe& r) {
+  r.excitation.f_lo_hz = e.RequiredNumber("f_lo_hz");
+  r.excitation.f_hi_hz = e.RequiredNumber("f_hi_hz");
+  r.excitation.line_spacing_hz = e.RequiredNumber("line_spacing_hz");
+  r.excitation.sample_rate_hz = e.RequiredNumber("sample_rate_hz");
+  r.excitation.peak_v = e.RequiredNumber("peak_v");
+  r.excitation.crest_iterations = e.Integer("crest_iterations", r.excitation.crest_iterations);
+  const int periods = e.Integer("periods", 4);
+  const int transient = e.Integer("transient_periods", 1);
+  const int pair = e.Integer("phase_pair", 0);
+  e.Require(r.excitation.f_lo_hz > 0, "f_lo_hz", "must be positive");
+  e.Require(r.excitation.f_hi_hz > r.excitation.f_lo_hz, "f_hi_hz",
+            "must be greater than " + e.PathOf("f_lo_hz"));
+  e.Require(r.excitation.sample_rate_hz >= 2.5 * r.excitation.f_hi_hz, "sample_rate_hz",
+            "must be at least 2.5 x f_hi_hz (anti-alias margin)");
+  e.Require(r.excitation.peak_v > 0 && r.excitation.peak_v <= 50, "peak_v",
+            "must be in (0, 50] V");
+  e.Require(periods >= 2 && periods <= 1000, "periods", "must be in [2, 1000]");
+  e.Require(transient >= 0 && transient <= 100, "transient_periods", "must be in [0, 100]");
+  e.Require(pair >= 0 && pair <= 2, "phase_pair", "must be 0 (U-V), 1 (V-W) or 2 (W-U)");
+  std::string why;
+  e.Require(r.excitation.IsValid(&why), "line_spacing_hz", why);
+  r.periods = static_cast<std::size_t>(periods);
+  r.transient_periods = static_cast<std::size_t>(transient);
+  r.analysis.frf.transient_periods = r.transient_periods;
+  r.phase_pair = static_cast<drivers::PhasePair>(pair);
+  e.RejectUnknown();
+}
+
+void ParseFixture(const JsonObject& f, Recipe& r) {
+  const JsonObject p = f.Object("clamp_pressure_bar");
+  r.clamp_pressure_lo_bar = p.RequiredNumber("lo");
+  r.clamp_pressure_hi_bar = p.RequiredNumber("hi");
+  p.Require(r.clamp_pressure_lo_bar > 0, "lo", "must be positive");
+  p.Require(r.clamp_pressure_hi_bar > r.clamp_pressure_lo_bar, "hi",
+            "must be greater than " + p.PathOf("lo"));
+  p.RejectUnknown();
+  r.clamp_timeout_s = f.Number("clamp_timeout_s", r.clamp_timeout_s);
+  r.release_timeout_s = f.Number("release_timeout_s", r.release_timeout_s);
+  f.Require(r.clamp_timeout_s > 0 && r.clamp_timeout_s <= 60, "clamp_timeout_s",
+            "must be in (0, 60] s");
+  f.Require(r.release_timeout_s > 0 && r.release_timeout_s <= 60, "release_timeout_s",
+            "must be in (0, 60] s");
+  f.RejectUnknown();
+}
+
+void ParseAnalysis(const JsonObject& a, Recipe& r) {
+  analysis::ResonanceFitOptions& fit = r.analysis.fit;
+  fit.f0_min_hz = a.Number("f0_min_hz", r.excitation.f_lo_hz);
+  fit.f0_max_hz = a.Number("f0_max_hz", r.excitation.f_hi_hz);
+  fit.q_min = a.Number("q_min", fit.q_min);
+  fit.q_max = a.Number("q_max", fit.q_max);
+  a.Require(fit.f0_min_hz >= r.excitation.f_lo_hz, "f0_min_hz",
+            "must lie inside the excited band [f_lo_hz, f_hi_hz]");
+  a.Require(fit.f0_max_hz <= r.excitation.f_hi_hz && fit.f0_max_hz > fit.f0_min_hz, "f0_max_hz",
+            "must lie inside the excited band and above f0_min_hz");
+  a.Require(fit.q_min > 0 && fit.q_max > fit.q_min, "q_max", "must be above q_min > 0");
+  std::string why;
+  a.Require(fit.IsValid(&why), "f0_min_hz", why);
+  a.RejectUnknown();
+}
+
+void ParseLimits(const nlohmann::json& limits, const std::string& path, Recipe& r) {
+  if (!limits.is_array() || limits.empty())
+    throw ConfigError(path + ": must be a non-empty array of limits");
+  for (std::size_t i = 0; i < limits.size(); ++i) {
+    const JsonObject l(limits[i], path + "/" + std::to_string(i));
+    analysis::MeasurementSpec s;
+    s.name = l.RequiredString("name");
+    const auto& all = analysis::names::kAll;
+    std::string known;
+    for (auto n : all) known += (known.empty() ? "" : ", ") + std::string(n);
+    l.Require(std::find(all.begin(), all.end(), s.name) != all.end(), "name",
+              "is not a measurement the analysis produces (known: " + known + ")");
+    for (const auto& other : r.limits)
+      l.Require(other.name != s.name, "name", "is declared twice");
+    s.unit = l.String("unit", "");
+    s.doc = l.String("doc", "");
+    s.limit.lo = l.OptionalNumber("lo");
+    s.limit.hi = l.OptionalNumber("hi");
+    s.limit.marginal = l.Number("marginal", 0.0);
+    l.Require(s.limit.lo || s.limit.hi, "lo", "a limit needs lo, hi or both");
+    l.Require(!(s.limit.lo && s.limit.hi) || *s.limit.hi > *s.limit.lo, "hi",
+              "must be greater than lo");
+    l.Require(s.limit.marginal >= 0, "marginal", "must not be negative");
+    l.RejectUnknown();
+    r.limits.push_back(s);
+  }
+}
+
+}  // namespace
+
+std::string Sha256Hex(const std::string& data) {
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int len = 0;
+  if (EVP_Digest(data.data(), data.size(), digest, &len, EVP_sha256(), nullptr) != 1)
+    throw std::runtime_error("SHA-256 failed");
+  std::string hex;
+  char buf[3];
+  for (unsigned int i = 0; i < len; ++i) {
+    std::snprintf(buf, sizeof buf, "%02x", digest[i]);
+    hex += buf;
+  }
+  return hex;
+}
+
+std::string CanonicalHash(const nlohmann::json& j) { return Sha256Hex(j.dump()); }
+
+Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
+  try {
+    const JsonObject root(j, "");
+    Recipe r;
+    r.id = root.RequiredString("id");
+    root.Require(!r.id.empty() && r.id.size() <= 64, "id", "must be 1 to 64 characters");
+    r.version = root.Integer("version", 0);
+    root.Require(r.version >= 1, "version", "must be a whole number >= 1");
+    r.description = root.String("description", "");
+    const JsonObject motor = root.Object("motor");
+    r.poles = motor.Integer("poles", r.poles);
+    r.rotor_inertia_kg_m2 = motor.RequiredNumber("rotor_inertia_kg_m2");
+    motor.Require(r.poles >= 2 && r.poles % 2 == 0, "poles", "must be an even number >= 2");
+    motor.Require(r.rotor_inertia_kg_m2 > 0, "rotor_inertia_kg_m2", "must be positive");
+    motor.RejectUnknown();
+    ParseExcitation(root.Object("excitation"), r);
+    ParseFixture(root.Object("fixture"), r);
+    if (auto a = root.OptionalObject("analysis")) {
+      ParseAnalysis(*a, r);
+    } else {
+      r.analysis.fit.f0_min_hz = r.excitation.f_lo_hz;
+      r.analysis.fit.f0_max_hz = r.excitation.f_hi_hz;
+    }
+    ParseLimits(root.Raw("limits"), "/limits", r);
+    root.RejectUnknown();
+    r.source = j;
+    r.hash = CanonicalHash(j);
+    return r;
+  } catch (const ConfigError& e) {
+    throw ConfigError("recipe " + source + ": " + e.what());
+  }
+}
+
+Recipe LoadRecipe(const std::string& path) { return ParseRecipe(drivers::ReadJsonFile(path), path); }
+
+}  // namespace eol::station

@@ -1,0 +1,64 @@
+// A recipe: everything that is specific to one motor type, one JSON file in recipes/.
+//
+// {
+//   "id": "pmsm-10pole", "version": 1, "description": "...",
+//   "motor":      {"poles": 10, "rotor_inertia_kg_m2": 1.0e-4},
+//   "excitation": {"f_lo_hz": 200, "f_hi_hz": 800, "line_spacing_hz": 1, "sample_rate_hz": 8000,
+//                  "peak_v": 2.0, "periods": 4, "transient_periods": 1, "phase_pair": 0},
+//   "fixture":    {"clamp_pressure_bar": {"lo": 4.5, "hi": 6.5}, "clamp_timeout_s": 2.0,
+//                  "release_timeout_s": 2.0},
+//   "analysis":   {"f0_min_hz": 250, "f0_max_hz": 700, "q_min": 5, "q_max": 500},
+//   "limits": [ {"name": "resonance_f_hz", "unit": "Hz", "lo": 370, "hi": 420,
+//                "marginal": 3, "doc": "..."}, ... ]
+// }
+// Validated on load: every message names the JSON path and the rule broken, and a recipe
+// that fails validation is never used. The hash is the SHA-256 of the canonical JSON (keys
+// sorted, no whitespace), so formatting changes do not change it.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/impedance_analysis.h"
+#include "analysis/qc/measurement.h"
+#include "analysis/signal/multisine.h"
+#include "drivers/fixture/fixture.h"
+
+namespace eol::station {
+
+struct Recipe {
+  std::string id;
+  int version = 0;
+  std::string description;
+  std::string hash;  // SHA-256 hex of the canonical JSON
+
+  int poles = 10;
+  double rotor_inertia_kg_m2 = 0.0;  // the given J_r of the paper's eq. 24-30
+
+  analysis::MultisineOptions excitation;
+  std::size_t periods = 4;            // averaged
+  std::size_t transient_periods = 1;  // played first and dropped
+  drivers::PhasePair phase_pair = drivers::PhasePair::kUV;
+
+  double clamp_pressure_lo_bar = 4.5;
+  double clamp_pressure_hi_bar = 6.5;
+  double clamp_timeout_s = 2.0;
+  double release_timeout_s = 2.0;
+
+  analysis::ImpedanceAnalysisOptions analysis;
+  std::vector<analysis::MeasurementSpec> limits;
+
+  nlohmann::json source;  // the recipe as loaded
+};
+
+// Throws drivers::ConfigError with "<source>: <json path>: <rule>".
+Recipe ParseRecipe(const nlohmann::json& j, const std::string& source);
+Recipe LoadRecipe(const std::string& path);
+
+std::string Sha256Hex(const std::string& data);
+std::string CanonicalHash(const nlohmann::json& j);
+
+}  // namespace eol::station

@@ -1,0 +1,427 @@
+#include "station/sequencer.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <sstream>
+#include <thread>
+
+#include "analysis/impedance_analysis.h"
+#include "db/clock.h"
+#include "station/version.h"
+
+namespace eol::station {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using drivers::FixtureOutput;
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+db::Curve ToCurve(const analysis::Frf& z, const std::string& name) {
+  db::Curve c;
+  c.name = name;
+  c.unit = "ohm";
+  c.freq_hz = z.freq_hz;
+  for (const auto& v : z.value) {
+    c.re.push_back(v.real());
+    c.im.push_back(v.imag());
+  }
+  c.sigma = z.sigma;
+  return c;
+}
+
+nlohmann::json FitJson(const analysis::FitSummary& fit) {
+  nlohmann::json params = nlohmann::json::object();
+  for (const auto& p : fit.params)
+    params[p.name] = {{"value", p.value}, {"sigma", p.sigma}, {"unit", p.unit}};
+  return {{"model", fit.model},
+          {"usable", fit.usable},
+          {"termination", fit.termination},
+          {"message", fit.message},
+          {"params", params},
+          {"chi2", fit.chi2},
+          {"dof", fit.dof},
+          {"chi2_per_dof", fit.chi2_per_dof},
+          {"iterations", fit.iterations},
+          {"sigma_estimated", fit.sigma_estimated}};
+}
+
+}  // namespace
+
+const char* ToString(SeqState s) {
+  switch (s) {
+    case SeqState::kWaitSerial:
+      return "wait_serial";
+    case SeqState::kCheckInterlocks:
+      return "check_interlocks";
+    case SeqState::kClamp:
+      return "clamp";
+    case SeqState::kConfirmClamp:
+      return "confirm_clamp";
+    case SeqState::kExcite:
+      return "excite";
+    case SeqState::kAnalyse:
+      return "analyse";
+    case SeqState::kJudge:
+      return "judge";
+    case SeqState::kUnclamp:
+      return "unclamp";
+    case SeqState::kSafeState:
+      return "safe_state";
+    case SeqState::kStore:
+      return "store";
+    case SeqState::kPublish:
+      return "publish";
+  }
+  return "unknown";
+}
+
+bool HeartbeatMonitor::Update(std::uint32_t beat, Clock::time_point now) {
+  if (!last_ || *last_ != beat) {
+    last_ = beat;
+    changed_at_ = now;
+    return true;
+  }
+  return now - changed_at_ <= timeout_;
+}
+
+double HeartbeatMonitor::stale_ms(Clock::time_point now) const {
+  return std::chrono::duration<double, std::milli>(now - changed_at_).count();
+}
+
+std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& r, bool require_clamp) {
+  if (!in.estop_ok) return "emergency stop chain open";
+  if (!in.door_closed) return "door open";
+  if (!in.part_present) return "no part present";
+  if (require_clamp) {
+    if (!in.clamped) return "clamp not confirmed (clamped sensor off)";
+    if (in.clamp_pressure_bar < r.clamp_pressure_lo_bar ||
+        in.clamp_pressure_bar > r.clamp_pressure_hi_bar)
+      return "clamp pressure " + Fixed(in.clamp_pressure_bar, 2) + " bar outside " +
+             Fixed(r.clamp_pressure_lo_bar, 2) + ".." + Fixed(r.clamp_pressure_hi_bar, 2) +
+             " bar";
+  }
+  return "";
+}
+
+// A fault that ends the test: ERROR (station fault) or ABORTED (stop requested).
+struct Sequencer::Fault {
+  analysis::Outcome outcome;
+  std::string reason;
+};
+
+// Polls the interlocks while the stator is excited. On the first broken interlock it opens
+// the excitation relay itself (not waiting for the sequencer thread), then tells the DAQ
+// to stop through the shared abort flag.
+class Sequencer::Watchdog {
+ public:
+  Watchdog(Sequencer& seq) : seq_(seq), thread_([this] { Run(); }) {}
+  ~Watchdog() {
+    stop_ = true;
+    thread_.join();
+  }
+  std::optional<std::string> fault() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return fault_;
+  }
+
+ private:
+  void Run() {
+    const auto period = std::chrono::duration<double, std::milli>(seq_.options_.safety.watchdog_period_ms);
+    while (!stop_) {
+      std::string why;
+      auto in = seq_.fixture_.ReadInputs();
+      const auto now = Clock::now();
+      if (!in.ok()) {
+        why = "fixture not answering during excitation: " + in.status().message();
+      } else {
+        why = InterlockFault(in.value(), seq_.recipe_, true);
+        if (why.empty() && !seq_.heartbeat_.Update(in.value().heartbeat, now))
+          why = "fixture heartbeat frozen for " + Fixed(seq_.heartbeat_.stale_ms(now), 0) + " ms";
+      }
+      if (!why.empty()) {
+        const drivers::Status off = seq_.fixture_.Write(FixtureOutput::kExcitationEnable, false);
+        seq_.abort_.store(true);
+        spdlog::error("watchdog: {}; excitation off{}", why,
+                      off.ok() ? "" : " command failed (" + off.message() + ")");
+        std::lock_guard<std::mutex> lock(mu_);
+        fault_ = "interlock lost during excitation: " + why;
+        return;
+      }
+      std::this_thread::sleep_until(now + std::chrono::duration_cast<Clock::duration>(period));
+    }
+  }
+
+  Sequencer& seq_;
+  std::atomic<bool> stop_{false};
+  std::mutex mu_;
+  std::optional<std::string> fault_;
+  std::thread thread_;  // last: starts after the members it uses exist
+};
+
+Sequencer::Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& store,
+                     const Recipe& recipe, StatusBoard& board, SequencerOptions options)
+    : fixture_(fixture),
+      daq_(daq),
+      store_(store),
+      recipe_(recipe),
+      board_(board),
+      options_(std::move(options)),
+      excitation_(analysis::DesignMultisine(recipe.excitation)),
+      heartbeat_(std::chrono::milliseconds(
+          static_cast<long>(options_.safety.heartbeat_timeout_ms))) {}
+
+void Sequencer::RequestAbort(const std::string& why) {
+  {
+    std::lock_guard<std::mutex> lock(abort_mu_);
+    abort_reason_ = why;
+  }
+  stop_requested_.store(true);
+  abort_.store(true);
+  // Open the relay now; the sequencer thread will reach its safe state on its own.
+  (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
+}
+
+void Sequencer::ThrowIfAborted() {
+  if (!stop_requested_.load()) return;
+  std::lock_guard<std::mutex> lock(abort_mu_);
+  throw Fault{analysis::Outcome::kAborted, "aborted: " + abort_reason_};
+}
+
+void Sequencer::Enter(db::TestRecord& record, SeqState s, const std::string& detail) {
+  state_.store(s);
+  const double t_ms = std::chrono::duration<double, std::milli>(Clock::now() - test_start_).count();
+  record.trace.push_back({ToString(s), t_ms, detail});
+  spdlog::info("[{}] {}{}{}", record.serial, ToString(s), detail.empty() ? "" : ": ", detail);
+  board_.OnState(record.serial, ToString(s), detail);
+}
+
+drivers::FixtureInputs Sequencer::ReadInputs(const char* purpose) {
+  auto in = fixture_.ReadInputs();
+  if (!in.ok()) throw Fault{analysis::Outcome::kError, std::string(purpose) + ": " + in.status().message()};
+  return in.value();
+}
+
+void Sequencer::CheckInterlocks(db::TestRecord& record) {
+  Enter(record, SeqState::kCheckInterlocks);
+  // A fixture that failed earlier gets a fresh connection: the station recovers by itself.
+  if (fixture_.lifecycle() != drivers::Lifecycle::kInactive &&
+      fixture_.lifecycle() != drivers::Lifecycle::kActive) {
+    if (const drivers::Status s = fixture_.Connect(); !s.ok())
+      throw Fault{analysis::Outcome::kError, "fixture unavailable: " + s.message()};
+  }
+  if (daq_.lifecycle() != drivers::Lifecycle::kInactive) {
+    if (const drivers::Status s = daq_.Connect(); !s.ok())
+      throw Fault{analysis::Outcome::kError, "acquisition unavailable: " + s.message()};
+  }
+  const drivers::FixtureInputs in = ReadInputs("check interlocks");
+  if (!heartbeat_.Update(in.heartbeat, Clock::now()))
+    throw Fault{analysis::Outcome::kError,
+                "fixture heartbeat frozen for " + Fixed(heartbeat_.stale_ms(Clock::now()), 0) + " ms"};
+  if (const std::string why = InterlockFault(in, recipe_, false); !why.empty())
+    throw Fault{analysis::Outcome::kError, "interlock: " + why};
+}
+
+void Sequencer::ClampAndConfirm(db::TestRecord& record) {
+  Enter(record, SeqState::kClamp, "phase pair " + std::to_string(static_cast<int>(recipe_.phase_pair)));
+  if (const drivers::Status s = fixture_.Activate(); !s.ok())
+    throw Fault{analysis::Outcome::kError, s.message()};
+  if (const drivers::Status s = fixture_.SelectPhasePair(recipe_.phase_pair); !s.ok())
+    throw Fault{analysis::Outcome::kError, s.message()};
+  if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, true); !s.ok())
+    throw Fault{analysis::Outcome::kError, s.message()};
+
+  Enter(record, SeqState::kConfirmClamp);
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(recipe_.clamp_timeout_s));
+  const auto poll = std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms);
+  std::string why;
+  drivers::FixtureInputs in;
+  while (true) {
+    ThrowIfAborted();
+    in = ReadInputs("confirm clamp");
+    why = InterlockFault(in, recipe_, true);
+    if (why.empty()) break;
+    if (Clock::now() > deadline)
+      throw Fault{analysis::Outcome::kError, "clamp not confirmed within " +
+                                                 Fixed(recipe_.clamp_timeout_s, 1) + " s: " + why};
+    std::this_thread::sleep_for(poll);
+  }
+  record.conditions["clamp_pressure_bar"] = in.clamp_pressure_bar;
+  record.conditions["phase_pair"] = static_cast<int>(recipe_.phase_pair);
+}
+
+analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
+  Enter(record, SeqState::kExcite,
+        std::to_string(recipe_.transient_periods + recipe_.periods) + " periods of " +
+            Fixed(1.0 / excitation_.line_spacing_hz, 3) + " s");
+  // Re-check right before closing the relay: nothing may have changed since confirmation.
+  const drivers::FixtureInputs in = ReadInputs("interlocks before excitation");
+  if (const std::string why = InterlockFault(in, recipe_, true); !why.empty())
+    throw Fault{analysis::Outcome::kError, "interlock before excitation: " + why};
+  ThrowIfAborted();
+
+  drivers::AcquisitionRequest req;
+  req.sample_rate_hz = excitation_.sample_rate_hz;
+  req.period_samples = excitation_.period_samples;
+  req.excitation_v = excitation_.Repeat(recipe_.transient_periods + recipe_.periods);
+  record.conditions["excitation_peak_v"] = recipe_.excitation.peak_v;
+  record.conditions["crest_factor"] = excitation_.crest_factor;
+  record.conditions["line_spacing_hz"] = excitation_.line_spacing_hz;
+  record.conditions["sample_rate_hz"] = excitation_.sample_rate_hz;
+
+  std::optional<drivers::StatusOr<analysis::Recording>> result;
+  std::optional<std::string> watchdog_fault;
+  {
+    Watchdog watchdog(*this);
+    if (const drivers::Status s = fixture_.Write(FixtureOutput::kExcitationEnable, true); !s.ok()) {
+      (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
+      throw Fault{analysis::Outcome::kError, s.message()};
+    }
+    result.emplace(daq_.Acquire(req, abort_));
+    (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
+    watchdog_fault = watchdog.fault();
+  }
+  record.calibration = {{"shunt_ohm", daq_.calibration().shunt_ohm},
+                        {"divider_ratio", daq_.calibration().divider_ratio},
+                        {"channel_delay_s", daq_.calibration().channel_delay_s},
+                        {"method", daq_.calibration().method},
+                        {"daq", daq_.name()}};
+  if (watchdog_fault) throw Fault{analysis::Outcome::kError, *watchdog_fault};
+  ThrowIfAborted();
+  if (!result->ok())
+    throw Fault{analysis::Outcome::kError, "acquisition failed: " + result->status().message()};
+  return std::move(result->value());
+}
+
+void Sequencer::AnalyseAndJudge(db::TestRecord& record, const analysis::Recording& recording) {
+  Enter(record, SeqState::kAnalyse);
+  const analysis::ImpedanceAnalysis a =
+      analysis::AnalyzeRecording(recording, excitation_.lines, recipe_.analysis);
+  if (a.frf.frf.size() > 0) record.curves.push_back(ToCurve(a.frf.frf, "impedance"));
+  record.conditions["periods_used"] = a.frf.periods_used;
+  if (!a.fit.params.empty()) {
+    record.fit = FitJson(a.fit);
+    record.curves.push_back(ToCurve(a.fit.Model().Evaluate(a.frf.frf.freq_hz), "model"));
+  }
+  if (!a.usable) throw Fault{analysis::Outcome::kError, a.message};
+
+  Enter(record, SeqState::kJudge);
+  const analysis::Verdict v = analysis::Judge(recipe_.limits, a.values);
+  record.outcome = v.outcome;
+  record.reasons = v.reasons;
+  record.measurements = v.measurements;
+}
+
+void Sequencer::Unclamp(db::TestRecord& record) {
+  Enter(record, SeqState::kUnclamp);
+  if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false); !s.ok())
+    throw Fault{analysis::Outcome::kError, "unclamp: " + s.message()};
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(recipe_.release_timeout_s));
+  while (!ReadInputs("confirm release").released) {
+    if (Clock::now() > deadline)
+      throw Fault{analysis::Outcome::kError,
+                  "clamp not released within " + Fixed(recipe_.release_timeout_s, 1) + " s"};
+    std::this_thread::sleep_for(
+        std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
+  }
+  (void)fixture_.Deactivate();
+}
+
+void Sequencer::SafeState(db::TestRecord& record) {
+  Enter(record, SeqState::kSafeState, record.reasons.empty() ? "" : record.reasons.front());
+  // 1. Excitation off, always first, whatever state the fixture is in.
+  if (const drivers::Status s = fixture_.Write(FixtureOutput::kExcitationEnable, false); !s.ok())
+    record.reasons.push_back("excitation-off command failed: " + s.message() +
+                             " (the relay is wired to drop on controller loss)");
+  // 2. Unclamp only when it is safe: the controller answers, nobody is at the door, the
+  //    emergency-stop chain is healthy. Otherwise leave the part clamped and say so.
+  auto in = fixture_.ReadInputs();
+  std::string unsafe;
+  if (!in.ok()) unsafe = "fixture not answering";
+  else if (!in.value().estop_ok) unsafe = "emergency stop open";
+  else if (!in.value().door_closed) unsafe = "door open";
+  if (!unsafe.empty()) {
+    record.reasons.push_back("clamp left as it is: " + unsafe);
+  } else {
+    (void)fixture_.Activate();
+    const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false);
+    if (!s.ok()) record.reasons.push_back("unclamp failed: " + s.message());
+  }
+  (void)fixture_.Deactivate();
+}
+
+void Sequencer::StoreAndPublish(db::TestRecord& record) {
+  Enter(record, SeqState::kStore, analysis::ToString(record.outcome));
+  record.finished_at = db::UtcNowIso8601();
+  try {
+    store_.FinishTest(record);
+  } catch (const std::exception& e) {
+    // Not stored: never show the motor's verdict; the station failed.
+    spdlog::error("[{}] record not stored: {}", record.serial, e.what());
+    record.outcome = analysis::Outcome::kError;
+    record.reasons.insert(record.reasons.begin(), std::string("record not stored: ") + e.what());
+  }
+  Enter(record, SeqState::kPublish, analysis::ToString(record.outcome));
+  board_.OnVerdict(record);
+  const bool pass = record.outcome == analysis::Outcome::kPass;
+  (void)fixture_.Write(FixtureOutput::kLampPass, pass);
+  (void)fixture_.Write(FixtureOutput::kLampFail, !pass);
+}
+
+db::TestRecord Sequencer::RunTest(const std::string& serial) {
+  test_start_ = Clock::now();
+  abort_.store(stop_requested_.load());
+  db::TestRecord record;
+  record.serial = serial;
+  record.station_id = options_.station_id;
+  record.recipe_id = recipe_.id;
+  record.recipe_version = recipe_.version;
+  record.recipe_hash = recipe_.hash;
+  record.software_version = SoftwareVersion();
+  record.started_at = db::UtcNowIso8601();
+  record.outcome = analysis::Outcome::kError;
+  Enter(record, SeqState::kWaitSerial, "serial " + serial + " received");
+
+  try {
+    store_.BeginTest(record);
+  } catch (const std::exception& e) {
+    // No durable record possible: do not clamp, do not excite.
+    record.reasons = {std::string("database unavailable, test not started: ") + e.what()};
+    Enter(record, SeqState::kPublish, "ERROR");
+    board_.OnVerdict(record);
+    Enter(record, SeqState::kWaitSerial);
+    return record;
+  }
+
+  try {
+    ThrowIfAborted();
+    if (options_.on_serial) options_.on_serial(serial);
+    CheckInterlocks(record);
+    ClampAndConfirm(record);
+    const analysis::Recording recording = ExciteAndRecord(record);
+    AnalyseAndJudge(record, recording);
+    Unclamp(record);
+  } catch (const Fault& f) {
+    record.outcome = f.outcome;
+    record.reasons.insert(record.reasons.begin(), f.reason);
+    SafeState(record);
+  } catch (const std::exception& e) {
+    record.outcome = analysis::Outcome::kError;
+    record.reasons.insert(record.reasons.begin(), std::string("internal error: ") + e.what());
+    SafeState(record);
+  }
+  StoreAndPublish(record);
+  Enter(record, SeqState::kWaitSerial);
+  return record;
+}
+
+}  // namespace eol::station

@@ -1,0 +1,120 @@
+// The one path every test takes (ARCHITECTURE.md), as explicit, logged states:
+//
+//   wait_serial -> check_interlocks -> clamp -> confirm_clamp -> excite -> analyse -> judge
+//     -> unclamp -> store -> publish -> wait_serial
+//   any fault:  -> safe_state (excitation off first; unclamp only when that is safe)
+//               -> store (ERROR or ABORTED with the cause) -> publish
+//
+// Safety: the excitation relay is closed only after the clamp is confirmed with the pressure
+// in the recipe's window, the door closed, the emergency stop healthy and the controller's
+// heartbeat alive; a watchdog thread re-checks all of them every watchdog_period_ms while
+// the stator is excited and opens the relay the moment one drops. ERROR is never a PASS,
+// and the verdict is published only after the record is durably stored.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "analysis/signal/multisine.h"
+#include "db/store.h"
+#include "db/test_record.h"
+#include "drivers/daq/daq.h"
+#include "drivers/fixture/fixture.h"
+#include "station/config.h"
+#include "station/recipe.h"
+#include "station/status_board.h"
+
+namespace eol::station {
+
+enum class SeqState {
+  kWaitSerial,
+  kCheckInterlocks,
+  kClamp,
+  kConfirmClamp,
+  kExcite,
+  kAnalyse,
+  kJudge,
+  kUnclamp,
+  kSafeState,
+  kStore,
+  kPublish,
+};
+const char* ToString(SeqState s);
+
+// Tracks the fixture controller's heartbeat counter: alive while it keeps changing.
+class HeartbeatMonitor {
+ public:
+  explicit HeartbeatMonitor(std::chrono::milliseconds timeout) : timeout_(timeout) {}
+  // Returns false once the counter has not changed for longer than the timeout.
+  bool Update(std::uint32_t beat, std::chrono::steady_clock::time_point now);
+  double stale_ms(std::chrono::steady_clock::time_point now) const;
+
+ private:
+  std::chrono::milliseconds timeout_;
+  std::optional<std::uint32_t> last_;
+  std::chrono::steady_clock::time_point changed_at_{};
+};
+
+// Empty when every interlock for exciting the stator holds; otherwise the first one broken,
+// named with its value ("door open", "clamp pressure 3.10 bar outside 4.50..6.50 bar").
+std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& recipe,
+                           bool require_clamp);
+
+struct SequencerOptions {
+  std::string station_id = "eol-1";
+  SafetyOptions safety;
+  // Called with the serial before the interlock check (the simulated operator loads a part).
+  std::function<void(const std::string& serial)> on_serial;
+};
+
+class Sequencer {
+ public:
+  Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& store, const Recipe& recipe,
+            StatusBoard& board, SequencerOptions options);
+  Sequencer(const Sequencer&) = delete;
+  Sequencer& operator=(const Sequencer&) = delete;
+
+  // Runs one test to its end and returns the stored record. Never throws for station,
+  // fixture, acquisition or data faults: they end as ERROR with the cause in reasons.
+  db::TestRecord RunTest(const std::string& serial);
+  // Thread-safe: aborts the test in flight (excitation off, safe state, outcome ABORTED).
+  void RequestAbort(const std::string& why);
+  SeqState state() const { return state_.load(); }
+
+ private:
+  struct Fault;
+  class Watchdog;
+
+  void Enter(db::TestRecord& record, SeqState s, const std::string& detail = "");
+  drivers::FixtureInputs ReadInputs(const char* purpose);
+  void CheckInterlocks(db::TestRecord& record);
+  void ClampAndConfirm(db::TestRecord& record);
+  analysis::Recording ExciteAndRecord(db::TestRecord& record);
+  void AnalyseAndJudge(db::TestRecord& record, const analysis::Recording& recording);
+  void Unclamp(db::TestRecord& record);
+  void SafeState(db::TestRecord& record);
+  void StoreAndPublish(db::TestRecord& record);
+  void ThrowIfAborted();
+
+  drivers::Fixture& fixture_;
+  drivers::Daq& daq_;
+  db::Store& store_;
+  const Recipe& recipe_;
+  StatusBoard& board_;
+  SequencerOptions options_;
+  const analysis::Excitation excitation_;
+  HeartbeatMonitor heartbeat_;
+
+  std::atomic<SeqState> state_{SeqState::kWaitSerial};
+  std::atomic<bool> stop_requested_{false};  // sticky: RequestAbort() was called
+  std::atomic<bool> abort_{false};  // read by the DAQ: stop playing now (reset per test)
+  std::mutex abort_mu_;
+  std::string abort_reason_;
+  std::chrono::steady_clock::time_point test_start_{};
+};
+
+}  // namespace eol::station

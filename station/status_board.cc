@@ -1,0 +1,93 @@
+#include "station/status_board.h"
+
+namespace eol::station {
+
+nlohmann::json RecordSummary(const db::TestRecord& r) {
+  return {{"id", r.id},
+          {"serial", r.serial},
+          {"outcome", analysis::ToString(r.outcome)},
+          {"reasons", r.reasons},
+          {"measurements", r.measurements},
+          {"started_at", r.started_at},
+          {"finished_at", r.finished_at},
+          {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}}};
+}
+
+StatusBoard::StatusBoard(std::string station_id, std::string recipe_id, std::string recipe_hash)
+    : station_id_(std::move(station_id)),
+      recipe_id_(std::move(recipe_id)),
+      recipe_hash_(std::move(recipe_hash)) {}
+
+void StatusBoard::PushEventLocked(nlohmann::json event) {
+  events_.emplace_back(next_event_++, std::move(event));
+  while (events_.size() > 256) events_.pop_front();
+  cv_.notify_all();
+}
+
+void StatusBoard::OnState(const std::string& serial, const std::string& state,
+                          const std::string& detail) {
+  std::lock_guard<std::mutex> lock(mu_);
+  state_ = state;
+  serial_ = serial;
+  detail_ = detail;
+  PushEventLocked({{"type", "state"}, {"state", state}, {"serial", serial}, {"detail", detail}});
+}
+
+void StatusBoard::OnVerdict(const db::TestRecord& record) {
+  std::lock_guard<std::mutex> lock(mu_);
+  last_ = RecordSummary(record);
+  recent_.push_front(last_);
+  while (recent_.size() > 20) recent_.pop_back();
+  switch (record.outcome) {
+    case analysis::Outcome::kPass:
+      ++pass_;
+      break;
+    case analysis::Outcome::kFail:
+      ++fail_;
+      break;
+    case analysis::Outcome::kError:
+      ++error_;
+      break;
+    case analysis::Outcome::kAborted:
+      ++aborted_;
+      break;
+  }
+  PushEventLocked({{"type", "verdict"}, {"record", last_}});
+}
+
+void StatusBoard::SetMessage(const std::string& message) {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (message == message_) return;
+  message_ = message;
+  PushEventLocked({{"type", "message"}, {"message", message}});
+}
+
+nlohmann::json StatusBoard::Snapshot() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return {{"station_id", station_id_},
+          {"state", state_},
+          {"serial", serial_},
+          {"detail", detail_},
+          {"message", message_},
+          {"recipe", {{"id", recipe_id_}, {"hash", recipe_hash_}}},
+          {"counts", {{"pass", pass_}, {"fail", fail_}, {"error", error_}, {"aborted", aborted_}}},
+          {"last", last_},
+          {"recent", recent_}};
+}
+
+std::vector<std::pair<std::uint64_t, nlohmann::json>> StatusBoard::EventsAfter(
+    std::uint64_t after, std::chrono::milliseconds wait) const {
+  std::unique_lock<std::mutex> lock(mu_);
+  cv_.wait_for(lock, wait, [&] { return next_event_ - 1 > after; });
+  std::vector<std::pair<std::uint64_t, nlohmann::json>> out;
+  for (const auto& e : events_)
+    if (e.first > after) out.push_back(e);
+  return out;
+}
+
+std::uint64_t StatusBoard::last_event() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return next_event_ - 1;
+}
+
+}  // namespace eol::station

@@ -1,0 +1,65 @@
+// What the station publishes: its live state and finished verdicts. The sequencer writes
+// here only after the record is stored; the HTTP API, the event stream and the operator page
+// read from here. Thread-safe.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "db/test_record.h"
+
+namespace eol::station {
+
+class StatusBoard {
+ public:
+  explicit StatusBoard(std::string station_id, std::string recipe_id = "",
+                       std::string recipe_hash = "");
+
+  // A sequencer state was entered.
+  void OnState(const std::string& serial, const std::string& state, const std::string& detail);
+  // A finished, stored record.
+  void OnVerdict(const db::TestRecord& record);
+  // Free text for the operator ("locked out: ...", "fixture not answering").
+  void SetMessage(const std::string& message);
+
+  // {"station_id", "state", "serial", "detail", "message", "recipe": {...}, "counts": {...},
+  //  "last": {serial, outcome, reasons, measurements, finished_at, id} | null,
+  //  "recent": [...]}
+  nlohmann::json Snapshot() const;
+
+  // Events (state changes and verdicts) with increasing sequence numbers. Blocks up to
+  // `wait` for an event newer than `after`; returns those still held (the last 256).
+  std::vector<std::pair<std::uint64_t, nlohmann::json>> EventsAfter(
+      std::uint64_t after, std::chrono::milliseconds wait) const;
+  std::uint64_t last_event() const;
+
+ private:
+  void PushEventLocked(nlohmann::json event);
+
+  const std::string station_id_;
+  const std::string recipe_id_;
+  const std::string recipe_hash_;
+  mutable std::mutex mu_;
+  mutable std::condition_variable cv_;
+  std::string state_ = "idle";
+  std::string serial_;
+  std::string detail_;
+  std::string message_;
+  nlohmann::json last_;  // null until the first verdict
+  std::deque<nlohmann::json> recent_;
+  std::uint64_t pass_ = 0, fail_ = 0, error_ = 0, aborted_ = 0;
+  std::deque<std::pair<std::uint64_t, nlohmann::json>> events_;
+  std::uint64_t next_event_ = 1;
+};
+
+// The summary of a record that the display and the status show (no curves).
+nlohmann::json RecordSummary(const db::TestRecord& record);
+
+}  // namespace eol::station

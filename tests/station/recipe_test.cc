@@ -1,0 +1,98 @@
+// Recipes: the shipped recipe loads; every malformed recipe is refused with a message that
+// names the JSON path and the rule; the hash ignores formatting but not content.
+#include "station/recipe.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "drivers/json_config.h"
+#include "../support/child_process.h"
+
+namespace eol::station {
+namespace {
+
+const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json";
+
+nlohmann::json Good() { return drivers::ReadJsonFile(kRecipe); }
+
+std::string ErrorOf(const nlohmann::json& j) {
+  try {
+    ParseRecipe(j, "test.json");
+  } catch (const drivers::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Recipe, ShippedRecipeLoads) {
+  const Recipe r = LoadRecipe(kRecipe);
+  EXPECT_EQ(r.id, "pmsm-10pole");
+  EXPECT_EQ(r.version, 1);
+  EXPECT_EQ(r.hash.size(), 64u);
+  EXPECT_FALSE(r.limits.empty());
+  EXPECT_DOUBLE_EQ(r.analysis.fit.f0_min_hz, 250.0);
+}
+
+TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
+  struct Case {
+    std::function<void(nlohmann::json&)> edit;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {[](auto& j) { j["excitation"]["f_hi_hz"] = 100; },
+       "test.json: /excitation/f_hi_hz: must be greater than /excitation/f_lo_hz (got 100)"},
+      {[](auto& j) { j["excitation"].erase("peak_v"); }, "/excitation/peak_v: missing (required)"},
+      {[](auto& j) { j["excitation"]["peak_v"] = "two"; },
+       "/excitation/peak_v: must be a number (got \"two\")"},
+      {[](auto& j) { j["excitation"]["periods"] = 1; }, "/excitation/periods: must be in [2, 1000]"},
+      {[](auto& j) { j["fixture"]["clamp_pressure_bar"]["hi"] = 1.0; },
+       "/fixture/clamp_pressure_bar/hi: must be greater than /fixture/clamp_pressure_bar/lo"},
+      {[](auto& j) { j["limits"][0]["name"] = "resonance_hz"; },
+       "/limits/0/name: is not a measurement the analysis produces"},
+      {[](auto& j) { j["limits"][1]["lo"] = 500; }, "/limits/1/hi: must be greater than lo"},
+      {[](auto& j) { j["limits"] = nlohmann::json::array(); },
+       "/limits: must be a non-empty array of limits"},
+      {[](auto& j) { j["excitaton"] = nlohmann::json::object(); }, "/excitaton: unknown field"},
+      {[](auto& j) { j["motor"]["poles"] = 9; }, "/motor/poles: must be an even number >= 2"},
+      {[](auto& j) { j["analysis"]["f0_max_hz"] = 900; },
+       "/analysis/f0_max_hz: must lie inside the excited band"},
+      {[](auto& j) { j["version"] = 0; }, "/version: must be a whole number >= 1"},
+  };
+  for (const Case& c : cases) {
+    nlohmann::json j = Good();
+    c.edit(j);
+    const std::string err = ErrorOf(j);
+    EXPECT_NE(err.find(c.expected), std::string::npos) << "got: " << err << "\nwant: " << c.expected;
+  }
+}
+
+TEST(Recipe, SyntaxErrorNamesTheFile) {
+  eol::testing::TempDir dir;
+  const std::string path = dir / "broken.json";
+  std::ofstream(path) << "{\"id\": \"x\", ";
+  try {
+    LoadRecipe(path);
+    FAIL() << "a broken file was accepted";
+  } catch (const drivers::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": not valid JSON"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Recipe, HashIgnoresFormattingButNotContent) {
+  const nlohmann::json j = Good();
+  const Recipe a = ParseRecipe(j, "a");
+  const Recipe b = ParseRecipe(nlohmann::json::parse(j.dump(4)), "b");
+  EXPECT_EQ(a.hash, b.hash);
+  nlohmann::json changed = j;
+  changed["limits"][0]["lo"] = 371;
+  EXPECT_NE(ParseRecipe(changed, "c").hash, a.hash);
+}
+
+TEST(Recipe, Sha256KnownAnswer) {
+  // FIPS 180-2 test vector.
+  EXPECT_EQ(Sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+}
+
+}  // namespace
+}  // namespace eol::station

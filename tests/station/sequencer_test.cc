@@ -1,0 +1,210 @@
+// The sequencer on the simulated bench with a real SQLite file: verdicts match the truth,
+// every fault ends as ERROR (never PASS) with the cause stored and the excitation off, and
+// the station recovers by itself once the fault clears.
+#include "station/sequencer.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+
+#include "analysis/qc/measurement_names.h"
+#include "drivers/daq/sim_daq.h"
+#include "drivers/fixture/sim_fixture.h"
+#include "../support/child_process.h"
+
+namespace eol::station {
+namespace {
+
+using analysis::Outcome;
+using drivers::FixtureOutput;
+using drivers::SimFault;
+using namespace std::chrono_literals;
+
+class SequencerTest : public ::testing::Test {
+ protected:
+  void Build(double time_scale) {
+    drivers::SimBenchSettings bench_settings;
+    bench_settings.clamp_close_s = 0.05;
+    bench_settings.clamp_open_s = 0.03;
+    bench_ = std::make_shared<drivers::SimBench>(bench_settings);
+    fixture_ = std::make_unique<drivers::SimFixture>(bench_);
+    drivers::SimDaqSettings daq_settings;
+    daq_settings.time_scale = time_scale;
+    daq_ = std::make_unique<drivers::SimDaq>(bench_, daq_settings);
+    ASSERT_TRUE(fixture_->Connect().ok());
+    ASSERT_TRUE(daq_->Connect().ok());
+    store_ = db::Store::Open(dir_ / "eol.sqlite");
+    recipe_ = LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json");
+    board_ = std::make_unique<StatusBoard>("test");
+    SequencerOptions o;
+    o.station_id = "test";
+    sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_, recipe_, *board_, o);
+  }
+
+  db::TestRecord Test(const std::string& serial, bool defective) {
+    bench_->LoadUnit(analysis::DrawUnit(bench_->settings().population, serial, defective));
+    return sequencer_->RunTest(serial);
+  }
+
+  static bool HasReason(const db::TestRecord& r, const std::string& text) {
+    for (const auto& reason : r.reasons)
+      if (reason.find(text) != std::string::npos) return true;
+    return false;
+  }
+
+  // The stored copy must agree with what the sequencer returned.
+  void ExpectStored(const db::TestRecord& r) {
+    const auto stored = store_->Test(r.id);
+    ASSERT_TRUE(stored.has_value()) << "record " << r.id << " not stored";
+    EXPECT_EQ(stored->outcome, r.outcome);
+    EXPECT_EQ(stored->reasons, r.reasons);
+    EXPECT_EQ(stored->serial, r.serial);
+    EXPECT_EQ(stored->recipe_hash, recipe_.hash);
+  }
+
+  eol::testing::TempDir dir_;
+  std::shared_ptr<drivers::SimBench> bench_;
+  std::unique_ptr<drivers::Fixture> fixture_;
+  std::unique_ptr<drivers::Daq> daq_;
+  std::unique_ptr<db::Store> store_;
+  Recipe recipe_;
+  std::unique_ptr<StatusBoard> board_;
+  std::unique_ptr<Sequencer> sequencer_;
+};
+
+TEST_F(SequencerTest, GoodRotorPassesAndIsStoredWithEverything) {
+  Build(0.0);
+  const db::TestRecord r = Test("GOOD-1", false);
+  EXPECT_EQ(r.outcome, Outcome::kPass) << (r.reasons.empty() ? "" : r.reasons.front());
+  ExpectStored(r);
+  const auto stored = store_->Test(r.id);
+  ASSERT_TRUE(stored);
+  EXPECT_EQ(stored->measurements.size(), recipe_.limits.size());
+  ASSERT_FALSE(stored->curves.empty());
+  EXPECT_EQ(stored->curves.front().name, "impedance");
+  EXPECT_EQ(stored->curves.front().freq_hz.size(), 601u);
+  // The fitted resonance is close to the simulator's truth.
+  const double truth = analysis::DrawUnit(bench_->settings().population, "GOOD-1", false)
+                           .rotor.NaturalFrequencyHz();
+  double f0 = 0;
+  for (const auto& m : stored->measurements)
+    if (m.name == analysis::names::kResonanceFHz) f0 = m.value;
+  EXPECT_NEAR(f0, truth, 0.5);
+  // The trace walks the documented states in order.
+  std::vector<std::string> states;
+  for (const auto& t : stored->trace) states.push_back(t.state);
+  const std::vector<std::string> expected = {"wait_serial", "check_interlocks", "clamp",
+                                             "confirm_clamp", "excite", "analyse", "judge",
+                                             "unclamp", "store"};
+  EXPECT_EQ(states, expected);
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+  EXPECT_FALSE(bench_->output(FixtureOutput::kClampCmd));
+  EXPECT_TRUE(bench_->output(FixtureOutput::kLampPass));
+}
+
+TEST_F(SequencerTest, PoorlyCementedRotorFailsOnResonance) {
+  Build(0.0);
+  const db::TestRecord r = Test("BAD-1", true);
+  EXPECT_EQ(r.outcome, Outcome::kFail);
+  EXPECT_TRUE(HasReason(r, "resonance_f_hz")) << r.reasons.front();
+  ExpectStored(r);
+  EXPECT_TRUE(bench_->output(FixtureOutput::kLampFail));
+}
+
+TEST_F(SequencerTest, ClampLostDuringExcitationIsErrorWithExcitationCutFast) {
+  Build(1.0);  // real-time acquisition so the fault lands mid-stream
+  bench_->InjectFault(SimFault::kClampDrops, 200ms);
+  const db::TestRecord r = Test("DROP-1", false);
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(r, "interlock lost during excitation: clamp not confirmed")) << r.reasons.front();
+  ExpectStored(r);
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+  // Reaction: relay open within 50 ms of the fixture reporting the fault.
+  ASSERT_TRUE(bench_->fault_visible_at() && bench_->last_excitation_off());
+  const double reaction_ms = std::chrono::duration<double, std::milli>(
+                                 *bench_->last_excitation_off() - *bench_->fault_visible_at())
+                                 .count();
+  EXPECT_GE(reaction_ms, 0.0);
+  EXPECT_LT(reaction_ms, 50.0);
+  // The station recovers: the next unit is tested normally.
+  bench_->ClearFaults();
+  EXPECT_EQ(Test("GOOD-2", false).outcome, Outcome::kPass);
+}
+
+TEST_F(SequencerTest, DoorOpenBeforeTestNeverExcites) {
+  Build(0.0);
+  bench_->InjectFault(SimFault::kDoorOpens, 0ms, /*on_excitation=*/false);
+  const db::TestRecord r = Test("DOOR-1", false);
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(r, "interlock: door open"));
+  EXPECT_TRUE(HasReason(r, "clamp left as it is: door open"));
+  EXPECT_FALSE(bench_->last_excitation_off().has_value()) << "the relay was closed at some point";
+  ExpectStored(r);
+}
+
+TEST_F(SequencerTest, FixtureThatStopsAnsweringIsErrorAndStationRecovers) {
+  Build(1.0);
+  bench_->InjectFault(SimFault::kStopsAnswering, 100ms);
+  const db::TestRecord r = Test("DEAD-1", false);
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(r, "fixture not answering during excitation")) << r.reasons.front();
+  EXPECT_FALSE(bench_->excitation_connected());
+  ExpectStored(r);
+  bench_->ClearFaults();
+  const db::TestRecord next = Test("GOOD-3", false);
+  EXPECT_EQ(next.outcome, Outcome::kPass) << (next.reasons.empty() ? "" : next.reasons.front());
+}
+
+TEST_F(SequencerTest, FrozenHeartbeatIsError) {
+  Build(1.0);
+  bench_->InjectFault(SimFault::kHeartbeatFreezes, 0ms);
+  const db::TestRecord r = Test("HB-1", false);
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(r, "heartbeat frozen")) << r.reasons.front();
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+}
+
+TEST_F(SequencerTest, AcquisitionFailureIsError) {
+  Build(0.0);
+  bench_->InjectFault(SimFault::kDaqFails, 0ms);
+  const db::TestRecord r = Test("DAQ-1", false);
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(r, "acquisition failed")) << r.reasons.front();
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+  ExpectStored(r);
+}
+
+TEST_F(SequencerTest, PressureOutOfWindowIsError) {
+  Build(1.0);
+  bench_->InjectFault(SimFault::kPressureLow, 150ms);
+  const db::TestRecord r = Test("P-1", false);
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(r, "clamp pressure 1.00 bar outside 4.50..6.50 bar")) << r.reasons.front();
+}
+
+TEST_F(SequencerTest, NoPartIsErrorBeforeClamping) {
+  Build(0.0);
+  bench_->RemovePart();
+  const db::TestRecord r = sequencer_->RunTest("EMPTY-1");
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(r, "no part present"));
+  EXPECT_FALSE(bench_->output(FixtureOutput::kClampCmd));
+}
+
+TEST_F(SequencerTest, AbortRequestEndsTestAsAbortedAndSafe) {
+  Build(1.0);
+  bench_->LoadUnit(analysis::DrawUnit(bench_->settings().population, "AB-1", false));
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(500ms);
+    sequencer_->RequestAbort("operator stop");
+  });
+  const db::TestRecord r = sequencer_->RunTest("AB-1");
+  stopper.join();
+  EXPECT_EQ(r.outcome, Outcome::kAborted);
+  EXPECT_TRUE(HasReason(r, "aborted: operator stop"));
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+  ExpectStored(r);
+}
+
+}  // namespace
+}  // namespace eol::station
