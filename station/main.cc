@@ -21,6 +21,13 @@ int main(int argc, char** argv) {
   eol::station::cli::AddDemoCommand(app);
   eol::station::cli::AddStationCommand(app);
   eol::station::cli::AddFixtureSimCommand(app);
+  eol::station::cli::AddAnalyzeCommand(app);
+  eol::station::cli::AddSimulateCommand(app);
+  eol::station::cli::AddFitBenchCommand(app);
+  eol::station::cli::AddGapCommand(app);
+  eol::station::cli::AddGapBenchCommand(app);
+  eol::station::cli::AddQueryCommand(app);
+  eol::station::cli::AddExportCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

@@ -10,5 +10,12 @@ namespace eol::station::cli {
 void AddDemoCommand(CLI::App& app);
 void AddStationCommand(CLI::App& app);
 void AddFixtureSimCommand(CLI::App& app);
+void AddAnalyzeCommand(CLI::App& app);
+void AddSimulateCommand(CLI::App& app);
+void AddFitBenchCommand(CLI::App& app);
+void AddGapCommand(CLI::App& app);
+void AddGapBenchCommand(CLI::App& app);
+void AddQueryCommand(CLI::App& app);
+void AddExportCommand(CLI::App& app);
 
 }  // namespace eol::station::cli
