@@ -529,4 +529,15 @@ std::vector<TestRecord> Store::Tests(const TestQuery& query) {
   return ReadTests(db_, path_, s, query.with_curves);
 }
 
+std::string Store::IntegrityCheck() {
+  Statement s(db_, path_, "PRAGMA integrity_check", "integrity check");
+  if (!s.Step()) throw StoreError(Message(path_, "integrity check", "no result"));
+  return s.Text(0);
+}
+
+int Store::CountRunning() {
+  return static_cast<int>(PragmaInt(db_, path_, "SELECT count(*) FROM tests WHERE outcome = 'RUNNING'",
+                                    "count running tests"));
+}
+
 }  // namespace eol::db

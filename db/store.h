@@ -75,6 +75,11 @@ class Store {
   // order for the store's one timestamp format (db/clock.h); a date "2024-05-01" also works.
   std::vector<TestRecord> Tests(const TestQuery& query);
 
+  // SQLite's own consistency check: "ok" or the first problem it finds.
+  std::string IntegrityCheck();
+  // Rows still RUNNING (a test in flight, or left by a crash not yet recovered).
+  int CountRunning();
+
  private:
   explicit Store(std::string path);
   std::string path_;
