@@ -76,6 +76,30 @@ void HttpApi::Routes() {
     SendJson(res, 200, board_.Snapshot());
   });
 
+  s.Get("/api/recipe", [this](const httplib::Request&, httplib::Response& res) {
+    SendJson(res, 200, options_.recipe);
+  });
+
+  s.Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
+    const nlohmann::json st = board_.Snapshot();
+    std::ostringstream m;
+    m << "# HELP eol_tests_total Finished tests since the station started, by outcome.\n"
+      << "# TYPE eol_tests_total counter\n";
+    for (const char* o : {"pass", "fail", "error", "aborted"})
+      m << "eol_tests_total{outcome=\"" << o << "\"} " << st["counts"][o].get<std::uint64_t>() << "\n";
+    m << "# HELP eol_testing 1 while a test is in progress.\n# TYPE eol_testing gauge\n"
+      << "eol_testing " << (st["state"] == "wait_serial" || st["state"] == "idle" ? 0 : 1) << "\n";
+    if (st["last"].is_object()) {
+      for (const auto& meas : st["last"]["measurements"]) {
+        if (meas["name"] != "resonance_f_hz" || !meas["value"].is_number()) continue;
+        m << "# HELP eol_last_resonance_hz Resonance of the last tested unit.\n"
+          << "# TYPE eol_last_resonance_hz gauge\n"
+          << "eol_last_resonance_hz " << meas["value"].get<double>() << "\n";
+      }
+    }
+    res.set_content(m.str(), "text/plain; version=0.0.4");
+  });
+
   s.Get(R"(/api/units/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
     const std::string serial = req.matches[1];
     std::string why;

@@ -6,6 +6,8 @@
 //   GET  /api/tests/{id}        one test with its curves
 //   GET  /api/tests?from=&to=&verdict=&serial=&limit=   tests in a time range
 //   POST /api/tests             {"serial": "..."} starts a test (bearer token when configured)
+//   GET  /api/recipe            the recipe in use with its hash (limits and masks)
+//   GET  /metrics               Prometheus text: tests by outcome, state, last resonance
 //   GET  /                      the operator page (station/web)
 //
 // Errors are JSON {"error": {"code": "...", "message": "..."}} with a fitting HTTP status.
@@ -38,6 +40,7 @@ struct HttpOptions {
   std::string operator_token;  // empty: writes need no token
   std::string engineer_token;
   std::string web_root;  // folder of the operator page; empty: built-in fallback page
+  nlohmann::json recipe;  // served at GET /api/recipe: {"id", "version", "hash", "masks", ...}
 };
 
 class HttpApi {

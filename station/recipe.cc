@@ -104,7 +104,47 @@ void ParseLimits(const nlohmann::json& limits, const std::string& path, Recipe& 
   }
 }
 
+void ParseMasks(const nlohmann::json& masks, const std::string& path, Recipe& r) {
+  if (!masks.is_array()) throw ConfigError(path + ": must be an array of masks");
+  for (std::size_t i = 0; i < masks.size(); ++i) {
+    const JsonObject m(masks[i], path + "/" + std::to_string(i));
+    analysis::CurveMask mask;
+    mask.name = m.RequiredString("name");
+    const bool name_ok = !mask.name.empty() && mask.name.size() <= 40 &&
+                         mask.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") ==
+                             std::string::npos;
+    m.Require(name_ok, "name", "must be 1 to 40 of a-z, 0-9 and _");
+    for (const auto& other : r.masks) m.Require(other.name != mask.name, "name", "is declared twice");
+    const std::string q = m.String("quantity", "re_ohm");
+    m.Require(q == "re_ohm" || q == "abs_ohm", "quantity", "must be re_ohm or abs_ohm");
+    mask.quantity = q == "re_ohm" ? analysis::MaskQuantity::kReOhm : analysis::MaskQuantity::kAbsOhm;
+    mask.max_lines_outside = m.Integer("max_lines_outside", 0);
+    mask.guard_sigma = m.Number("guard_sigma", 0.0);
+    const nlohmann::json& pts = m.Raw("points");
+    if (!pts.is_array()) throw ConfigError(m.PathOf("points") + ": must be an array of points");
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const JsonObject p(pts[k], m.PathOf("points") + "/" + std::to_string(k));
+      analysis::MaskPoint point;
+      point.f_hz = p.RequiredNumber("f_hz");
+      point.lo = p.OptionalNumber("lo");
+      point.hi = p.OptionalNumber("hi");
+      p.RejectUnknown();
+      mask.points.push_back(point);
+    }
+    std::string why;
+    m.Require(mask.IsValid(&why), "points", why);
+    m.RejectUnknown();
+    r.masks.push_back(mask);
+  }
+}
+
 }  // namespace
+
+std::vector<analysis::MeasurementSpec> Recipe::Specs() const {
+  std::vector<analysis::MeasurementSpec> specs = limits;
+  for (const auto& m : masks) specs.push_back(m.Spec());
+  return specs;
+}
 
 std::string Sha256Hex(const std::string& data) {
   unsigned char digest[EVP_MAX_MD_SIZE];
@@ -146,6 +186,7 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
       r.analysis.fit.f0_max_hz = r.excitation.f_hi_hz;
     }
     ParseLimits(root.Raw("limits"), "/limits", r);
+    if (root.Has("masks")) ParseMasks(root.Raw("masks"), "/masks", r);
     root.RejectUnknown();
     r.source = j;
     r.hash = CanonicalHash(j);

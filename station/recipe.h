@@ -9,7 +9,10 @@
 //                  "release_timeout_s": 2.0},
 //   "analysis":   {"f0_min_hz": 250, "f0_max_hz": 700, "q_min": 5, "q_max": 500},
 //   "limits": [ {"name": "resonance_f_hz", "unit": "Hz", "lo": 370, "hi": 420,
-//                "marginal": 3, "doc": "..."}, ... ]
+//                "marginal": 3, "doc": "..."}, ... ],
+//   "masks": [ {"name": "re_z_low_band", "quantity": "re_ohm" | "abs_ohm",
+//               "max_lines_outside": 0, "guard_sigma": 3,
+//               "points": [{"f_hz": 300, "hi": 0.75}, {"f_hz": 365, "hi": 0.75}]} ]  optional
 // }
 // Validated on load: every message names the JSON path and the rule broken, and a recipe
 // that fails validation is never used. The hash is the SHA-256 of the canonical JSON (keys
@@ -23,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/impedance_analysis.h"
+#include "analysis/qc/curve_mask.h"
 #include "analysis/qc/measurement.h"
 #include "analysis/signal/multisine.h"
 #include "drivers/fixture/fixture.h"
@@ -50,6 +54,10 @@ struct Recipe {
 
   analysis::ImpedanceAnalysisOptions analysis;
   std::vector<analysis::MeasurementSpec> limits;
+  std::vector<analysis::CurveMask> masks;
+
+  // Every declared measurement: the scalar limits, then one per mask.
+  std::vector<analysis::MeasurementSpec> Specs() const;
 
   nlohmann::json source;  // the recipe as loaded
 };

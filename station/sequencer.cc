@@ -314,9 +314,20 @@ void Sequencer::AnalyseAndJudge(db::TestRecord& record, const analysis::Recordin
   if (!a.usable) throw Fault{analysis::Outcome::kError, a.message};
 
   Enter(record, SeqState::kJudge);
-  const analysis::Verdict v = analysis::Judge(recipe_.limits, a.values);
+  std::map<std::string, analysis::Estimate> values = a.values;
+  std::vector<std::string> mask_details;
+  for (const analysis::CurveMask& mask : recipe_.masks) {
+    const analysis::MaskCheck c = analysis::CheckMask(a.frf.frf, mask);
+    values[mask.MeasurementName()] = {static_cast<double>(c.lines_outside), std::nan("")};
+    if (c.lines_outside > mask.max_lines_outside)
+      mask_details.push_back("mask " + mask.name + ": worst line " + Fixed(c.worst_f_hz, 1) +
+                             " Hz, " + Fixed(c.worst_excess, 3) + " ohm beyond the bound");
+  }
+  const analysis::Verdict v = analysis::Judge(recipe_.Specs(), values);
   record.outcome = v.outcome;
   record.reasons = v.reasons;
+  if (v.outcome == analysis::Outcome::kFail)
+    record.reasons.insert(record.reasons.end(), mask_details.begin(), mask_details.end());
   record.measurements = v.measurements;
 }
 

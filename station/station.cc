@@ -47,6 +47,8 @@ void Station::StartHttp(const std::string& web_root) {
   o.operator_token = config_.operator_token;
   o.engineer_token = config_.engineer_token;
   o.web_root = web_root;
+  o.recipe = recipe_.source;
+  o.recipe["hash"] = recipe_.hash;
   http_ = std::make_unique<HttpApi>(*board_, o, [this](const std::string& s, std::string* why) {
     return Enqueue(s, why);
   });

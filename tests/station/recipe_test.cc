@@ -96,3 +96,27 @@ TEST(Recipe, Sha256KnownAnswer) {
 
 }  // namespace
 }  // namespace eol::station
+
+namespace eol::station {
+namespace {
+
+TEST(RecipeMasks, ShippedMaskParsesAndBadMasksNameTheirPath) {
+  const Recipe r = LoadRecipe(kRecipe);
+  ASSERT_EQ(r.masks.size(), 1u);
+  EXPECT_EQ(r.Specs().size(), r.limits.size() + 1);
+  EXPECT_EQ(r.Specs().back().name, "mask_re_z_low_band_lines_outside");
+
+  nlohmann::json j = Good();
+  j["masks"][0]["points"][1]["f_hz"] = 100;
+  EXPECT_NE(ErrorOf(j).find("/masks/0/points: point 1: f_hz must increase"), std::string::npos)
+      << ErrorOf(j);
+  j = Good();
+  j["masks"][0]["quantity"] = "phase";
+  EXPECT_NE(ErrorOf(j).find("/masks/0/quantity: must be re_ohm or abs_ohm"), std::string::npos);
+  j = Good();
+  j["masks"][0]["points"][0].erase("hi");
+  EXPECT_NE(ErrorOf(j).find("/masks/0/points: point 0: needs lo, hi or both"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace eol::station

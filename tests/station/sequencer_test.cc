@@ -79,7 +79,7 @@ TEST_F(SequencerTest, GoodRotorPassesAndIsStoredWithEverything) {
   ExpectStored(r);
   const auto stored = store_->Test(r.id);
   ASSERT_TRUE(stored);
-  EXPECT_EQ(stored->measurements.size(), recipe_.limits.size());
+  EXPECT_EQ(stored->measurements.size(), recipe_.Specs().size());
   ASSERT_FALSE(stored->curves.empty());
   EXPECT_EQ(stored->curves.front().name, "impedance");
   EXPECT_EQ(stored->curves.front().freq_hz.size(), 601u);
