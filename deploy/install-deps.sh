@@ -8,15 +8,20 @@ build_pkgs=(
   g++ cmake ninja-build pkg-config git
   libeigen3-dev libfftw3-dev libmodbus-dev libsqlite3-dev libspdlog-dev nlohmann-json3-dev
   libcpp-httplib-dev libcli11-dev libgtest-dev libssl-dev zlib1g-dev libasound2-dev
+  libsndfile1-dev
 )
 test_pkgs=(
   python3 python3-numpy python3-scipy python3-pymodbus python3-can can-utils socat sqlite3
+  chromium
 )
 
 pkgs=("${build_pkgs[@]}")
 if [[ "${1:-}" == "--tests" ]]; then pkgs+=("${test_pkgs[@]}"); fi
 
 missing=()
+# The browser test drives chromium with playwright-core from npm: node.js is needed, from
+# Debian unless the machine already has one.
+if [[ "${1:-}" == "--tests" ]] && ! command -v node >/dev/null 2>&1; then pkgs+=(nodejs npm); fi
 for p in "${pkgs[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
     missing+=("$p")
