@@ -71,4 +71,21 @@ CREATE TABLE curves (
 CREATE INDEX curves_test ON curves(test_id);
 )sql";
 
+// Version 1 -> 2: the audit log of recipe changes (who, when, old and new hash).
+inline constexpr const char kSchemaV2[] = R"sql(
+CREATE TABLE recipe_audit (
+  id           INTEGER PRIMARY KEY,
+  at           TEXT    NOT NULL,
+  who          TEXT    NOT NULL,
+  role         TEXT    NOT NULL,
+  recipe_id    TEXT    NOT NULL,
+  old_version  INTEGER,
+  new_version  INTEGER NOT NULL,
+  old_hash     TEXT,
+  new_hash     TEXT    NOT NULL,
+  path         TEXT    NOT NULL
+);
+CREATE INDEX recipe_audit_at ON recipe_audit (at);
+)sql";
+
 }  // namespace eol::db::schema

@@ -160,7 +160,11 @@ void MigrateTo1(sqlite3* db, const std::string& path) {
   Exec(db, path, schema::kSchemaV1, "migrate the schema to version 1");
 }
 
-constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {&MigrateTo1};
+void MigrateTo2(sqlite3* db, const std::string& path) {
+  Exec(db, path, schema::kSchemaV2, "migrate the schema to version 2");
+}
+
+constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {&MigrateTo1, &MigrateTo2};
 
 std::int64_t PragmaInt(sqlite3* db, const std::string& path, const char* sql,
                        const std::string& op) {
@@ -538,6 +542,46 @@ std::string Store::IntegrityCheck() {
 int Store::CountRunning() {
   return static_cast<int>(PragmaInt(db_, path_, "SELECT count(*) FROM tests WHERE outcome = 'RUNNING'",
                                     "count running tests"));
+}
+
+void Store::AppendAudit(const RecipeAudit& a) {
+  Statement s(db_, path_,
+              "INSERT INTO recipe_audit (at, who, role, recipe_id, old_version, new_version, "
+              "old_hash, new_hash, path) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
+              "append to the recipe audit log");
+  s.BindText(1, a.at);
+  s.BindText(2, a.who);
+  s.BindText(3, a.role);
+  s.BindText(4, a.recipe_id);
+  if (a.old_version) s.BindInt(5, *a.old_version); else s.BindNull(5);
+  s.BindInt(6, a.new_version);
+  if (a.old_hash.empty()) s.BindNull(7); else s.BindText(7, a.old_hash);
+  s.BindText(8, a.new_hash);
+  s.BindText(9, a.path);
+  s.Step();
+}
+
+std::vector<RecipeAudit> Store::AuditLog(int limit) {
+  Statement s(db_, path_,
+              "SELECT at, who, role, recipe_id, old_version, new_version, old_hash, new_hash, "
+              "path FROM recipe_audit ORDER BY id DESC LIMIT ?1",
+              "read the recipe audit log");
+  s.BindInt(1, std::clamp(limit, 1, 10000));
+  std::vector<RecipeAudit> out;
+  while (s.Step()) {
+    RecipeAudit a;
+    a.at = s.Text(0);
+    a.who = s.Text(1);
+    a.role = s.Text(2);
+    a.recipe_id = s.Text(3);
+    if (!s.IsNull(4)) a.old_version = static_cast<int>(s.Int(4));
+    a.new_version = static_cast<int>(s.Int(5));
+    a.old_hash = s.IsNull(6) ? "" : s.Text(6);
+    a.new_hash = s.Text(7);
+    a.path = s.Text(8);
+    out.push_back(a);
+  }
+  return out;
 }
 
 }  // namespace eol::db

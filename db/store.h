@@ -40,9 +40,23 @@ struct TestQuery {
   bool with_curves = false;
 };
 
+// One change of a recipe through the API: who (token name), with which role, when, and the
+// recipe's version and SHA-256 before and after.
+struct RecipeAudit {
+  std::string at;  // ISO 8601 UTC
+  std::string who;
+  std::string role;
+  std::string recipe_id;
+  std::optional<int> old_version;
+  int new_version = 0;
+  std::string old_hash;  // empty for a new recipe
+  std::string new_hash;
+  std::string path;  // the file written
+};
+
 class Store {
  public:
-  static constexpr int kSchemaVersion = 1;
+  static constexpr int kSchemaVersion = 2;
 
   // kWriter: the station's one connection; recovers unfinished tests as ABORTED.
   // kReader: further connections (the HTTP API, queries, exports) that must never touch a
@@ -74,6 +88,9 @@ class Store {
   // Newest first; limit is clamped to 1..10000. from/to compare as strings, which is time
   // order for the store's one timestamp format (db/clock.h); a date "2024-05-01" also works.
   std::vector<TestRecord> Tests(const TestQuery& query);
+
+  void AppendAudit(const RecipeAudit& entry);
+  std::vector<RecipeAudit> AuditLog(int limit = 100);  // newest first
 
   // SQLite's own consistency check: "ok" or the first problem it finds.
   std::string IntegrityCheck();

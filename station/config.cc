@@ -27,10 +27,24 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       c.http_listen = http->String("listen", c.http_listen);
       c.http_port = http->Integer("port", c.http_port);
       http->Require(c.http_port >= 0 && c.http_port <= 65535, "port", "must be in [0, 65535]");
-      if (auto tokens = http->OptionalObject("tokens")) {
-        c.operator_token = tokens->String("operator", "");
-        c.engineer_token = tokens->String("engineer", "");
-        tokens->RejectUnknown();
+      if (http->Has("tokens")) {
+        const nlohmann::json& list = http->Raw("tokens");
+        if (!list.is_array()) throw drivers::ConfigError(http->PathOf("tokens") + ": must be an array");
+        for (std::size_t i = 0; i < list.size(); ++i) {
+          const JsonObject t(list[i], http->PathOf("tokens") + "/" + std::to_string(i));
+          ApiToken token{t.RequiredString("name"), t.RequiredString("role"),
+                         t.RequiredString("token")};
+          t.Require(token.role == "operator" || token.role == "engineer", "role",
+                    "must be operator or engineer");
+          // Token values never appear in messages.
+          if (token.token.size() < 16)
+            throw drivers::ConfigError(t.PathOf("token") + ": must be at least 16 characters");
+          for (const ApiToken& other : c.tokens)
+            if (other.token == token.token)
+              throw drivers::ConfigError(t.PathOf("token") + ": is used twice");
+          t.RejectUnknown();
+          c.tokens.push_back(token);
+        }
       }
       http->RejectUnknown();
     }

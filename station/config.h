@@ -5,7 +5,10 @@
 //   "recipe": "../recipes/pmsm-10pole.json",     relative paths are relative to this file
 //   "db": "/var/lib/eol/eol.sqlite",
 //   "http": {"listen": "127.0.0.1", "port": 8080,
-//            "tokens": {"operator": "...", "engineer": "..."}},   optional; writes need one
+//            "tokens": [{"name": "line1-operator", "role": "operator", "token": "..."},
+//                       {"name": "qe-anna", "role": "engineer", "token": "..."}]},
+//     Reads need no token. With tokens configured, starting a test needs an operator or
+//     engineer token; changing the recipe always needs an engineer token.
 //   "fixture": {"driver": "sim" | ...},              see drivers/factory.h
 //   "daq": {"driver": "sim" | ...},
 //   "sim": {...},                                    the simulated bench, when a driver is sim
@@ -15,6 +18,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -26,14 +30,19 @@ struct SafetyOptions {
   double poll_period_ms = 10.0;        // clamp/release confirmation polling
 };
 
+struct ApiToken {
+  std::string name;  // who, in the audit log
+  std::string role;  // "operator" or "engineer"
+  std::string token;
+};
+
 struct StationConfig {
   std::string station_id = "eol-1";
   std::string recipe_path;
   std::string db_path;
   std::string http_listen = "127.0.0.1";
   int http_port = 8080;
-  std::string operator_token;  // empty: no token required
-  std::string engineer_token;
+  std::vector<ApiToken> tokens;
   SafetyOptions safety;
   bool serial_from_stdin = false;
   nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}

@@ -30,6 +30,15 @@ std::string BearerToken(const httplib::Request& req) {
   return auth.rfind(prefix, 0) == 0 ? auth.substr(prefix.size()) : "";
 }
 
+// The configured token presented as "Authorization: Bearer <token>", if any.
+const ApiToken* FindToken(const std::vector<ApiToken>& tokens, const httplib::Request& req) {
+  const std::string presented = BearerToken(req);
+  if (presented.empty()) return nullptr;
+  for (const ApiToken& t : tokens)
+    if (t.token == presented) return &t;
+  return nullptr;
+}
+
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return "";
@@ -40,8 +49,8 @@ std::string ReadFile(const std::string& path) {
 
 }  // namespace
 
-HttpApi::HttpApi(StatusBoard& board, HttpOptions options, StartTest start_test)
-    : board_(board), options_(std::move(options)), start_test_(std::move(start_test)) {}
+HttpApi::HttpApi(StatusBoard& board, HttpOptions options, HttpHandlers handlers)
+    : board_(board), options_(std::move(options)), handlers_(std::move(handlers)) {}
 
 HttpApi::~HttpApi() { Stop(); }
 
@@ -77,7 +86,37 @@ void HttpApi::Routes() {
   });
 
   s.Get("/api/recipe", [this](const httplib::Request&, httplib::Response& res) {
-    SendJson(res, 200, options_.recipe);
+    SendJson(res, 200, handlers_.recipe());
+  });
+
+  s.Put("/api/recipe", [this](const httplib::Request& req, httplib::Response& res) {
+    const ApiToken* who = FindToken(options_.tokens, req);
+    if (!who) return SendError(res, 401, "unauthorized", "an engineer's bearer token is required");
+    if (who->role != "engineer")
+      return SendError(res, 403, "forbidden", "only engineers may change recipes");
+    nlohmann::json body;
+    try {
+      body = nlohmann::json::parse(req.body);
+    } catch (const std::exception&) {
+      return SendError(res, 400, "bad_json", "request body is not JSON");
+    }
+    const auto [status, answer] = handlers_.change_recipe(body, *who);
+    SendJson(res, status, answer);
+  });
+
+  s.Get("/api/recipe/audit", [this](const httplib::Request&, httplib::Response& res) {
+    std::vector<db::RecipeAudit> log;
+    {
+      std::lock_guard<std::mutex> lock(db_mu_);
+      log = db_->AuditLog(100);
+    }
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& a : log)
+      list.push_back({{"at", a.at}, {"who", a.who}, {"role", a.role}, {"recipe_id", a.recipe_id},
+                      {"old_version", a.old_version ? nlohmann::json(*a.old_version) : nlohmann::json()},
+                      {"new_version", a.new_version}, {"old_hash", a.old_hash},
+                      {"new_hash", a.new_hash}, {"path", a.path}});
+    SendJson(res, 200, {{"audit", list}});
   });
 
   s.Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
@@ -160,12 +199,8 @@ void HttpApi::Routes() {
   });
 
   s.Post("/api/tests", [this](const httplib::Request& req, httplib::Response& res) {
-    if (!options_.operator_token.empty() || !options_.engineer_token.empty()) {
-      const std::string token = BearerToken(req);
-      const bool ok = !token.empty() &&
-                      (token == options_.operator_token || token == options_.engineer_token);
-      if (!ok) return SendError(res, 401, "unauthorized", "a valid bearer token is required");
-    }
+    if (!options_.tokens.empty() && !FindToken(options_.tokens, req))
+      return SendError(res, 401, "unauthorized", "a valid bearer token is required");
     nlohmann::json body;
     try {
       body = nlohmann::json::parse(req.body);
@@ -177,7 +212,7 @@ void HttpApi::Routes() {
     const std::string serial = body["serial"].get<std::string>();
     std::string why;
     if (!ValidSerial(serial, &why)) return SendError(res, 400, "bad_serial", why);
-    if (!start_test_ || !start_test_(serial, &why)) return SendError(res, 409, "busy", why);
+    if (!handlers_.start_test(serial, &why)) return SendError(res, 409, "busy", why);
     SendJson(res, 202, {{"serial", serial}, {"accepted", true}});
   });
 

@@ -6,6 +6,8 @@
 //   GET  /api/tests/{id}        one test with its curves
 //   GET  /api/tests?from=&to=&verdict=&serial=&limit=   tests in a time range
 //   POST /api/tests             {"serial": "..."} starts a test (bearer token when configured)
+//   PUT  /api/recipe            a new version of the recipe (engineer token; audited)
+//   GET  /api/recipe/audit      who changed the recipe, when, old and new hash
 //   GET  /api/recipe            the recipe in use with its hash (limits and masks)
 //   GET  /metrics               Prometheus text: tests by outcome, state, last resonance
 //   GET  /                      the operator page (station/web)
@@ -20,7 +22,10 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
+#include "station/config.h"
 #include "station/status_board.h"
 
 namespace httplib {
@@ -37,18 +42,25 @@ struct HttpOptions {
   std::string listen = "127.0.0.1";
   int port = 8080;  // 0: any free port (see HttpApi::port())
   std::string db_path;
-  std::string operator_token;  // empty: writes need no token
-  std::string engineer_token;
+  // Empty: starting tests needs no token. Recipe changes always need an engineer token.
+  std::vector<ApiToken> tokens;
   std::string web_root;  // folder of the operator page; empty: built-in fallback page
-  nlohmann::json recipe;  // served at GET /api/recipe: {"id", "version", "hash", "masks", ...}
+};
+
+// What the API asks of the station.
+struct HttpHandlers {
+  // Queues a test for `serial`; false with the reason when refused (busy, stopping).
+  std::function<bool(const std::string& serial, std::string* why)> start_test;
+  // The recipe in use as JSON, with its "hash".
+  std::function<nlohmann::json()> recipe;
+  // Validates, stores and activates a new recipe version; returns the HTTP status and body.
+  std::function<std::pair<int, nlohmann::json>(const nlohmann::json& recipe, const ApiToken& who)>
+      change_recipe;
 };
 
 class HttpApi {
  public:
-  // Queues a test for `serial`; returns false with the reason when refused (busy, locked).
-  using StartTest = std::function<bool(const std::string& serial, std::string* why)>;
-
-  HttpApi(StatusBoard& board, HttpOptions options, StartTest start_test);
+  HttpApi(StatusBoard& board, HttpOptions options, HttpHandlers handlers);
   ~HttpApi();
   HttpApi(const HttpApi&) = delete;
   HttpApi& operator=(const HttpApi&) = delete;
@@ -63,7 +75,7 @@ class HttpApi {
 
   StatusBoard& board_;
   HttpOptions options_;
-  StartTest start_test_;
+  HttpHandlers handlers_;
   std::unique_ptr<httplib::Server> server_;
   std::thread thread_;
   int port_ = 0;

@@ -142,7 +142,7 @@ class Sequencer::Watchdog {
       if (!in.ok()) {
         why = "fixture not answering during excitation: " + in.status().message();
       } else {
-        why = InterlockFault(in.value(), seq_.recipe_, true);
+        why = InterlockFault(in.value(), *seq_.recipe_, true);
         if (why.empty() && !seq_.heartbeat_.Update(in.value().heartbeat, now))
           why = "fixture heartbeat frozen for " + Fixed(seq_.heartbeat_.stale_ms(now), 0) + " ms";
       }
@@ -167,16 +167,22 @@ class Sequencer::Watchdog {
 };
 
 Sequencer::Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& store,
-                     const Recipe& recipe, StatusBoard& board, SequencerOptions options)
+                     std::shared_ptr<const Recipe> recipe, StatusBoard& board,
+                     SequencerOptions options)
     : fixture_(fixture),
       daq_(daq),
       store_(store),
-      recipe_(recipe),
+      recipe_(std::move(recipe)),
       board_(board),
       options_(std::move(options)),
-      excitation_(analysis::DesignMultisine(recipe.excitation)),
+      excitation_(analysis::DesignMultisine(recipe_->excitation)),
       heartbeat_(std::chrono::milliseconds(
           static_cast<long>(options_.safety.heartbeat_timeout_ms))) {}
+
+void Sequencer::SetRecipe(std::shared_ptr<const Recipe> recipe) {
+  excitation_ = analysis::DesignMultisine(recipe->excitation);
+  recipe_ = std::move(recipe);
+}
 
 void Sequencer::RequestAbort(const std::string& why) {
   {
@@ -225,54 +231,54 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
     throw Fault{analysis::Outcome::kError,
                 "fixture heartbeat frozen for " + Fixed(heartbeat_.stale_ms(Clock::now()), 0) + " ms"};
-  if (const std::string why = InterlockFault(in, recipe_, false); !why.empty())
+  if (const std::string why = InterlockFault(in, *recipe_, false); !why.empty())
     throw Fault{analysis::Outcome::kError, "interlock: " + why};
 }
 
 void Sequencer::ClampAndConfirm(db::TestRecord& record) {
-  Enter(record, SeqState::kClamp, "phase pair " + std::to_string(static_cast<int>(recipe_.phase_pair)));
+  Enter(record, SeqState::kClamp, "phase pair " + std::to_string(static_cast<int>(recipe_->phase_pair)));
   if (const drivers::Status s = fixture_.Activate(); !s.ok())
     throw Fault{analysis::Outcome::kError, s.message()};
-  if (const drivers::Status s = fixture_.SelectPhasePair(recipe_.phase_pair); !s.ok())
+  if (const drivers::Status s = fixture_.SelectPhasePair(recipe_->phase_pair); !s.ok())
     throw Fault{analysis::Outcome::kError, s.message()};
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, true); !s.ok())
     throw Fault{analysis::Outcome::kError, s.message()};
 
   Enter(record, SeqState::kConfirmClamp);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(recipe_.clamp_timeout_s));
+                                           std::chrono::duration<double>(recipe_->clamp_timeout_s));
   const auto poll = std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms);
   std::string why;
   drivers::FixtureInputs in;
   while (true) {
     ThrowIfAborted();
     in = ReadInputs("confirm clamp");
-    why = InterlockFault(in, recipe_, true);
+    why = InterlockFault(in, *recipe_, true);
     if (why.empty()) break;
     if (Clock::now() > deadline)
       throw Fault{analysis::Outcome::kError, "clamp not confirmed within " +
-                                                 Fixed(recipe_.clamp_timeout_s, 1) + " s: " + why};
+                                                 Fixed(recipe_->clamp_timeout_s, 1) + " s: " + why};
     std::this_thread::sleep_for(poll);
   }
   record.conditions["clamp_pressure_bar"] = in.clamp_pressure_bar;
-  record.conditions["phase_pair"] = static_cast<int>(recipe_.phase_pair);
+  record.conditions["phase_pair"] = static_cast<int>(recipe_->phase_pair);
 }
 
 analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
   Enter(record, SeqState::kExcite,
-        std::to_string(recipe_.transient_periods + recipe_.periods) + " periods of " +
+        std::to_string(recipe_->transient_periods + recipe_->periods) + " periods of " +
             Fixed(1.0 / excitation_.line_spacing_hz, 3) + " s");
   // Re-check right before closing the relay: nothing may have changed since confirmation.
   const drivers::FixtureInputs in = ReadInputs("interlocks before excitation");
-  if (const std::string why = InterlockFault(in, recipe_, true); !why.empty())
+  if (const std::string why = InterlockFault(in, *recipe_, true); !why.empty())
     throw Fault{analysis::Outcome::kError, "interlock before excitation: " + why};
   ThrowIfAborted();
 
   drivers::AcquisitionRequest req;
   req.sample_rate_hz = excitation_.sample_rate_hz;
   req.period_samples = excitation_.period_samples;
-  req.excitation_v = excitation_.Repeat(recipe_.transient_periods + recipe_.periods);
-  record.conditions["excitation_peak_v"] = recipe_.excitation.peak_v;
+  req.excitation_v = excitation_.Repeat(recipe_->transient_periods + recipe_->periods);
+  record.conditions["excitation_peak_v"] = recipe_->excitation.peak_v;
   record.conditions["crest_factor"] = excitation_.crest_factor;
   record.conditions["line_spacing_hz"] = excitation_.line_spacing_hz;
   record.conditions["sample_rate_hz"] = excitation_.sample_rate_hz;
@@ -304,7 +310,7 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
 void Sequencer::AnalyseAndJudge(db::TestRecord& record, const analysis::Recording& recording) {
   Enter(record, SeqState::kAnalyse);
   const analysis::ImpedanceAnalysis a =
-      analysis::AnalyzeRecording(recording, excitation_.lines, recipe_.analysis);
+      analysis::AnalyzeRecording(recording, excitation_.lines, recipe_->analysis);
   if (a.frf.frf.size() > 0) record.curves.push_back(ToCurve(a.frf.frf, "impedance"));
   record.conditions["periods_used"] = a.frf.periods_used;
   if (!a.fit.params.empty()) {
@@ -316,14 +322,14 @@ void Sequencer::AnalyseAndJudge(db::TestRecord& record, const analysis::Recordin
   Enter(record, SeqState::kJudge);
   std::map<std::string, analysis::Estimate> values = a.values;
   std::vector<std::string> mask_details;
-  for (const analysis::CurveMask& mask : recipe_.masks) {
+  for (const analysis::CurveMask& mask : recipe_->masks) {
     const analysis::MaskCheck c = analysis::CheckMask(a.frf.frf, mask);
     values[mask.MeasurementName()] = {static_cast<double>(c.lines_outside), std::nan("")};
     if (c.lines_outside > mask.max_lines_outside)
       mask_details.push_back("mask " + mask.name + ": worst line " + Fixed(c.worst_f_hz, 1) +
                              " Hz, " + Fixed(c.worst_excess, 3) + " ohm beyond the bound");
   }
-  const analysis::Verdict v = analysis::Judge(recipe_.Specs(), values);
+  const analysis::Verdict v = analysis::Judge(recipe_->Specs(), values);
   record.outcome = v.outcome;
   record.reasons = v.reasons;
   if (v.outcome == analysis::Outcome::kFail)
@@ -336,11 +342,11 @@ void Sequencer::Unclamp(db::TestRecord& record) {
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false); !s.ok())
     throw Fault{analysis::Outcome::kError, "unclamp: " + s.message()};
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(recipe_.release_timeout_s));
+                                           std::chrono::duration<double>(recipe_->release_timeout_s));
   while (!ReadInputs("confirm release").released) {
     if (Clock::now() > deadline)
       throw Fault{analysis::Outcome::kError,
-                  "clamp not released within " + Fixed(recipe_.release_timeout_s, 1) + " s"};
+                  "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s"};
     std::this_thread::sleep_for(
         std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
   }
@@ -394,9 +400,9 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
   db::TestRecord record;
   record.serial = serial;
   record.station_id = options_.station_id;
-  record.recipe_id = recipe_.id;
-  record.recipe_version = recipe_.version;
-  record.recipe_hash = recipe_.hash;
+  record.recipe_id = recipe_->id;
+  record.recipe_version = recipe_->version;
+  record.recipe_hash = recipe_->hash;
   record.software_version = SoftwareVersion();
   record.started_at = db::UtcNowIso8601();
   record.outcome = analysis::Outcome::kError;

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -73,8 +74,8 @@ struct SequencerOptions {
 
 class Sequencer {
  public:
-  Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& store, const Recipe& recipe,
-            StatusBoard& board, SequencerOptions options);
+  Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& store,
+            std::shared_ptr<const Recipe> recipe, StatusBoard& board, SequencerOptions options);
   Sequencer(const Sequencer&) = delete;
   Sequencer& operator=(const Sequencer&) = delete;
 
@@ -84,6 +85,9 @@ class Sequencer {
   // Thread-safe: aborts the test in flight (excitation off, safe state, outcome ABORTED).
   void RequestAbort(const std::string& why);
   SeqState state() const { return state_.load(); }
+  // Between tests only (the caller guarantees no RunTest is in progress).
+  void SetRecipe(std::shared_ptr<const Recipe> recipe);
+  const Recipe& recipe() const { return *recipe_; }
 
  private:
   struct Fault;
@@ -103,10 +107,10 @@ class Sequencer {
   drivers::Fixture& fixture_;
   drivers::Daq& daq_;
   db::Store& store_;
-  const Recipe& recipe_;
+  std::shared_ptr<const Recipe> recipe_;
   StatusBoard& board_;
   SequencerOptions options_;
-  const analysis::Excitation excitation_;
+  analysis::Excitation excitation_;  // designed from the recipe
   HeartbeatMonitor heartbeat_;
 
   std::atomic<SeqState> state_{SeqState::kWaitSerial};

@@ -2,18 +2,23 @@
 
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+#include <fstream>
+
+#include "db/clock.h"
+
 namespace eol::station {
 
 Station::Station(StationConfig config) : config_(std::move(config)) {
-  recipe_ = LoadRecipe(config_.recipe_path);
-  spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_.id, recipe_.version, config_.recipe_path,
-               recipe_.hash.substr(0, 12));
+  recipe_ = std::make_shared<const Recipe>(LoadRecipe(config_.recipe_path));
+  spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_->id, recipe_->version,
+               config_.recipe_path, recipe_->hash.substr(0, 12));
   store_ = db::Store::Open(config_.db_path);
   if (store_->aborted_on_open() > 0)
     spdlog::warn("store {}: {} test(s) interrupted by a previous stop recorded as ABORTED",
                  config_.db_path, store_->aborted_on_open());
   drivers_ = drivers::MakeDrivers(config_.drivers);
-  board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_.id, recipe_.hash);
+  board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_->id, recipe_->hash);
   if (const drivers::Status s = drivers_.fixture->Connect(); !s.ok()) {
     spdlog::error("{} (will retry at the next test)", s.message());
     board_->SetMessage(s.message());
@@ -44,15 +49,92 @@ void Station::StartHttp(const std::string& web_root) {
   o.listen = config_.http_listen;
   o.port = config_.http_port;
   o.db_path = config_.db_path;
-  o.operator_token = config_.operator_token;
-  o.engineer_token = config_.engineer_token;
+  o.tokens = config_.tokens;
   o.web_root = web_root;
-  o.recipe = recipe_.source;
-  o.recipe["hash"] = recipe_.hash;
-  http_ = std::make_unique<HttpApi>(*board_, o, [this](const std::string& s, std::string* why) {
-    return Enqueue(s, why);
-  });
+  HttpHandlers h;
+  h.start_test = [this](const std::string& s, std::string* why) { return Enqueue(s, why); };
+  h.recipe = [this] {
+    const auto r = recipe();
+    nlohmann::json j = r->source;
+    j["hash"] = r->hash;
+    return j;
+  };
+  h.change_recipe = [this](const nlohmann::json& j, const ApiToken& who) {
+    return ChangeRecipe(j, who);
+  };
+  http_ = std::make_unique<HttpApi>(*board_, o, h);
   http_->Start();
+}
+
+std::shared_ptr<const Recipe> Station::recipe() const {
+  std::lock_guard<std::mutex> lock(recipe_mu_);
+  return recipe_;
+}
+
+std::pair<int, nlohmann::json> Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who) {
+  auto error = [](int status, const std::string& code, const std::string& message) {
+    return std::pair<int, nlohmann::json>(
+        status, {{"error", {{"code", code}, {"message", message}}}});
+  };
+  std::shared_ptr<const Recipe> next;
+  try {
+    next = std::make_shared<const Recipe>(ParseRecipe(j, "PUT /api/recipe"));
+  } catch (const drivers::ConfigError& e) {
+    return error(400, "invalid_recipe", e.what());
+  }
+  // Holding the queue lock keeps the sequencer idle until the new recipe is in place.
+  std::lock_guard<std::mutex> queue_lock(queue_mu_);
+  if (running_test_ || !queue_.empty())
+    return error(409, "busy", "a test is running or waiting; change the recipe between tests");
+  const std::shared_ptr<const Recipe> current = recipe();
+  if (next->id != current->id)
+    return error(409, "wrong_recipe", "recipe id must stay '" + current->id +
+                                          "' (another motor type needs another station config)");
+  if (next->version <= current->version)
+    return error(409, "version_not_increased",
+                 "version must increase: the station runs version " +
+                     std::to_string(current->version) + ", got " + std::to_string(next->version));
+  namespace fs = std::filesystem;
+  const fs::path path = config_.recipe_path;
+  const fs::path kept = path.parent_path() / (path.stem().string() + ".v" +
+                                              std::to_string(current->version) + ".json");
+  try {
+    if (!fs::exists(kept)) fs::copy_file(path, kept);
+    const fs::path tmp = path.string() + ".tmp";
+    {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      out << j.dump(2) << "\n";
+      out.flush();
+      if (!out) throw std::runtime_error(tmp.string() + ": cannot be written");
+    }
+    fs::rename(tmp, path);  // atomic on one file system
+  } catch (const std::exception& e) {
+    return error(500, "recipe_not_written", e.what());
+  }
+  db::RecipeAudit audit;
+  audit.at = db::UtcNowIso8601();
+  audit.who = who.name;
+  audit.role = who.role;
+  audit.recipe_id = next->id;
+  audit.old_version = current->version;
+  audit.new_version = next->version;
+  audit.old_hash = current->hash;
+  audit.new_hash = next->hash;
+  audit.path = path.string();
+  store_->AppendAudit(audit);
+  {
+    std::lock_guard<std::mutex> lock(recipe_mu_);
+    recipe_ = next;
+  }
+  sequencer_->SetRecipe(next);
+  board_->SetRecipe(next->id, next->hash);
+  spdlog::warn("recipe {} changed by {} ({}): v{} {} -> v{} {}", next->id, who.name, who.role,
+               current->version, current->hash.substr(0, 12), next->version,
+               next->hash.substr(0, 12));
+  return {200, {{"id", next->id}, {"version", next->version}, {"hash", next->hash},
+                {"path", path.string()},
+                {"previous", {{"version", current->version}, {"hash", current->hash},
+                              {"kept_as", kept.string()}}}}};
 }
 
 int Station::http_port() const { return http_ ? http_->port() : 0; }

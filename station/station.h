@@ -45,7 +45,11 @@ class Station {
   // Thread-safe: aborts the test in flight and ends Serve().
   void RequestStop(const std::string& why);
 
-  const Recipe& recipe() const { return recipe_; }
+  std::shared_ptr<const Recipe> recipe() const;
+  // PUT /api/recipe: validates a new version of the recipe in use, keeps the old file as
+  // <name>.v<old version>.json beside it, replaces the configured file atomically, writes the
+  // audit log, and activates it for the next test. Refused while a test runs or waits.
+  std::pair<int, nlohmann::json> ChangeRecipe(const nlohmann::json& recipe, const ApiToken& who);
   const StationConfig& config() const { return config_; }
   StatusBoard& board() { return *board_; }
   drivers::SimBench* bench() { return drivers_.bench.get(); }
@@ -53,7 +57,8 @@ class Station {
 
  private:
   StationConfig config_;
-  Recipe recipe_;
+  mutable std::mutex recipe_mu_;
+  std::shared_ptr<const Recipe> recipe_;
   std::unique_ptr<db::Store> store_;
   drivers::DriverSet drivers_;
   std::unique_ptr<StatusBoard> board_;

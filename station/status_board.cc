@@ -55,6 +55,13 @@ void StatusBoard::OnVerdict(const db::TestRecord& record) {
   PushEventLocked({{"type", "verdict"}, {"record", last_}});
 }
 
+void StatusBoard::SetRecipe(const std::string& recipe_id, const std::string& recipe_hash) {
+  std::lock_guard<std::mutex> lock(mu_);
+  recipe_id_ = recipe_id;
+  recipe_hash_ = recipe_hash;
+  PushEventLocked({{"type", "recipe"}, {"id", recipe_id}, {"hash", recipe_hash}});
+}
+
 void StatusBoard::SetMessage(const std::string& message) {
   std::lock_guard<std::mutex> lock(mu_);
   if (message == message_) return;

@@ -26,6 +26,8 @@ class StatusBoard {
   void OnState(const std::string& serial, const std::string& state, const std::string& detail);
   // A finished, stored record.
   void OnVerdict(const db::TestRecord& record);
+  // The recipe changed (between tests).
+  void SetRecipe(const std::string& recipe_id, const std::string& recipe_hash);
   // Free text for the operator ("locked out: ...", "fixture not answering").
   void SetMessage(const std::string& message);
 
@@ -44,8 +46,8 @@ class StatusBoard {
   void PushEventLocked(nlohmann::json event);
 
   const std::string station_id_;
-  const std::string recipe_id_;
-  const std::string recipe_hash_;
+  std::string recipe_id_;
+  std::string recipe_hash_;
   mutable std::mutex mu_;
   mutable std::condition_variable cv_;
   std::string state_ = "idle";

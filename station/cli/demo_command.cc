@@ -48,7 +48,7 @@ int RunDemo(const DemoArgs& a) {
   station.StartHttp(DefaultWebRoot());
   std::ostream& out = a.json ? std::cerr : std::cout;
   out << "eol demo: " << a.units << " simulated units, defect share " << a.defect_share
-      << ", recipe " << station.recipe().id << " v" << station.recipe().version
+      << ", recipe " << station.recipe()->id << " v" << station.recipe()->version
       << ", records in " << a.db << ", status at http://" << a.listen << ":"
       << station.http_port() << "/api/status\n";
 

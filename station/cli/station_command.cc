@@ -28,7 +28,7 @@ int RunStation(const std::string& config_path, std::string web_root) {
   if (web_root.empty()) web_root = DefaultWebRoot();
   station.StartHttp(web_root);
   std::cout << "eol station: " << station.config().station_id << " ready, recipe "
-            << station.recipe().id << " v" << station.recipe().version << ", http://"
+            << station.recipe()->id << " v" << station.recipe()->version << ", http://"
             << station.config().http_listen << ":" << station.http_port() << "/" << std::endl;
 
   std::thread signal_thread([&] {

@@ -1,6 +1,7 @@
 // Contract tests of db::Store (db/store.h): each test opens a fresh file in its own
 // temporary directory, removed afterwards.
 #include "db/store.h"
+#include "db/schema.h"
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -164,7 +165,7 @@ TEST_F(StoreTest, OpenCreatesTheSchemaWithWalAndVersion) {
   EXPECT_EQ(raw.Column("PRAGMA user_version"),
             std::vector<std::string>{std::to_string(Store::kSchemaVersion)});
   EXPECT_EQ(raw.Column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
-            (std::vector<std::string>{"curves", "measurements", "tests"}));
+            (std::vector<std::string>{"curves", "measurements", "recipe_audit", "tests"}));
   const auto indexes = raw.Column("SELECT name FROM sqlite_schema WHERE type = 'index'");
   for (const char* name : {"tests_serial_started", "tests_started", "measurements_name"})
     EXPECT_NE(std::find(indexes.begin(), indexes.end(), name), indexes.end()) << name;
@@ -586,6 +587,56 @@ TEST_F(StoreTest, TwoStoresOnOneFileSeeEachOthersCommits) {
   reader->Insert(retest);
   EXPECT_EQ(retest.retest_of, r.id);
   EXPECT_EQ(writer->TestsOfSerial("M-1").size(), 2u);
+}
+
+}  // namespace
+}  // namespace eol::db
+
+namespace eol::db {
+namespace {
+
+class StoreMigrationTest : public ::testing::Test {
+ protected:
+  void SetUp() override { fs::create_directories(dir_); }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_ = fs::temp_directory_path() / ("eol-migrate-" + std::to_string(getpid()));
+};
+
+TEST_F(StoreMigrationTest, VersionOneFileMigratesToTwoKeepingItsTests) {
+  const fs::path path = dir_ / "v1.sqlite";
+  {
+    RawDb raw(path);
+    raw.Exec(schema::kSchemaV1);
+    raw.Exec("PRAGMA application_id = " + std::to_string(schema::kApplicationId) +
+             "; PRAGMA user_version = 1");
+    raw.Exec("INSERT INTO tests (serial, station_id, recipe_id, recipe_version, recipe_hash, "
+             "software_version, started_at, finished_at, outcome, reasons) VALUES ('OLD-1', 's', "
+             "'r', 1, 'h', 'v', '2025-01-01T00:00:00.000Z', '2025-01-01T00:00:01.000Z', 'PASS', "
+             "'[]')");
+  }
+  auto store = Store::Open(path.string());
+  RawDb raw(path);
+  EXPECT_EQ(raw.Column("PRAGMA user_version"), std::vector<std::string>{"2"});
+  EXPECT_EQ(store->TestsOfSerial("OLD-1").size(), 1u);
+  EXPECT_TRUE(store->AuditLog().empty());
+}
+
+TEST_F(StoreMigrationTest, AuditLogRoundTripsNewestFirst) {
+  auto store = Store::Open((dir_ / "a.sqlite").string());
+  RecipeAudit a{"2026-11-22T05:00:00.000Z", "qe-anna", "engineer", "pmsm-10pole", 1, 2,
+                std::string(64, 'a'), std::string(64, 'b'), "/etc/eol/recipe.json"};
+  RecipeAudit b = a;
+  b.at = "2026-11-22T06:00:00.000Z";
+  b.old_version = 2;
+  b.new_version = 3;
+  store->AppendAudit(a);
+  store->AppendAudit(b);
+  const auto log = store->AuditLog();
+  ASSERT_EQ(log.size(), 2u);
+  EXPECT_EQ(log[0].new_version, 3);
+  EXPECT_EQ(log[1].who, "qe-anna");
+  EXPECT_EQ(log[1].old_version, 1);
+  EXPECT_EQ(log[1].old_hash, std::string(64, 'a'));
 }
 
 }  // namespace

@@ -38,7 +38,8 @@ class SequencerTest : public ::testing::Test {
     board_ = std::make_unique<StatusBoard>("test");
     SequencerOptions o;
     o.station_id = "test";
-    sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_, recipe_, *board_, o);
+    sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
+                                             std::make_shared<const Recipe>(recipe_), *board_, o);
   }
 
   db::TestRecord Test(const std::string& serial, bool defective) {

@@ -1,0 +1,110 @@
+// Recipe changes over the API: engineers only, validated, version must increase, the old
+// file kept, the audit log written, and the next test judged with the new recipe.
+#include <httplib.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "db/store.h"
+#include "drivers/json_config.h"
+#include "../support/child_process.h"
+
+namespace eol {
+namespace {
+
+using namespace std::chrono_literals;
+using eol::testing::ChildProcess;
+
+constexpr char kOperator[] = "operator-token-0123456789";
+constexpr char kEngineer[] = "engineer-token-0123456789";
+
+int PortFromReadyLine(const std::string& out) {
+  std::smatch m;
+  static const std::regex re("ready, .* http://127\\.0\\.0\\.1:([0-9]+)/");
+  return std::regex_search(out, m, re) ? std::stoi(m[1]) : 0;
+}
+
+TEST(RecipeApi, EngineersChangeRecipesAuditedAndVersioned) {
+  eol::testing::TempDir dir;
+  const std::string recipe_path = dir / "pmsm-10pole.json";
+  std::filesystem::copy_file(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json", recipe_path);
+  std::ofstream(dir / "station.json") << nlohmann::json{
+      {"station_id", "recipe-api"},
+      {"recipe", "pmsm-10pole.json"},
+      {"db", "s.sqlite"},
+      {"http",
+       {{"listen", "127.0.0.1"},
+        {"port", 0},
+        {"tokens", {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
+                    {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
+      {"fixture", {{"driver", "sim"}}},
+      {"daq", {{"driver", "sim"}}}}.dump();
+  ChildProcess station({EOL_BINARY, "station", "--config", dir / "station.json"});
+  ASSERT_TRUE(station.WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; }, 30s))
+      << station.output();
+  httplib::Client http("127.0.0.1", PortFromReadyLine(station.output()));
+  auto with = [](const char* token) {
+    return httplib::Headers{{"Authorization", std::string("Bearer ") + token}};
+  };
+
+  nlohmann::json recipe = drivers::ReadJsonFile(recipe_path);
+  const std::string old_hash = nlohmann::json::parse(http.Get("/api/recipe")->body)["hash"];
+  recipe["version"] = 2;
+  recipe["limits"][0]["lo"] = 372;
+
+  // Nobody without a token, operators not at all.
+  auto res = http.Put("/api/recipe", recipe.dump(), "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 401);
+  res = http.Put("/api/recipe", with(kOperator), recipe.dump(), "application/json");
+  EXPECT_EQ(res->status, 403);
+  // Starting a test needs a token too, and an operator's will do.
+  res = http.Post("/api/tests", R"({"serial": "RA-1"})", "application/json");
+  EXPECT_EQ(res->status, 401);
+
+  // Invalid recipes are refused naming the field; the version must increase.
+  nlohmann::json bad = recipe;
+  bad["excitation"]["f_hi_hz"] = 10;
+  res = http.Put("/api/recipe", with(kEngineer), bad.dump(), "application/json");
+  EXPECT_EQ(res->status, 400);
+  EXPECT_NE(res->body.find("/excitation/f_hi_hz"), std::string::npos) << res->body;
+  nlohmann::json same = recipe;
+  same["version"] = 1;
+  res = http.Put("/api/recipe", with(kEngineer), same.dump(), "application/json");
+  EXPECT_EQ(res->status, 409);
+  EXPECT_NE(res->body.find("version must increase"), std::string::npos) << res->body;
+
+  res = http.Put("/api/recipe", with(kEngineer), recipe.dump(), "application/json");
+  ASSERT_EQ(res->status, 200) << res->body;
+  const auto changed = nlohmann::json::parse(res->body);
+  EXPECT_EQ(changed["version"], 2);
+  EXPECT_EQ(changed["previous"]["hash"], old_hash);
+  EXPECT_TRUE(std::filesystem::exists(dir / "pmsm-10pole.v1.json")) << "old version not kept";
+  EXPECT_EQ(drivers::ReadJsonFile(recipe_path)["version"], 2);
+  EXPECT_EQ(nlohmann::json::parse(http.Get("/api/recipe")->body)["version"], 2);
+
+  const auto audit = nlohmann::json::parse(http.Get("/api/recipe/audit")->body)["audit"];
+  ASSERT_EQ(audit.size(), 1u);
+  EXPECT_EQ(audit[0]["who"], "qe-anna");
+  EXPECT_EQ(audit[0]["old_hash"], old_hash);
+  EXPECT_EQ(audit[0]["new_hash"], changed["hash"]);
+
+  // The next test runs on the new recipe.
+  res = http.Post("/api/tests", with(kOperator), R"({"serial": "RA-2"})", "application/json");
+  ASSERT_EQ(res->status, 202) << res->body;
+  nlohmann::json tests;
+  for (int i = 0; i < 300 && tests.empty(); ++i) {
+    std::this_thread::sleep_for(100ms);
+    tests = nlohmann::json::parse(http.Get("/api/units/RA-2")->body)["tests"];
+  }
+  ASSERT_EQ(tests.size(), 1u);
+  EXPECT_EQ(tests[0]["recipe"]["version"], 2);
+  EXPECT_EQ(tests[0]["recipe"]["hash"], changed["hash"]);
+  station.Stop(SIGTERM, 20s);
+}
+
+}  // namespace
+}  // namespace eol
