@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "db/clock.h"
+#include "station/systemd_notify.h"
 
 namespace eol::station {
 
@@ -161,7 +162,12 @@ void Station::Serve() {
     std::string serial;
     {
       std::unique_lock<std::mutex> lock(queue_mu_);
-      queue_cv_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      // Wakes at least every second to tell systemd's watchdog the loop is alive; a test that
+      // hangs stops the pings and gets the daemon restarted.
+      while (!queue_cv_.wait_for(lock, std::chrono::seconds(1),
+                                 [&] { return stop_ || !queue_.empty(); }))
+        NotifyWatchdog();
+      NotifyWatchdog();
       if (stop_) return;
       serial = queue_.front();
       queue_.pop_front();

@@ -16,8 +16,9 @@ std::string FirstExisting(std::initializer_list<std::string> candidates) {
 }  // namespace
 
 std::string DefaultRecipePath() {
-  const std::string found = FirstExisting({std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json",
-                                           "/usr/share/eol/recipes/pmsm-10pole.json"});
+  const std::string found =
+      FirstExisting({std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json",
+                     "/var/lib/eol/recipes/pmsm-10pole.json", "/usr/share/eol/recipes/pmsm-10pole.json"});
   return found.empty() ? "recipes/pmsm-10pole.json" : found;
 }
 

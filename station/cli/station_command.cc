@@ -12,6 +12,7 @@
 #include "station/cli/common.h"
 #include "station/serial_number.h"
 #include "station/station.h"
+#include "station/systemd_notify.h"
 
 namespace eol::station::cli {
 namespace {
@@ -31,11 +32,13 @@ int RunStation(const std::string& config_path, std::string web_root) {
             << station.recipe()->id << " v" << station.recipe()->version << ", http://"
             << station.config().http_listen << ":" << station.http_port() << "/" << std::endl;
 
+  NotifyReady("testing " + station.recipe()->id + " v" + std::to_string(station.recipe()->version));
   std::thread signal_thread([&] {
     int sig = 0;
     sigwait(&stop_signals, &sig);
     spdlog::warn("received {}: stopping (test in flight is aborted safely)",
                  sig == SIGTERM ? "SIGTERM" : "SIGINT");
+    NotifyStopping();
     station.RequestStop(sig == SIGTERM ? "station stopping (SIGTERM)" : "station stopping (SIGINT)");
   });
   if (station.config().serial_from_stdin) {

@@ -1,0 +1,29 @@
+# Installation layout and the Debian package (cpack -G DEB, or `cmake --build build --target
+# package`). See README "Installing on a station PC".
+#   /usr/bin/eol                              the program
+#   /usr/share/eol/recipes/, /usr/share/eol/web/   shipped recipes and the operator page
+#   /etc/eol/station.json                     the station config (a conffile)
+#   /lib/systemd/system/eol-station.service   the daemon, with systemd's watchdog
+#   /var/lib/eol/                             records and the recipes in use (made by postinst)
+include(GNUInstallDirs)
+install(TARGETS eol RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/recipes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/recipes)
+install(FILES ${PROJECT_SOURCE_DIR}/station/web/index.html ${PROJECT_SOURCE_DIR}/station/web/app.js
+              ${PROJECT_SOURCE_DIR}/station/web/style.css
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/web)
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/debian/station.json DESTINATION /etc/eol)
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/eol-station.service DESTINATION /lib/systemd/system)
+
+set(CPACK_GENERATOR "DEB")
+set(CPACK_PACKAGE_NAME "eol-station")
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGE_CONTACT "EOL station maintainers <eol-station@localhost>")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY
+    "End-of-line test station for permanent-magnet motors (magnet bond check by impedance)")
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SECTION "science")
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
+    ${PROJECT_SOURCE_DIR}/deploy/debian/conffiles ${PROJECT_SOURCE_DIR}/deploy/debian/postinst)
+set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
+include(CPack)
