@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   eol::station::cli::AddGapBenchCommand(app);
   eol::station::cli::AddQueryCommand(app);
   eol::station::cli::AddExportCommand(app);
+  eol::station::cli::AddSafetyBenchCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

@@ -17,5 +17,6 @@ void AddGapCommand(CLI::App& app);
 void AddGapBenchCommand(CLI::App& app);
 void AddQueryCommand(CLI::App& app);
 void AddExportCommand(CLI::App& app);
+void AddSafetyBenchCommand(CLI::App& app);
 
 }  // namespace eol::station::cli
