@@ -1,5 +1,6 @@
 #include "drivers/factory.h"
 
+#include "drivers/fixture/modbus_fixture.h"
 #include "drivers/fixture/sim_fixture.h"
 
 namespace eol::drivers {
@@ -79,9 +80,15 @@ DriverSet MakeDrivers(const nlohmann::json& station_config) {
   if (fixture_driver == "sim") {
     fixture.RejectUnknown();
     set.fixture = std::make_unique<SimFixture>(set.bench);
+  } else if (fixture_driver == "modbus-tcp") {
+    set.fixture = std::make_unique<ModbusFixture>(
+        ParseModbusFixtureSettings(fixture, ModbusLink::Transport::kTcp));
+  } else if (fixture_driver == "modbus-rtu") {
+    set.fixture = std::make_unique<ModbusFixture>(
+        ParseModbusFixtureSettings(fixture, ModbusLink::Transport::kRtu));
   } else {
     throw ConfigError(fixture.PathOf("driver") + ": unknown fixture driver '" + fixture_driver +
-                      "' (known: sim)");
+                      "' (known: sim, modbus-tcp, modbus-rtu)");
   }
 
   if (daq_driver == "sim") {

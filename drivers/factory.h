@@ -1,7 +1,13 @@
 // The one place that lists the drivers and makes them from configuration (STYLE.md 1).
 //
 //   "fixture": {"driver": "sim"}                    in-process simulated bench
-//   "daq":     {"driver": "sim", "time_scale": 0, "voltage_noise_v": 0.002, ...}
+//   "fixture": {"driver": "modbus-tcp", "host": "10.0.0.20", "port": 502, "unit_id": 1, ...}
+//   "fixture": {"driver": "modbus-rtu", "device": "/dev/ttyUSB0", "baud": 19200, ...}
+//                                                   a Modbus controller (modbus_fixture.h;
+//                                                   `eol fixture-sim` emulates one)
+//   "daq":     {"driver": "sim", "model": "steady_state" | "time_domain",
+//               "amplifier_output_ohm": 0, "time_scale": 0, "voltage_noise_v": 0.002, ...}
+//                                                   the simulated acquisition (sim_daq.h)
 //   "sim":     {"population": {...}, "clamp_close_s": 0.15, ...}   the simulated bench
 //
 // A simulator is chosen exactly as real hardware is. A driver that was not compiled in, or
