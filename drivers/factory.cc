@@ -64,7 +64,7 @@ SimDaqSettings ParseSimDaqSettings(const JsonObject& o) {
   return s;
 }
 
-DriverSet MakeDrivers(const nlohmann::json& station_config) {
+DriverSet MakeDrivers(const nlohmann::json& station_config, std::shared_ptr<SimBench> bench) {
   const JsonObject root(station_config, "");
   const JsonObject fixture = root.Object("fixture");
   const JsonObject daq = root.Object("daq");
@@ -72,7 +72,10 @@ DriverSet MakeDrivers(const nlohmann::json& station_config) {
   const std::string daq_driver = daq.RequiredString("driver");
 
   DriverSet set;
-  if (fixture_driver == "sim" || daq_driver == "sim") {
+  if (bench) {
+    (void)root.OptionalObject("sim");  // the caller built the bench from it
+    set.bench = std::move(bench);
+  } else if (fixture_driver == "sim" || daq_driver == "sim") {
     const auto sim = root.OptionalObject("sim");
     set.bench = std::make_shared<SimBench>(sim ? ParseSimBenchSettings(*sim) : SimBenchSettings{});
   }

@@ -33,8 +33,10 @@ struct DriverSet {
 };
 
 // `station_config` is the whole station config; its "fixture", "daq" and optional "sim"
-// objects are read. Throws ConfigError.
-DriverSet MakeDrivers(const nlohmann::json& station_config);
+// objects are read. Throws ConfigError. A given `bench` is used by the sim drivers instead of
+// a new one: the demo shares one bench between the sim DAQ and the Modbus fixture emulator.
+DriverSet MakeDrivers(const nlohmann::json& station_config,
+                      std::shared_ptr<SimBench> bench = nullptr);
 
 SimBenchSettings ParseSimBenchSettings(const JsonObject& sim);
 analysis::MotorPopulation ParsePopulation(const JsonObject& population);

@@ -10,7 +10,8 @@
 
 namespace eol::station {
 
-Station::Station(StationConfig config) : config_(std::move(config)) {
+Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
+    : config_(std::move(config)) {
   recipe_ = std::make_shared<const Recipe>(LoadRecipe(config_.recipe_path));
   spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_->id, recipe_->version,
                config_.recipe_path, recipe_->hash.substr(0, 12));
@@ -18,7 +19,7 @@ Station::Station(StationConfig config) : config_(std::move(config)) {
   if (store_->aborted_on_open() > 0)
     spdlog::warn("store {}: {} test(s) interrupted by a previous stop recorded as ABORTED",
                  config_.db_path, store_->aborted_on_open());
-  drivers_ = drivers::MakeDrivers(config_.drivers);
+  drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench));
   board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_->id, recipe_->hash);
   if (const drivers::Status s = drivers_.fixture->Connect(); !s.ok()) {
     spdlog::error("{} (will retry at the next test)", s.message());

@@ -26,7 +26,8 @@ class Station {
   // ABORTED), makes the drivers and connects them. A fixture or DAQ that does not answer
   // yet is not fatal: the station says so and retries at the next test. A bad recipe,
   // config or database is fatal (throws with the cause).
-  explicit Station(StationConfig config);
+  // `bench`: a simulated bench shared with a fixture emulator (the demo); normally null.
+  explicit Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench = nullptr);
   ~Station();
   Station(const Station&) = delete;
   Station& operator=(const Station&) = delete;

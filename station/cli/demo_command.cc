@@ -10,6 +10,7 @@
 #include "analysis/qc/measurement_names.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "drivers/fixture/modbus_fixture_server.h"
 #include "station/station.h"
 
 namespace eol::station::cli {
@@ -26,6 +27,7 @@ struct DemoArgs {
   double defect_share = 0.2;
   double time_scale = 0.0;
   bool verbose = false;
+  std::string fixture = "modbus";
 };
 
 double MeasurementValue(const db::TestRecord& r, std::string_view name) {
@@ -35,19 +37,38 @@ double MeasurementValue(const db::TestRecord& r, std::string_view name) {
 }
 
 int RunDemo(const DemoArgs& a) {
-  nlohmann::json cfg = {
-      {"station_id", "demo"},
-      {"recipe", a.recipe},
-      {"db", a.db},
-      {"http", {{"listen", a.listen}, {"port", a.port}}},
-      {"fixture", {{"driver", "sim"}}},
-      {"daq", {{"driver", "sim"}, {"time_scale", a.time_scale}}},
-      {"sim", {{"population", {{"defect_share", a.defect_share}, {"seed", a.seed}}}}}};
+  const nlohmann::json sim = {{"population", {{"defect_share", a.defect_share}, {"seed", a.seed}}}};
+  nlohmann::json cfg = {{"station_id", "demo"},
+                        {"recipe", a.recipe},
+                        {"db", a.db},
+                        {"http", {{"listen", a.listen}, {"port", a.port}}},
+                        {"fixture", {{"driver", "sim"}}},
+                        {"daq", {{"driver", "sim"}, {"time_scale", a.time_scale}}},
+                        {"sim", sim}};
   spdlog::set_level(a.verbose ? spdlog::level::info : spdlog::level::warn);
-  Station station(ParseStationConfig(cfg, "demo", ""));
+  // One simulated bench: the DAQ plays into its motor, and with --fixture modbus the station
+  // reaches its clamp and interlocks over real Modbus TCP through the fixture emulator that
+  // `eol fixture-sim` runs, on a free port of 127.0.0.1.
+  auto bench = std::make_shared<drivers::SimBench>(
+      drivers::ParseSimBenchSettings(drivers::JsonObject(sim, "/sim")));
+  std::unique_ptr<drivers::ModbusFixtureServer> emulator;
+  if (a.fixture == "modbus") {
+    drivers::ModbusFixtureServerSettings es;
+    es.link.transport = drivers::ModbusLink::Transport::kTcp;
+    es.link.host = "127.0.0.1";
+    es.link.port = 0;
+    emulator = std::make_unique<drivers::ModbusFixtureServer>(bench, es);
+    if (const drivers::Status s = emulator->Start(); !s.ok())
+      throw std::runtime_error("fixture emulator: " + s.message());
+    cfg["fixture"] = {{"driver", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", emulator->port()},
+                      {"unit_id", 1}};
+  }
+  Station station(ParseStationConfig(cfg, "demo", ""), bench);
   station.StartHttp(DefaultWebRoot());
   std::ostream& out = a.json ? std::cerr : std::cout;
   out << "eol demo: " << a.units << " simulated units, defect share " << a.defect_share
+      << ", fixture " << (emulator ? "over Modbus TCP 127.0.0.1:" + std::to_string(emulator->port())
+                                   : std::string("in-process"))
       << ", recipe " << station.recipe()->id << " v" << station.recipe()->version
       << ", records in " << a.db << ", status at http://" << a.listen << ":"
       << station.http_port() << "/api/status\n";
@@ -117,6 +138,10 @@ void AddDemoCommand(CLI::App& app) {
   cmd->add_option("--time-scale", args->time_scale,
                   "Pace of the simulated acquisition: 1 real time, 0 as fast as possible")
       ->capture_default_str()->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--fixture", args->fixture,
+                  "modbus: the station talks Modbus TCP to the fixture emulator (eol fixture-sim's\n"
+                  "server) on 127.0.0.1; sim: the in-process simulated fixture")
+      ->capture_default_str()->check(CLI::IsMember({"modbus", "sim"}));
   cmd->add_flag("--verbose", args->verbose, "Log every sequencer state (to stderr)");
   cmd->callback([args] { RunGuarded("demo", [&] { return RunDemo(*args); }); });
 }

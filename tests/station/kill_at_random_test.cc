@@ -45,9 +45,10 @@ TEST(KillAtRandom, DatabaseStaysConsistentAndInterruptedTestsBecomeAborted) {
     ChildProcess station({EOL_BINARY, "station", "--config", dir / "station.json"});
     ASSERT_TRUE(station.WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; }, 30s))
         << station.output();
-    if (expect_recovery_message)
+    if (expect_recovery_message) {
       EXPECT_NE(station.output().find("recorded as ABORTED"), std::string::npos)
           << "cycle " << cycle << ": the interrupted test was not recovered at start";
+    }
     httplib::Client http("127.0.0.1", PortFromReadyLine(station.output()));
     const std::string serial = "CRASH-" + std::to_string(cycle);
     const auto res = http.Post("/api/tests", nlohmann::json{{"serial", serial}}.dump(),
