@@ -10,8 +10,11 @@ find_package(ZLIB REQUIRED)       # compressed raw curves in the store
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 pkg_check_modules(MODBUS REQUIRED IMPORTED_TARGET libmodbus)
+pkg_check_modules(SNDFILE REQUIRED IMPORTED_TARGET sndfile)  # WAV recordings (station/files)
 # cpp-httplib 0.11 is compiled; its .pc carries the defines that fix its class layout.
 pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
+# systemd's readiness and watchdog notifications (optional: without it the daemon still runs).
+pkg_check_modules(SYSTEMD IMPORTED_TARGET libsystemd)
 if(EOL_WITH_ALSA)
   find_package(ALSA REQUIRED)
 endif()

@@ -49,6 +49,16 @@ SimBenchSettings ParseSimBenchSettings(const JsonObject& o) {
 
 SimDaqSettings ParseSimDaqSettings(const JsonObject& o) {
   SimDaqSettings s;
+  const std::string model = o.String("model", ToString(s.model));
+  if (model == ToString(SimMotorModel::kSteadyState)) {
+    s.model = SimMotorModel::kSteadyState;
+  } else if (model == ToString(SimMotorModel::kTimeDomain)) {
+    s.model = SimMotorModel::kTimeDomain;
+  } else {
+    o.Require(false, "model", "must be \"steady_state\" or \"time_domain\"");
+  }
+  s.amplifier_output_ohm = o.Number("amplifier_output_ohm", s.amplifier_output_ohm);
+  o.Require(s.amplifier_output_ohm >= 0.0, "amplifier_output_ohm", "must not be negative");
   s.time_scale = o.Number("time_scale", s.time_scale);
   s.voltage_noise_v = o.Number("voltage_noise_v", s.voltage_noise_v);
   s.current_noise_a = o.Number("current_noise_a", s.current_noise_a);

@@ -185,6 +185,12 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
       r.analysis.fit.f0_min_hz = r.excitation.f_lo_hz;
       r.analysis.fit.f0_max_hz = r.excitation.f_hi_hz;
     }
+    if (auto retest = root.OptionalObject("retest")) {
+      r.max_tests_per_serial = retest->Integer("max_tests_per_serial", r.max_tests_per_serial);
+      retest->Require(r.max_tests_per_serial >= 0 && r.max_tests_per_serial <= 100,
+                      "max_tests_per_serial", "must be in [0, 100] (0: no limit)");
+      retest->RejectUnknown();
+    }
     ParseLimits(root.Raw("limits"), "/limits", r);
     if (root.Has("masks")) ParseMasks(root.Raw("masks"), "/masks", r);
     root.RejectUnknown();

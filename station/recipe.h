@@ -8,6 +8,7 @@
 //   "fixture":    {"clamp_pressure_bar": {"lo": 4.5, "hi": 6.5}, "clamp_timeout_s": 2.0,
 //                  "release_timeout_s": 2.0},
 //   "analysis":   {"f0_min_hz": 250, "f0_max_hz": 700, "q_min": 5, "q_max": 500},
+//   "retest":     {"max_tests_per_serial": 3},                                    optional
 //   "limits": [ {"name": "resonance_f_hz", "unit": "Hz", "lo": 370, "hi": 420,
 //                "marginal": 3, "doc": "..."}, ... ],
 //   "masks": [ {"name": "re_z_low_band", "quantity": "re_ohm" | "abs_ohm",
@@ -51,6 +52,10 @@ struct Recipe {
   double clamp_pressure_hi_bar = 6.5;
   double clamp_timeout_s = 2.0;
   double release_timeout_s = 2.0;
+
+  // Retest policy: how many tests one serial may have in all (first test and retests); a
+  // serial beyond it is refused before clamping ("send to rework"). 0 = no limit.
+  int max_tests_per_serial = 3;
 
   analysis::ImpedanceAnalysisOptions analysis;
   std::vector<analysis::MeasurementSpec> limits;

@@ -409,6 +409,20 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
   Enter(record, SeqState::kWaitSerial, "serial " + serial + " received");
 
   try {
+    const int max_tests = recipe_->max_tests_per_serial;
+    if (max_tests > 0) {
+      const std::size_t earlier = store_.TestsOfSerial(serial).size();
+      if (earlier >= static_cast<std::size_t>(max_tests)) {
+        // Refused before anything moves; not a test of the motor, so nothing is stored.
+        record.reasons = {"retest limit: serial " + serial + " already has " +
+                          std::to_string(earlier) + " tests (recipe allows " +
+                          std::to_string(max_tests) + "); send the motor to rework"};
+        Enter(record, SeqState::kPublish, "ERROR");
+        board_.OnVerdict(record);
+        Enter(record, SeqState::kWaitSerial);
+        return record;
+      }
+    }
     store_.BeginTest(record);
   } catch (const std::exception& e) {
     // No durable record possible: do not clamp, do not excite.

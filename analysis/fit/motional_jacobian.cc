@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "analysis/fit/least_squares.h"
+
 namespace eol::analysis {
 
 const std::array<const char*, kMotionalParamCount> kMotionalParamNames = {"R_ohm", "L_h", "Rp_ohm",
@@ -83,19 +85,10 @@ void MotionalJacobian(const MotionalImpedance& p, const std::vector<double>& fre
 }
 
 bool InvertInformation(const MotionalMatrix& information, MotionalMatrix* inverse) {
-  if (!information.allFinite()) return false;
-  const MotionalVector d = information.diagonal();
-  if (!(d.array() > 0.0).all()) return false;
-  const MotionalVector s = d.array().rsqrt().matrix();
-  const MotionalMatrix scaled = s.asDiagonal() * information * s.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<MotionalMatrix> eig(scaled);
-  if (eig.info() != Eigen::Success) return false;
-  const MotionalVector lambda = eig.eigenvalues();  // ascending
-  if (!(lambda[0] > 1e-13 * lambda[kMotionalParamCount - 1])) return false;
-  const MotionalMatrix scaled_inverse =
-      eig.eigenvectors() * lambda.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
-  *inverse = s.asDiagonal() * scaled_inverse * s.asDiagonal();
-  return inverse->allFinite();
+  Eigen::MatrixXd result;
+  if (!InvertInformation(Eigen::MatrixXd(information), &result)) return false;
+  *inverse = result;
+  return true;
 }
 
 MotionalMatrix LogToNaturalCovariance(const MotionalImpedance& p, const MotionalMatrix& c_log) {

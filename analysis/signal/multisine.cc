@@ -4,28 +4,16 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
+#include <random>
 #include <stdexcept>
 
 #include "analysis/signal/fft.h"
+#include "analysis/signal/waveform.h"
 
 namespace eol::analysis {
-namespace {
 
-double Rms(const std::vector<double>& x) {
-  double s = 0.0;
-  for (double v : x) s += v * v;
-  return std::sqrt(s / static_cast<double>(x.size()));
-}
-
-double Peak(const std::vector<double>& x) {
-  double p = 0.0;
-  for (double v : x) p = std::max(p, std::abs(v));
-  return p;
-}
-
-}  // namespace
-
-bool MultisineOptions::IsValid(std::string* why) const {
+bool ValidPeriodicBand(double sample_rate_hz, double line_spacing_hz, double f_lo_hz,
+                       double f_hi_hz, double peak_v, std::string* why) {
   auto fail = [&](const std::string& m) {
     if (why) *why = m;
     return false;
@@ -40,10 +28,19 @@ bool MultisineOptions::IsValid(std::string* why) const {
   if (!(f_lo_hz > 0.0)) return fail("f_lo_hz must be positive");
   if (!(f_hi_hz > f_lo_hz)) return fail("f_hi_hz must be greater than f_lo_hz");
   if (!(f_hi_hz < sample_rate_hz / 2.0)) return fail("f_hi_hz must be below the Nyquist frequency");
-  if (std::floor(f_hi_hz / line_spacing_hz + 1e-9) < std::ceil(f_lo_hz / line_spacing_hz - 1e-9))
+  if (BandLines(f_lo_hz, f_hi_hz, line_spacing_hz).empty())
     return fail("no line of the grid falls inside [f_lo_hz, f_hi_hz]");
   if (!(peak_v > 0.0) || !std::isfinite(peak_v)) return fail("peak_v must be positive");
-  if (crest_iterations < 0) return fail("crest_iterations must not be negative");
+  return true;
+}
+
+bool MultisineOptions::IsValid(std::string* why) const {
+  if (!ValidPeriodicBand(sample_rate_hz, line_spacing_hz, f_lo_hz, f_hi_hz, peak_v, why))
+    return false;
+  if (crest_iterations < 0) {
+    if (why) *why = "crest_iterations must not be negative";
+    return false;
+  }
   return true;
 }
 
@@ -68,26 +65,28 @@ Excitation DesignMultisine(const MultisineOptions& o) {
   e.sample_rate_hz = o.sample_rate_hz;
   e.line_spacing_hz = o.line_spacing_hz;
   e.period_samples = static_cast<std::size_t>(std::llround(o.sample_rate_hz / o.line_spacing_hz));
-  const auto k_lo = static_cast<std::size_t>(std::ceil(o.f_lo_hz / o.line_spacing_hz - 1e-9));
-  const auto k_hi = static_cast<std::size_t>(std::floor(o.f_hi_hz / o.line_spacing_hz + 1e-9));
-  for (std::size_t k = k_lo; k <= k_hi; ++k) e.lines.push_back(k);
+  e.lines = BandLines(o.f_lo_hz, o.f_hi_hz, o.line_spacing_hz);
 
   const RealFft fft(e.period_samples);
   const double f_count = static_cast<double>(e.lines.size());
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> uniform(0.0, 2.0 * std::numbers::pi);
   std::vector<std::complex<double>> spectrum(e.period_samples / 2 + 1);
   for (std::size_t i = 0; i < e.lines.size(); ++i) {
     const double idx = static_cast<double>(i + 1);
-    const double phase = -std::numbers::pi * idx * (idx - 1.0) / f_count;
+    const double phase = o.phases == MultisinePhases::kSchroeder
+                             ? -std::numbers::pi * idx * (idx - 1.0) / f_count
+                             : uniform(rng);
     spectrum[e.lines[i]] = std::polar(1.0, phase);
   }
   std::vector<double> x = fft.Inverse(spectrum);
 
   // Crest-factor reduction: clip the peaks, then put the line amplitudes back (keeping the
   // phases the clipping produced) and zero everything outside the excited lines.
-  double best_cf = Peak(x) / Rms(x);
+  double best_cf = CrestFactor(x);
   std::vector<double> best = x;
   for (int it = 0; it < o.crest_iterations; ++it) {
-    const double clip = 0.9 * Peak(x);
+    const double clip = 0.9 * PeakAbs(x);
     for (double& v : x) v = std::clamp(v, -clip, clip);
     std::vector<std::complex<double>> s = fft.Forward(x.data());
     std::vector<std::complex<double>> shaped(s.size());
@@ -96,13 +95,13 @@ Excitation DesignMultisine(const MultisineOptions& o) {
       shaped[k] = mag > 0.0 ? s[k] / mag : std::complex<double>(1.0, 0.0);
     }
     x = fft.Inverse(shaped);
-    const double cf = Peak(x) / Rms(x);
+    const double cf = CrestFactor(x);
     if (cf < best_cf) {
       best_cf = cf;
       best = x;
     }
   }
-  const double scale = o.peak_v / Peak(best);
+  const double scale = o.peak_v / PeakAbs(best);
   for (double& v : best) v *= scale;
   e.period_v = std::move(best);
   e.crest_factor = best_cf;

@@ -1,25 +1,35 @@
-// Periodic broadband excitation: Schroeder multisine with crest-factor reduction.
+// Periodic broadband excitation: multisine with crest-factor reduction.
 //
 // One period lasts 1/line_spacing_hz and holds period_samples = sample_rate_hz/line_spacing_hz
 // samples (must be a whole number). Lines are the DFT bins k (f_k = k * line_spacing_hz) in
-// [f_lo_hz, f_hi_hz]; all get the same amplitude. Schroeder phases phi_k = -pi k (k-1) / F
-// give a crest factor of about 1.7; clipping iterations (clip in time, restore the line
-// amplitudes in frequency, keep the phases) bring it to about 1.5.
+// [f_lo_hz, f_hi_hz]; all get the same amplitude. Phases (F lines, i = 1..F):
+//   Schroeder:  phi_i = -pi i (i - 1) / F     crest factor about 1.7 for a band from near DC,
+//                                             1.9 for the recipe's 200-800 Hz (NOTES.md 3)
+//   random:     phi_i uniform on [0, 2 pi)    crest factor about 3.6-3.9 (seeded)
+// Clipping iterations (clip in time at 0.9 of the peak, restore the line amplitudes in
+// frequency, keep the phases the clipping produced, zero every other bin) converge slowly:
+// Schroeder 200-800 Hz reaches 1.64 after 30, 1.55 after 100 and 1.52 after 300 (about 60 ms);
+// the best period seen is kept. The period is scaled to a peak of peak_v volts.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 namespace eol::analysis {
+
+enum class MultisinePhases { kSchroeder, kRandom };
 
 struct MultisineOptions {
   double sample_rate_hz = 8000.0;
   double line_spacing_hz = 1.0;
   double f_lo_hz = 200.0;
   double f_hi_hz = 800.0;
-  double peak_v = 2.0;           // peak of the designed period, volts at the amplifier output
-  int crest_iterations = 30;     // 0: plain Schroeder phases
+  double peak_v = 2.0;         // peak of the designed period, volts at the amplifier output
+  int crest_iterations = 300;  // 0: the plain phases
+  MultisinePhases phases = MultisinePhases::kSchroeder;
+  std::uint64_t seed = 1;  // of the random phases (kRandom only)
 
   bool IsValid(std::string* why) const;
 };
@@ -36,6 +46,12 @@ struct Excitation {
   std::vector<double> Repeat(std::size_t periods) const;
   std::vector<double> LineFrequenciesHz() const;
 };
+
+// The checks every periodic excitation shares: positive finite rate, spacing and peak, a whole
+// number of samples per period, 0 < f_lo < f_hi < Nyquist and at least one line in the band.
+// Returns false with the reason (naming the field) in *why.
+bool ValidPeriodicBand(double sample_rate_hz, double line_spacing_hz, double f_lo_hz,
+                       double f_hi_hz, double peak_v, std::string* why);
 
 // Throws std::invalid_argument with the reason when !options.IsValid().
 Excitation DesignMultisine(const MultisineOptions& options);

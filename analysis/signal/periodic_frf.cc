@@ -1,9 +1,13 @@
 #include "analysis/signal/periodic_frf.h"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
+#include <numbers>
 #include <sstream>
 
+#include "analysis/signal/channel_checks.h"
 #include "analysis/signal/fft.h"
 
 namespace eol::analysis {
@@ -12,22 +16,7 @@ namespace {
 using Cplx = std::complex<double>;
 using Spectra = std::vector<std::vector<Cplx>>;  // [period][line]
 
-// Index of the first non-finite sample, or -1.
-long FirstNonFinite(const std::vector<double>& x) {
-  for (std::size_t i = 0; i < x.size(); ++i)
-    if (!std::isfinite(x[i])) return static_cast<long>(i);
-  return -1;
-}
-
-std::size_t CountClipped(const std::vector<double>& x, double full_scale) {
-  if (full_scale <= 0.0) return 0;
-  std::size_t n = 0;
-  for (double v : x)
-    if (std::abs(v) >= 0.999 * full_scale) ++n;
-  return n;
-}
-
-Spectra LineSpectra(const std::vector<double>& x, std::size_t n, std::size_t periods,
+Spectra LineSpectra(std::span<const double> x, std::size_t n, std::size_t periods,
                     const std::vector<std::size_t>& lines, const RealFft& fft) {
   Spectra s(periods, std::vector<Cplx>(lines.size()));
   const double scale = 2.0 / static_cast<double>(n);
@@ -82,46 +71,33 @@ bool PeriodicFrfOptions::IsValid(std::string* why) const {
   return true;
 }
 
-FrfSummary EstimatePeriodicFrf(const Recording& rec, const std::vector<std::size_t>& lines,
-                               const PeriodicFrfOptions& o) {
+FrfSummary EstimatePeriodicTransfer(const ChannelPair& pair, const std::vector<std::size_t>& lines,
+                                    const PeriodicFrfOptions& o) {
   FrfSummary out;
   std::string why;
   if (!o.IsValid(&why)) {
     out.message = "invalid options: " + why;
     return out;
   }
-  const std::size_t n = rec.period_samples;
+  const std::size_t n = pair.period_samples;
   if (n < 2 || lines.empty()) {
     out.message = "recording is not periodic or no lines are excited";
     return out;
   }
-  if (rec.voltage_v.size() != rec.current_a.size()) {
-    out.message = "voltage and current have different lengths (" +
-                  std::to_string(rec.voltage_v.size()) + " vs " +
-                  std::to_string(rec.current_a.size()) + " samples)";
+  if (!(pair.sample_rate_hz > 0.0)) {
+    out.message = "sample rate must be positive";
     return out;
   }
-  if (lines.back() >= n / 2) {
-    out.message = "excited line " + std::to_string(lines.back()) + " is above Nyquist";
+  if (lines.front() == 0 || lines.back() >= n / 2) {
+    out.message = "excited line " + std::to_string(lines.front() == 0 ? 0 : lines.back()) +
+                  " is DC or above Nyquist";
     return out;
   }
-  for (auto [name, x] : {std::pair{"voltage", &rec.voltage_v}, {"current", &rec.current_a}}) {
-    const long bad = FirstNonFinite(*x);
-    if (bad >= 0) {
-      out.message = std::string(name) + " sample " + std::to_string(bad) + " is not finite (NaN or inf)";
-      return out;
-    }
-  }
-  const std::size_t clipped_u = CountClipped(rec.voltage_v, rec.voltage_full_scale_v);
-  const std::size_t clipped_i = CountClipped(rec.current_a, rec.current_full_scale_a);
-  if (clipped_u + clipped_i > 0) {
-    std::ostringstream m;
-    m << "clipping: " << clipped_u << " voltage and " << clipped_i
-      << " current samples at full scale; lower the excitation level or raise the range";
-    out.message = m.str();
+  if (const std::string bad = CheckChannels(pair); !bad.empty()) {
+    out.message = bad;
     return out;
   }
-  const std::size_t periods = rec.voltage_v.size() / n;
+  const std::size_t periods = pair.x.size() / n;
   if (periods < o.transient_periods + o.min_periods) {
     out.message = "only " + std::to_string(periods) + " whole periods recorded; need " +
                   std::to_string(o.transient_periods + o.min_periods);
@@ -129,69 +105,97 @@ FrfSummary EstimatePeriodicFrf(const Recording& rec, const std::vector<std::size
   }
 
   const RealFft fft(n);
-  const Spectra u_all = LineSpectra(rec.voltage_v, n, periods, lines, fft);
-  const Spectra i_all = LineSpectra(rec.current_a, n, periods, lines, fft);
+  const Spectra y_all = LineSpectra(pair.y, n, periods, lines, fft);
+  const Spectra x_all = LineSpectra(pair.x, n, periods, lines, fft);
   std::size_t first = o.transient_periods;
   while (periods - first > o.min_periods &&
-         LeadingPeriodDeviation(u_all, i_all, first) > o.transient_threshold)
+         LeadingPeriodDeviation(y_all, x_all, first) > o.transient_threshold)
     ++first;
   const std::size_t p_used = periods - first;
   const double pd = static_cast<double>(p_used);
+  const double df = pair.sample_rate_hz / static_cast<double>(n);
 
-  Frf& z = out.frf;
-  z.quantity = Quantity::kImpedanceOhm;
-  z.method = "periodic-eiv";
-  std::size_t weak_lines = 0;
-  double worst_snr = 1e300;
-  for (std::size_t l = 0; l < lines.size(); ++l) {
-    const Cplx u = MeanOf(u_all, first, l);
-    const Cplx i = MeanOf(i_all, first, l);
-    double su2 = 0.0, si2 = 0.0;
-    Cplx sui = 0.0;
+  Frf& h = out.frf;
+  h.quantity = pair.quantity;
+  h.method = "periodic-eiv";
+  // Per-line means and period-to-period (co)variances, then pooled over neighbouring lines.
+  const std::size_t nl = lines.size();
+  std::vector<Cplx> y_mean(nl), x_mean(nl), syx(nl, 0.0);
+  std::vector<double> sy2(nl, 0.0), sx2(nl, 0.0);
+  for (std::size_t l = 0; l < nl; ++l) {
+    y_mean[l] = MeanOf(y_all, first, l);
+    x_mean[l] = MeanOf(x_all, first, l);
     for (std::size_t p = first; p < periods; ++p) {
-      const Cplx du = u_all[p][l] - u;
-      const Cplx di = i_all[p][l] - i;
-      su2 += std::norm(du);
-      si2 += std::norm(di);
-      sui += du * std::conj(di);
+      const Cplx dy = y_all[p][l] - y_mean[l];
+      const Cplx dx = x_all[p][l] - x_mean[l];
+      sy2[l] += std::norm(dy) / (pd - 1.0);
+      sx2[l] += std::norm(dx) / (pd - 1.0);
+      syx[l] += dy * std::conj(dx) / (pd - 1.0);
     }
-    su2 /= pd - 1.0;
-    si2 /= pd - 1.0;
-    sui /= pd - 1.0;
-    const double snr_i = si2 > 0.0 ? std::abs(i) / std::sqrt(si2 / pd) : 1e300;
-    worst_snr = std::min(worst_snr, snr_i);
-    if (std::abs(i) == 0.0 || std::abs(u) == 0.0 || snr_i < o.min_line_snr) {
+  }
+  const std::size_t hw = o.noise_smoothing_lines;
+  std::size_t weak_lines = 0;
+  double worst_snr = std::numeric_limits<double>::infinity();
+  for (std::size_t l = 0; l < nl; ++l) {
+    const std::size_t lo = l >= hw ? l - hw : 0;
+    const std::size_t hi = std::min(nl - 1, l + hw);
+    double py2 = 0.0, px2 = 0.0;
+    Cplx pyx = 0.0;
+    for (std::size_t j = lo; j <= hi; ++j) {
+      py2 += sy2[j];
+      px2 += sx2[j];
+      pyx += syx[j];
+    }
+    const double count = static_cast<double>(hi - lo + 1);
+    py2 /= count;
+    px2 /= count;
+    pyx /= count;
+    const Cplx x = x_mean[l];
+    const double snr_x =
+        px2 > 0.0 ? std::abs(x) / std::sqrt(px2 / pd) : std::numeric_limits<double>::infinity();
+    worst_snr = std::min(worst_snr, snr_x);
+    if (std::abs(x) == 0.0 || snr_x < o.min_line_snr) {
       ++weak_lines;
       continue;
     }
-    const Cplx zk = u / i;
-    double rel = su2 / std::norm(u) + si2 / std::norm(i) - 2.0 * std::real(sui / (u * std::conj(i)));
-    // Guard against a noise-free channel pair (simulation): keep sigma positive.
-    rel = std::max(rel, 1e-30);
-    z.freq_hz.push_back(static_cast<double>(lines[l]) * rec.sample_rate_hz / static_cast<double>(n));
-    z.value.push_back(zk);
-    z.sigma.push_back(std::abs(zk) * std::sqrt(rel / pd));
+    const Cplx h0 = y_mean[l] / x;
+    double var =
+        (py2 + std::norm(h0) * px2 - 2.0 * std::real(std::conj(h0) * pyx)) / (pd * std::norm(x));
+    // A noise-free pair (simulation) has var ~ 0 (or slightly negative from rounding): keep
+    // sigma positive, as Frf requires.
+    var = std::max(var, 1e-30 * std::norm(h0) + std::numeric_limits<double>::min());
+    const double f = static_cast<double>(lines[l]) * df;
+    const double w = 2.0 * std::numbers::pi * f;
+    const Cplx jw_n = std::pow(Cplx(0.0, w), pair.output_jw_power);
+    h.freq_hz.push_back(f);
+    h.value.push_back(jw_n * h0);
+    h.sigma.push_back(std::abs(jw_n) * std::sqrt(var));
   }
   out.periods_used = p_used;
   out.periods_dropped = first;
-  // More than a tenth of the lines without current is no measurement (open circuit, relay
+  // More than a tenth of the lines without input is no measurement (open circuit, relay
   // off, amplifier dead); a few weak lines are dropped and said.
   if (weak_lines * 10 > lines.size()) {
     std::ostringstream m;
-    m << "no signal: " << weak_lines << " of " << lines.size()
-      << " excited lines have no current above the noise (worst line SNR " << worst_snr
+    m << "no signal: " << weak_lines << " of " << lines.size() << " excited lines have no "
+      << pair.x_name << " above the noise (worst line SNR " << worst_snr
       << "); check the excitation relay, amplifier and wiring";
     out.message = m.str();
     return out;
   }
   std::ostringstream m;
-  m << "periodic EIV estimate from " << p_used << " periods (" << first << " dropped), "
-    << z.size() << " lines";
+  m << "periodic EIV estimate from " << p_used << " periods (" << first << " dropped), " << h.size()
+    << " lines";
   if (weak_lines) m << ", " << weak_lines << " weak lines dropped";
+  if (!h.Validate(&out.message)) return out;
+  out.usable = true;
   out.message = m.str();
-  out.usable = z.Validate(&out.message) ? true : false;
-  if (out.usable) out.message = m.str();
   return out;
+}
+
+FrfSummary EstimatePeriodicFrf(const Recording& recording, const std::vector<std::size_t>& lines,
+                               const PeriodicFrfOptions& options) {
+  return EstimatePeriodicTransfer(ChannelPair::Impedance(recording), lines, options);
 }
 
 }  // namespace eol::analysis

@@ -2,10 +2,18 @@
 // motor that is in the fixture and records voltage and current with white noise on both
 // channels, quantised by nothing and clipped at the channels' full scale.
 //
-// The recorded current is the motor's periodic steady state (analysis/sim/steady_state.h)
-// while the bench's excitation relay is closed and zero (plus noise) while it is open, so a
-// sequencer that forgets to enable the relay, or a watchdog that cuts it, is visible in the
-// data. Pacing: time_scale 1 plays in real time, 0 as fast as the machine computes.
+// The excitation drives the motor through the bench circuit (analysis/sim/bench_circuit.h:
+// amplifier output resistance, motor, current shunt of the calibration); the voltage channel
+// reads the motor's terminals. Two motor models ("model" in the config):
+//   steady_state  (default, fast) the periodic steady state of every period
+//                 (analysis/sim/steady_state.h): no start transient.
+//   time_domain   the exact time-domain integration (analysis/sim/time_domain.h) of the
+//                 motor from rest, start transient included, with a band-limited input hold.
+// With no part in the fixture the voltage channel reads the amplifier and the current is
+// zero. While the bench's excitation relay is open both channels read zero (plus noise), and
+// the time-domain motor restarts from rest when it closes, so a sequencer that forgets to enable
+// the relay, or a watchdog that cuts it, is visible in the data. Pacing: time_scale 1 plays
+// in real time, 0 as fast as the machine computes.
 #pragma once
 
 #include <cstdint>
@@ -16,13 +24,18 @@
 
 namespace eol::drivers {
 
+enum class SimMotorModel { kSteadyState, kTimeDomain };
+const char* ToString(SimMotorModel m);
+
 struct SimDaqSettings {
+  SimMotorModel model = SimMotorModel::kSteadyState;
+  double amplifier_output_ohm = 0.0;  // in series with the motor; the shunt is calibration's
   double time_scale = 0.0;
   double voltage_noise_v = 2.0e-3;  // rms per sample
   double current_noise_a = 1.0e-3;  // rms per sample
   double voltage_full_scale_v = 10.0;
   double current_full_scale_a = 2.0;
-  double chunk_s = 0.02;            // relay state, faults and abort are checked per chunk
+  double chunk_s = 0.02;  // relay state, faults and abort are checked per chunk
   std::uint64_t seed = 7;
   Calibration calibration;
 };

@@ -1,16 +1,392 @@
-// STUB, being replaced: `eol analyze`.
+// `eol analyze --measured FILE`: the station's analysis on a measured FRF or raw recording,
+// offline. Reads the file (station/files/measured_input.h), estimates Z(f) with sigma for a
+// periodic recording, fits the clamped motor (analysis::AnalyzeImpedance / AnalyzeRecording)
+// and, with --recipe, judges the result against the recipe's limits (analysis::Judge).
+// A mobility FRF (f_hz,re,im[,sigma]) is fitted with the two-mass model instead (no verdict).
+// Exit codes: 0 a usable analysis (whatever the verdict), 1 the data cannot be analysed
+// (reason on stderr and in JSON "error"), 2 usage or file errors.
+#include <cmath>
 #include <iostream>
+#include <locale>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
 
+#include "analysis/impedance_analysis.h"
+#include "analysis/model/two_mass.h"
+#include "analysis/signal/waveform.h"
+#include "analysis/signal/welch.h"
 #include "station/cli/commands.h"
+#include "station/cli/common.h"
+#include "station/files/file_error.h"
+#include "station/files/measured_input.h"
+#include "station/recipe.h"
 
 namespace eol::station::cli {
+namespace {
+
+using nlohmann::json;
+
+struct AnalyzeArgs {
+  std::string measured;
+  std::string recipe;
+  bool json = false;
+  std::size_t period_samples = 0;
+  std::string lines;
+  std::string excitation_band;
+  double voltage_gain = 0.0;
+  double current_gain = 0.0;
+  std::size_t welch_segment = 0;  // > 0: a non-periodic recording, Welch H1
+  std::string band;               // Welch: f_lo,f_hi of the reported lines
+};
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+double ParseDouble(const std::string& s, const std::string& what) {
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(s, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != s.size() || !std::isfinite(v))
+    throw UsageError(what + ": \"" + s + "\" is not a number");
+  return v;
+}
+
+std::vector<std::string> Split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, sep)) out.push_back(item);
+  return out;
+}
+
+// "200:800,900,1000:1010" -> the bins, increasing and unique.
+std::vector<std::size_t> ParseLines(const std::string& spec) {
+  std::vector<std::size_t> lines;
+  for (const std::string& item : Split(spec, ',')) {
+    const std::vector<std::string> range = Split(item, ':');
+    if (range.empty() || range.size() > 2) throw UsageError("--lines: bad item \"" + item + "\"");
+    const double lo = ParseDouble(range.front(), "--lines");
+    const double hi = range.size() == 2 ? ParseDouble(range.back(), "--lines") : lo;
+    if (lo < 1 || hi < lo || lo != std::floor(lo) || hi != std::floor(hi))
+      throw UsageError("--lines: \"" + item +
+                       "\" is not a bin or an increasing range of bins >= 1");
+    for (double k = lo; k <= hi; ++k) lines.push_back(static_cast<std::size_t>(k));
+  }
+  for (std::size_t i = 1; i < lines.size(); ++i)
+    if (lines[i] <= lines[i - 1]) throw UsageError("--lines must be increasing and unique");
+  if (lines.empty()) throw UsageError("--lines is empty");
+  return lines;
+}
+
+// The excited bins and period of a periodic recording, from the options or the recipe.
+std::vector<std::size_t> SetUpPeriodic(const AnalyzeArgs& a, const Recipe* recipe,
+                                       analysis::Recording* rec) {
+  const double fs = rec->sample_rate_hz;
+  auto whole_period = [&](double spacing_hz, const std::string& from) {
+    const double n = fs / spacing_hz;
+    if (!(spacing_hz > 0.0) || std::abs(n - std::round(n)) > 1e-6 * n)
+      throw UsageError(from + ": a line spacing of " + std::to_string(spacing_hz) +
+                       " Hz is not a whole number of samples at " + std::to_string(fs) + " Hz");
+    return static_cast<std::size_t>(std::llround(n));
+  };
+  if (!a.excitation_band.empty()) {
+    if (a.period_samples != 0 || !a.lines.empty())
+      throw UsageError("give either --excitation-band or --period-samples with --lines");
+    const std::vector<std::string> v = Split(a.excitation_band, ',');
+    if (v.size() != 3) throw UsageError("--excitation-band needs f_lo,f_hi,spacing (Hz)");
+    const double lo = ParseDouble(v[0], "--excitation-band"),
+                 hi = ParseDouble(v[1], "--excitation-band");
+    const double df = ParseDouble(v[2], "--excitation-band");
+    rec->period_samples = whole_period(df, "--excitation-band");
+    const std::vector<std::size_t> lines = analysis::BandLines(lo, hi, df);
+    if (lines.empty()) throw UsageError("--excitation-band: no line between f_lo and f_hi");
+    return lines;
+  }
+  if (a.period_samples != 0 || !a.lines.empty()) {
+    if (a.period_samples == 0 || a.lines.empty())
+      throw UsageError("--period-samples and --lines go together");
+    rec->period_samples = a.period_samples;
+    return ParseLines(a.lines);
+  }
+  if (recipe) {
+    const analysis::MultisineOptions& e = recipe->excitation;
+    if (std::abs(fs - e.sample_rate_hz) > 1e-6 * fs)
+      throw UsageError("the recording is sampled at " + std::to_string(fs) +
+                       " Hz but the recipe's "
+                       "excitation at " +
+                       std::to_string(e.sample_rate_hz) + " Hz");
+    rec->period_samples = whole_period(e.line_spacing_hz, "recipe " + recipe->id);
+    return analysis::BandLines(e.f_lo_hz, e.f_hi_hz, e.line_spacing_hz);
+  }
+  throw UsageError(
+      "a raw recording needs its excitation: --recipe, --excitation-band f_lo,f_hi,spacing, or "
+      "--period-samples N --lines a:b,...");
+}
+
+// Welch H1 options for a non-periodic recording: the band from --band, else the recipe's.
+analysis::WelchOptions SetUpWelch(const AnalyzeArgs& a, const Recipe* recipe) {
+  if (a.period_samples != 0 || !a.lines.empty() || !a.excitation_band.empty())
+    throw UsageError("--welch-segment excludes --period-samples, --lines and --excitation-band");
+  analysis::WelchOptions w;
+  w.segment_samples = a.welch_segment;
+  if (!a.band.empty()) {
+    const std::vector<std::string> v = Split(a.band, ',');
+    if (v.size() != 2) throw UsageError("--band needs f_lo,f_hi (Hz)");
+    w.f_lo_hz = ParseDouble(v[0], "--band");
+    w.f_hi_hz = ParseDouble(v[1], "--band");
+  } else if (recipe) {
+    w.f_lo_hz = recipe->excitation.f_lo_hz;
+    w.f_hi_hz = recipe->excitation.f_hi_hz;
+  }
+  std::string why;
+  if (!w.IsValid(&why)) throw UsageError("Welch options: " + why);
+  return w;
+}
+
+json Param(const analysis::FittedParameter& p) {
+  return {{"value", p.value}, {"sigma", p.sigma}, {"unit", p.unit}};
+}
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os.setf(std::ios::fixed);
+  os.precision(digits);
+  os << v;
+  return os.str();
+}
+
+std::string Sci(double v) {
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os.precision(5);
+  os << v;
+  return os.str();
+}
+
+json VerdictJson(const analysis::Verdict& v) {
+  json ms = json::array();
+  for (const analysis::Measurement& m : v.measurements)
+    ms.push_back({{"name", m.name},
+                  {"unit", m.unit},
+                  {"value", m.value},
+                  {"sigma", m.sigma},
+                  {"lo", m.limit.lo ? json(*m.limit.lo) : json(nullptr)},
+                  {"hi", m.limit.hi ? json(*m.limit.hi) : json(nullptr)},
+                  {"outcome", analysis::ToString(m.outcome)},
+                  {"marginal", m.marginal}});
+  return {{"outcome", analysis::ToString(v.outcome)}, {"reasons", v.reasons}, {"measurements", ms}};
+}
+
+// Prints the failure on stderr (and as JSON on stdout) and returns the exit code.
+int Fail(const AnalyzeArgs& a, json out, int code, const std::string& why) {
+  std::cerr << "eol analyze: " << why << std::endl;
+  if (a.json) {
+    out["error"] = why;
+    out["usable"] = false;
+    std::cout << out.dump() << std::endl;
+  }
+  return code;
+}
+
+int AnalyzeMobility(const AnalyzeArgs& a, const analysis::Frf& h, json out) {
+  const analysis::TwoMassFit fit = analysis::FitTwoMass(h, analysis::TwoMassFitOptions{});
+  out["fit"] = {{"model", "two-mass"},
+                {"chi2", fit.chi2},
+                {"dof", fit.dof},
+                {"chi2_per_dof", fit.chi2_per_dof},
+                {"termination", fit.termination},
+                {"message", fit.message}};
+  out["noise_estimated"] = fit.sigma_estimated;
+  if (!fit.usable) return Fail(a, out, 1, "two-mass fit not usable: " + fit.message);
+  json params = json::object();
+  for (const auto& p : fit.params) params[p.name] = Param(p);
+  out["params"] = params;
+  const analysis::FittedParameter& fr = *fit.Find("f_r_hz");
+  const analysis::FittedParameter& far = *fit.Find("f_ar_hz");
+  const double zr = fit.response.ZetaR();
+  const double q = 1.0 / (2.0 * zr);
+  const double q_sigma = q * fit.Find("zeta_ar")->sigma / std::abs(fit.response.zeta_ar);
+  out["resonance"] = {{"f_hz", fr.value}, {"f_sigma_hz", fr.sigma}, {"q", q}, {"q_sigma", q_sigma}};
+  out["anti_resonance"] = {{"f_hz", far.value}, {"f_sigma_hz", far.sigma}};
+  out["usable"] = true;
+  if (a.json) {
+    std::cout << out.dump() << std::endl;
+  } else {
+    std::cout << "two-mass fit: anti-resonance " << Fixed(far.value, 3) << " +- " << Sci(far.sigma)
+              << " Hz, resonance " << Fixed(fr.value, 3) << " +- " << Sci(fr.sigma) << " Hz\n"
+              << fit.message << "\n";
+  }
+  return 0;
+}
+
+int RunAnalyze(const AnalyzeArgs& a) {
+  json out = {{"file", a.measured}};
+  std::unique_ptr<Recipe> recipe;
+  files::MeasuredInput in;
+  std::vector<std::size_t> lines;
+  analysis::WelchOptions welch;
+  try {
+    if (a.measured.empty()) throw UsageError("--measured FILE is required");
+    if (!a.recipe.empty()) recipe = std::make_unique<Recipe>(LoadRecipe(a.recipe));
+    in = files::ReadMeasured(a.measured, {a.voltage_gain, a.current_gain});
+    const bool recording = in.kind == files::MeasuredKind::kRecording;
+    if (recording && a.welch_segment > 0)
+      welch = SetUpWelch(a, recipe.get());
+    else if (recording)
+      lines = SetUpPeriodic(a, recipe.get(), &in.recording);
+    else if (a.period_samples != 0 || !a.lines.empty() || !a.excitation_band.empty() ||
+             a.welch_segment > 0)
+      throw UsageError(
+          "--period-samples, --lines, --excitation-band and --welch-segment apply to raw "
+          "recordings only");
+  } catch (const UsageError& e) {
+    return Fail(a, out, 2, std::string("usage: ") + e.what());
+  } catch (const std::exception& e) {  // files::FileError, drivers::ConfigError
+    return Fail(a, out, 2, e.what());
+  }
+  out["format"] = in.format;
+  if (recipe)
+    out["recipe"] = {{"id", recipe->id}, {"version", recipe->version}, {"hash", recipe->hash}};
+  if (in.kind == files::MeasuredKind::kFrf && in.frf.quantity == analysis::Quantity::kMobility)
+    return AnalyzeMobility(a, in.frf, out);
+
+  const analysis::ImpedanceAnalysisOptions options =
+      recipe ? recipe->analysis : analysis::ImpedanceAnalysisOptions{};
+  analysis::ImpedanceAnalysis result;
+  if (in.kind == files::MeasuredKind::kFrf) {
+    result = analysis::AnalyzeImpedance(in.frf, options.fit);
+  } else if (a.welch_segment > 0) {
+    const analysis::WelchSummary w =
+        analysis::EstimateWelchFrf(analysis::ChannelPair::Impedance(in.recording), welch);
+    out["frf"] = {{"method", w.frf.method},
+                  {"segments", w.segments},
+                  {"effective_averages", w.effective_averages},
+                  {"message", w.message}};
+    if (!w.usable) {
+      if (recipe) {
+        analysis::Verdict v;
+        v.outcome = analysis::Outcome::kError;
+        v.reasons = {w.message};
+        out["verdict"] = VerdictJson(v);
+      }
+      return Fail(a, out, 1, "invalid measurement: " + w.message);
+    }
+    result = analysis::AnalyzeImpedance(w.frf, options.fit);
+    result.frf.message = w.message;
+  } else {
+    result = analysis::AnalyzeRecording(in.recording, lines, options);
+  }
+  const analysis::Frf& z = result.frf.frf;
+  if (in.kind == files::MeasuredKind::kRecording && a.welch_segment == 0)
+    out["frf"] = {{"method", z.method},
+                  {"periods_used", result.frf.periods_used},
+                  {"periods_dropped", result.frf.periods_dropped},
+                  {"message", result.frf.message},
+                  {"sample_rate_hz", in.recording.sample_rate_hz},
+                  {"period_samples", in.recording.period_samples}};
+  out["lines"] = z.size();
+  const bool noise_estimated = !z.has_sigma();
+  out["noise_estimated"] = noise_estimated;
+  const analysis::FitSummary& fit = result.fit;
+  out["fit"] = {{"model", fit.model},
+                {"chi2", fit.chi2},
+                {"dof", fit.dof},
+                {"chi2_per_dof", fit.chi2_per_dof},
+                {"iterations", fit.iterations},
+                {"termination", fit.termination},
+                {"message", fit.message}};
+  if (noise_estimated) out["estimated_sigma_ohm"] = fit.estimated_sigma;
+  if (!result.usable) {
+    if (recipe) {
+      analysis::Verdict v;
+      v.outcome = analysis::Outcome::kError;
+      v.reasons = {result.message};
+      out["verdict"] = VerdictJson(v);
+    }
+    return Fail(a, out, 1, result.message);
+  }
+  json params = json::object();
+  for (const auto& p : fit.params) params[p.name] = Param(p);
+  out["params"] = params;
+  const analysis::FittedParameter& f0 = *fit.Find("f0_hz");
+  const analysis::FittedParameter& q = *fit.Find("Q");
+  out["resonance"] = {
+      {"f_hz", f0.value}, {"f_sigma_hz", f0.sigma}, {"q", q.value}, {"q_sigma", q.sigma}};
+  analysis::Verdict verdict;
+  if (recipe) {
+    verdict = analysis::Judge(recipe->limits, result.values);
+    out["verdict"] = VerdictJson(verdict);
+  }
+  out["usable"] = true;
+  if (a.json) {
+    std::cout << out.dump() << std::endl;
+    return 0;
+  }
+  std::cout << a.measured << ": " << in.format << ", " << z.size() << " lines "
+            << Fixed(z.freq_hz.front(), 1) << "-" << Fixed(z.freq_hz.back(), 1) << " Hz";
+  if (in.kind == files::MeasuredKind::kRecording) std::cout << " (" << result.frf.message << ")";
+  std::cout << "\n";
+  if (noise_estimated)
+    std::cout << "noise: the file has no sigma; estimated from the fit residual as "
+              << Sci(fit.estimated_sigma) << " ohm per line (complex std): uncertainties below "
+              << "assume the model is right\n";
+  std::cout << "resonance: f0 = " << Fixed(f0.value, 3) << " +- " << Sci(f0.sigma)
+            << " Hz, Q = " << Fixed(q.value, 2) << " +- " << Sci(q.sigma) << "\n";
+  for (const auto& p : fit.params)
+    std::cout << "  " << p.name << " = " << Sci(p.value) << " +- " << Sci(p.sigma) << " " << p.unit
+              << "\n";
+  std::cout << "fit: " << fit.model << ", chi2/dof = " << Fixed(fit.chi2_per_dof, 3) << " (dof "
+            << fit.dof << "), " << fit.termination << " in " << fit.iterations << " iterations\n";
+  if (recipe) {
+    std::cout << "verdict (" << recipe->id << " v" << recipe->version
+              << "): " << analysis::ToString(verdict.outcome) << "\n";
+    for (const std::string& r : verdict.reasons) std::cout << "  " << r << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
 
 void AddAnalyzeCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("analyze", "Analyse a measured FRF or raw recording (not yet built)");
-  cmd->callback([] {
-    std::cerr << "analyze: not built yet\n";
-    throw CLI::RuntimeError(2);
-  });
+  auto args = std::make_shared<AnalyzeArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "analyze",
+      "Analyse a measured frequency response or raw recording offline: estimate Z(f) with its\n"
+      "sigma (periodic recordings), fit the clamped motor's resonance by weighted maximum\n"
+      "likelihood and, with --recipe, judge it against the recipe's limits.\n"
+      "Files: FRF CSV (f_hz,re_ohm,im_ohm[,sigma_ohm]; f_hz,re,im[,sigma] for a mobility, fitted\n"
+      "with the two-mass model), .zma (f, |Z|, phase deg), recording CSV (t_s,u_v,i_a), "
+      "two-channel\n"
+      ".wav (voltage, current; with --voltage-gain and --current-gain). CSV may be gzipped.\n"
+      "A recording of random excitation is analysed with Welch H1 (--welch-segment).\n"
+      "Exit: 0 analysed, 1 the data cannot be analysed, 2 usage or file error.");
+  cmd->add_option("--measured", args->measured, "The measured file");
+  cmd->add_option("--recipe", args->recipe,
+                  "Recipe JSON: fit options, limits for a verdict, and the excitation of a raw "
+                  "recording");
+  cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
+  cmd->add_option("--period-samples", args->period_samples,
+                  "Raw recording: samples per excitation period (with --lines)");
+  cmd->add_option("--lines", args->lines,
+                  "Raw recording: excited DFT bins of one period, e.g. 200:800 or 11,13,17:20");
+  cmd->add_option("--excitation-band", args->excitation_band,
+                  "Raw recording: f_lo,f_hi,spacing in Hz (every line of the grid in the band)");
+  cmd->add_option("--welch-segment", args->welch_segment,
+                  "Raw recording of a non-periodic (noise) excitation: Welch H1 with Hann "
+                  "segments of N samples, 50 % overlap, sigma from the coherence");
+  cmd->add_option("--band", args->band,
+                  "Welch: f_lo,f_hi of the lines to fit (default: the recipe's excitation band)");
+  cmd->add_option("--voltage-gain", args->voltage_gain, "WAV: volts per unit of full scale");
+  cmd->add_option("--current-gain", args->current_gain, "WAV: amperes per unit of full scale");
+  cmd->callback([args] { RunGuarded("analyze", [&] { return RunAnalyze(*args); }); });
 }
 
 }  // namespace eol::station::cli

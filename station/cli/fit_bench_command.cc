@@ -1,16 +1,195 @@
-// STUB, being replaced: `eol fit-bench`.
+// `eol fit-bench`: the benchmark of the identification engine (analysis/fit_bench.h) on the
+// recipe's measurement of the population's nominal good rotor with the simulated DAQ's noise,
+// and the same pipeline in SciPy on the same data for the time ratio (station/fit_bench_peer.h).
+// Prints the five figures of issue 3; README "Benchmarks: identification engine" records them.
+#include <cmath>
 #include <iostream>
+#include <locale>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
 
+#include "analysis/fit_bench.h"
+#include "analysis/sim/population.h"
+#include "drivers/daq/sim_daq.h"
 #include "station/cli/commands.h"
+#include "station/cli/common.h"
+#include "station/fit_bench_peer.h"
+#include "station/recipe.h"
 
 namespace eol::station::cli {
+namespace {
+
+struct FitBenchArgs {
+  int runs = 500;
+  std::uint64_t seed = 1;
+  bool json = false;
+  std::string recipe = DefaultRecipePath();
+  int check_runs = 200;
+  int peer_runs = 20;
+  std::string python = "/usr/bin/python3";
+  std::string script = DefaultScipyPipelineScript();
+};
+
+std::string G(double v, int precision = 4) {
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os.precision(precision);
+  os << v;
+  return os.str();
+}
+
+int RunFitBench(const FitBenchArgs& a) {
+  const Recipe recipe = LoadRecipe(a.recipe);
+  const analysis::MotorPopulation population;
+  analysis::ClampedRotor rotor;
+  rotor.inertia_kg_m2 = population.inertia_kg_m2;
+  rotor.k_rotor_nm_per_rad = population.KRotorNmPerRad(false);
+  rotor.k_fixture_nm_per_rad = population.KFixtureNmPerRad();
+  rotor.q = population.q_good;
+  rotor.transmission_nm_per_a = population.transmission_nm_per_a;
+  const drivers::SimDaqSettings daq;
+
+  analysis::FitBenchOptions o;
+  o.truth = rotor.Electrical(population.r_ohm, population.l_h);
+  o.excitation = recipe.excitation;
+  o.periods = recipe.periods;
+  o.transient_periods = recipe.transient_periods;
+  o.voltage_noise_v = daq.voltage_noise_v;
+  o.current_noise_a = daq.current_noise_a;
+  o.analysis = recipe.analysis;
+  o.runs = a.runs;
+  o.seed = a.seed;
+  o.check_runs = a.check_runs;
+  o.keep_recordings = static_cast<std::size_t>(std::max(0, std::min(a.peer_runs, a.runs)));
+  const analysis::FitBenchResult r = analysis::RunFitBench(o);
+  if (r.usable_runs < 2) {
+    std::cerr << "eol fit-bench: only " << r.usable_runs << " of " << r.runs
+              << " runs were usable; first failure: " << r.first_failure << std::endl;
+    return 1;
+  }
+  ScipyPeerResult peer;
+  peer.message = "skipped (--peer-runs 0)";
+  if (a.peer_runs > 0) peer = RunScipyPipelinePeer(r, o, a.python, a.script);
+  double peer_max_diff_sigma = 0.0;
+  for (std::size_t k = 0; peer.ran && k < peer.f0_hz.size() && k < r.kept_f0_hat_hz.size(); ++k)
+    peer_max_diff_sigma =
+        std::max(peer_max_diff_sigma, std::abs(peer.f0_hz[k] - r.kept_f0_hat_hz[k]) / r.crb_f0_hz);
+  const double ratio = peer.ran ? peer.ms_mean / r.analysis_ms_mean : std::nan("");
+
+  nlohmann::json j = {
+      {"recipe", {{"id", recipe.id}, {"version", recipe.version}}},
+      {"truth",
+       {{"R_ohm", o.truth.r_ohm},
+        {"L_h", o.truth.l_h},
+        {"Rp_ohm", o.truth.rp_ohm},
+        {"f0_hz", o.truth.f0_hz},
+        {"Q", o.truth.q}}},
+      {"noise", {{"voltage_v_rms", o.voltage_noise_v}, {"current_a_rms", o.current_noise_a}}},
+      {"runs", r.runs},
+      {"usable_runs", r.usable_runs},
+      {"seed", a.seed},
+      {"crest_factor", r.excitation.crest_factor},
+      {"f0",
+       {{"mean_hz", r.f0_mean_hz},
+        {"std_hz", r.f0_std_hz},
+        {"crb_hz", r.crb_f0_hz},
+        {"crb_closed_form_hz", r.crb_f0_closed_form_hz},
+        {"std_over_crb", r.std_over_crb}}},
+      {"coverage_2sigma", r.coverage_2sigma},
+      {"mean_reported_f_sigma_hz", r.mean_reported_f_sigma_hz},
+      {"bias",
+       {{"ml_hz", r.ml_bias_hz},
+        {"peak_pick_hz", r.peak_pick_bias_hz},
+        {"peak_pick_std_hz", r.peak_pick_std_hz}}},
+      {"time",
+       {{"analysis_ms_mean", r.analysis_ms_mean},
+        {"analysis_ms_min", r.analysis_ms_min},
+        {"scipy_ran", peer.ran},
+        {"scipy_message", peer.message},
+        {"scipy_version", peer.scipy_version},
+        {"scipy_ms_mean", peer.ms_mean},
+        {"scipy_over_ours", ratio},
+        {"scipy_max_f0_diff_over_crb", peer_max_diff_sigma}}},
+      {"measurement_time",
+       {{"target_f0_sigma_hz", o.target_f0_sigma_hz},
+        {"averaged_s", r.averaged_time_s},
+        {"needed_s", r.time_for_target_s},
+        {"check_periods", r.check_periods},
+        {"check_predicted_f0_std_hz", r.check_predicted_f0_std_hz},
+        {"check_measured_f0_std_hz", r.check_measured_f0_std_hz}}},
+      {"chi2_per_dof_mean", r.chi2_per_dof_mean}};
+  if (a.json) {
+    std::cout << j.dump() << std::endl;
+    return 0;
+  }
+  const auto& e = recipe.excitation;
+  std::cout << "eol fit-bench: recipe " << recipe.id << " v" << recipe.version << ": multisine "
+            << G(e.f_lo_hz) << "-" << G(e.f_hi_hz) << " Hz at " << G(e.line_spacing_hz)
+            << " Hz spacing, " << G(e.sample_rate_hz) << " Hz, " << G(e.peak_v)
+            << " V peak (crest factor " << G(r.excitation.crest_factor, 3) << "), "
+            << o.transient_periods << " + " << o.periods << " periods\n"
+            << "  motor R " << G(o.truth.r_ohm) << " ohm, L " << G(o.truth.l_h) << " H, Rp "
+            << G(o.truth.rp_ohm) << " ohm, f0 " << G(o.truth.f0_hz) << " Hz, Q " << G(o.truth.q)
+            << "; noise " << G(o.voltage_noise_v) << " V and " << G(o.current_noise_a)
+            << " A rms per sample; " << r.usable_runs << "/" << r.runs << " runs, seed " << a.seed
+            << "\n"
+            << "(1) std(f0) " << G(r.f0_std_hz) << " Hz; Cramer-Rao bound " << G(r.crb_f0_hz)
+            << " Hz (closed form " << G(r.crb_f0_closed_form_hz) << " Hz): ratio "
+            << G(r.std_over_crb, 3) << " (target <= 1.1)\n"
+            << "(2) coverage of +-2 f_sigma_hz: " << G(100.0 * r.coverage_2sigma, 3)
+            << " % (mean reported f_sigma_hz " << G(r.mean_reported_f_sigma_hz) << ")\n"
+            << "(3) bias: ML fit " << G(r.ml_bias_hz) << " Hz; |Z| peak-picking "
+            << G(r.peak_pick_bias_hz) << " Hz (std " << G(r.peak_pick_std_hz) << " Hz), "
+            << G(std::abs(r.peak_pick_bias_hz) / r.f0_std_hz, 3) << " ML standard deviations\n"
+            << "(4) analysis time per test " << G(r.analysis_ms_mean, 3) << " ms (min "
+            << G(r.analysis_ms_min, 3) << " ms)";
+  if (peer.ran)
+    std::cout << "; SciPy " << peer.scipy_version << " pipeline " << G(peer.ms_mean, 3) << " ms on "
+              << peer.f0_hz.size() << " of the same recordings: ratio " << G(ratio, 3)
+              << " (largest f0 difference " << G(peer_max_diff_sigma, 2) << " bounds)\n";
+  else
+    std::cout << "; SciPy pipeline not run: " << peer.message << "\n";
+  std::cout
+      << "(5) measurement time for std(f0) = " << G(o.target_f0_sigma_hz)
+      << " Hz: " << G(r.time_for_target_s, 3) << " s of averaging (the recipe averages "
+      << G(r.averaged_time_s) << " s"
+      << (r.time_for_target_s < 1.0 / e.line_spacing_hz
+              ? ", and less than one period: the line spacing sets the test time, not the noise"
+              : "")
+      << "); check at " << r.check_periods << " periods: predicted "
+      << G(r.check_predicted_f0_std_hz) << " Hz, Monte Carlo " << G(r.check_measured_f0_std_hz)
+      << " Hz\n"
+      << "    mean chi2/dof " << G(r.chi2_per_dof_mean, 3) << "\n";
+  return 0;
+}
+
+}  // namespace
 
 void AddFitBenchCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("fit-bench", "Benchmark of the identification engine (not yet built)");
-  cmd->callback([] {
-    std::cerr << "fit-bench: not built yet\n";
-    throw CLI::RuntimeError(2);
-  });
+  auto args = std::make_shared<FitBenchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "fit-bench",
+      "Benchmark of the identification engine on simulated measurements of the recipe's motor:\n"
+      "std(f0) against the Cramer-Rao bound, coverage of the reported sigma, |Z| peak-picking\n"
+      "bias, analysis time per test (and the same pipeline in SciPy, as a ratio), and the\n"
+      "measurement time needed for std(f0) = 0.5 Hz.");
+  cmd->add_option("--runs", args->runs, "Monte Carlo runs")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 1000000));
+  cmd->add_option("--seed", args->seed, "Seed of the noise")->capture_default_str();
+  cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
+  cmd->add_option("--recipe", args->recipe, "Recipe JSON")->capture_default_str();
+  cmd->add_option("--check-runs", args->check_runs, "Runs of the measurement-time check (0: skip)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000000));
+  cmd->add_option("--peer-runs", args->peer_runs,
+                  "Recordings given to the SciPy pipeline (0: skip it)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 10000));
+  cmd->add_option("--python", args->python, "Python with SciPy")->capture_default_str();
+  cmd->add_option("--script", args->script, "The SciPy pipeline")->capture_default_str();
+  cmd->callback([args] { RunGuarded("fit-bench", [&] { return RunFitBench(*args); }); });
 }
 
 }  // namespace eol::station::cli

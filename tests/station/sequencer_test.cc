@@ -103,6 +103,20 @@ TEST_F(SequencerTest, GoodRotorPassesAndIsStoredWithEverything) {
   EXPECT_TRUE(bench_->output(FixtureOutput::kLampPass));
 }
 
+TEST_F(SequencerTest, RetestLimitRefusesASerialBeforeClamping) {
+  Build(0.0);
+  for (int i = 0; i < recipe_.max_tests_per_serial; ++i) {
+    const db::TestRecord r = Test("RETEST-1", true);
+    EXPECT_EQ(r.outcome, Outcome::kFail);
+    if (i > 0) EXPECT_TRUE(r.retest_of.has_value());
+  }
+  const db::TestRecord refused = Test("RETEST-1", true);
+  EXPECT_EQ(refused.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(refused, "retest limit: serial RETEST-1 already has 3 tests"));
+  EXPECT_EQ(store_->TestsOfSerial("RETEST-1").size(), 3u);
+  EXPECT_FALSE(bench_->output(FixtureOutput::kClampCmd));
+}
+
 TEST_F(SequencerTest, PoorlyCementedRotorFailsOnResonance) {
   Build(0.0);
   const db::TestRecord r = Test("BAD-1", true);

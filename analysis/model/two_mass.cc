@@ -1,0 +1,370 @@
+#include "analysis/model/two_mass.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <locale>
+#include <numbers>
+#include <sstream>
+#include <unsupported/Eigen/NonLinearOptimization>
+
+namespace eol::analysis {
+namespace {
+
+using Cplx = std::complex<double>;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr double kRejectResidual = 1e100;
+constexpr double kDelayScale = 1e-3;  // tau is fitted in ms: theta = tau / 1 ms
+constexpr double kZetaScale = 1e-2;   // zeta_ar is fitted in %
+
+// Which parameters theta holds, in order: ln g, ln f_ar, ln f_r, 100 zeta_ar, [beta], [tau].
+// zeta_ar and beta are linear: either may be near zero (the friction to ground can carry all
+// the damping), where a log parameter would make the information matrix singular.
+struct Layout {
+  bool friction = false;
+  bool delay = false;
+  int size() const { return 4 + (friction ? 1 : 0) + (delay ? 1 : 0); }
+};
+
+TwoMassResponse FromTheta(const Eigen::VectorXd& t, const Layout& l) {
+  TwoMassResponse r;
+  r.gain_rad_per_s2_per_a = std::exp(t[0]);
+  r.f_ar_hz = std::exp(t[1]);
+  r.f_r_hz = std::exp(t[2]);
+  r.zeta_ar = t[3] * kZetaScale;
+  int i = 4;
+  if (l.friction) r.friction_per_s = t[i++];
+  if (l.delay) r.delay_s = t[i] * kDelayScale;
+  return r;
+}
+
+Eigen::VectorXd ToTheta(const TwoMassResponse& r, const Layout& l) {
+  Eigen::VectorXd t(l.size());
+  t[0] = std::log(r.gain_rad_per_s2_per_a);
+  t[1] = std::log(r.f_ar_hz);
+  t[2] = std::log(r.f_r_hz);
+  t[3] = r.zeta_ar / kZetaScale;
+  int i = 4;
+  if (l.friction) t[i++] = r.friction_per_s;
+  if (l.delay) t[i] = r.delay_s / kDelayScale;
+  return t;
+}
+
+struct Data {
+  std::vector<double> f;
+  std::vector<Cplx> h;
+  std::vector<double> scale;  // sqrt(2) / sigma
+};
+
+void Residual(const TwoMassResponse& m, const Data& d, Eigen::VectorXd* r) {
+  const std::size_t n = d.f.size();
+  r->resize(static_cast<Eigen::Index>(2 * n));
+  for (std::size_t k = 0; k < n; ++k) {
+    const Cplx e = (m.At(d.f[k]) - d.h[k]) * d.scale[k];
+    (*r)[static_cast<Eigen::Index>(2 * k)] = e.real();
+    (*r)[static_cast<Eigen::Index>(2 * k + 1)] = e.imag();
+  }
+}
+
+struct TwoMassFunctor {
+  using Scalar = double;
+  enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
+  using InputType = Eigen::VectorXd;
+  using ValueType = Eigen::VectorXd;
+  using JacobianType = Eigen::MatrixXd;
+
+  const Data& data;
+  Layout layout;
+
+  int inputs() const { return layout.size(); }
+  int values() const { return static_cast<int>(2 * data.f.size()); }
+
+  int operator()(const Eigen::VectorXd& theta, Eigen::VectorXd& r) const {
+    if (!theta.allFinite() || theta.head(3).cwiseAbs().maxCoeff() > 700.0) {
+      r.setConstant(values(), kRejectResidual);
+      return 0;
+    }
+    Residual(FromTheta(theta, layout), data, &r);
+    if (!r.allFinite()) r.setConstant(kRejectResidual);
+    return 0;
+  }
+
+  // Central differences: the model is cheap and smooth in theta.
+  int df(const Eigen::VectorXd& theta, Eigen::MatrixXd& jac) const {
+    jac.resize(values(), inputs());
+    Eigen::VectorXd rp, rm;
+    for (int i = 0; i < inputs(); ++i) {
+      const double h = 1e-6 * std::max(1.0, std::abs(theta[i]));
+      Eigen::VectorXd tp = theta, tm = theta;
+      tp[i] += h;
+      tm[i] -= h;
+      (*this)(tp, rp);
+      (*this)(tm, rm);
+      jac.col(i) = (rp - rm) / (2.0 * h);
+    }
+    return jac.allFinite() ? 0 : -1;
+  }
+};
+
+std::ostringstream Stream() {
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os.precision(6);
+  return os;
+}
+
+}  // namespace
+
+Cplx TwoMassResponse::At(double f_hz) const {
+  const Cplx s(0.0, kTwoPi * f_hz);
+  const double w_ar = kTwoPi * f_ar_hz;
+  const double r1 = (f_ar_hz / f_r_hz) * (f_ar_hz / f_r_hz);
+  const double r2 = 1.0 - r1;
+  const Cplx coupling = 2.0 * zeta_ar * w_ar * s + w_ar * w_ar;  // (c s + k) / J2
+  const Cplx n = s * s + coupling;
+  const Cplx h = gain_rad_per_s2_per_a * n / ((r1 * s + friction_per_s) * n + r2 * s * coupling);
+  return delay_s == 0.0 ? h : h * std::exp(-s * delay_s);
+}
+
+Frf TwoMassResponse::Evaluate(const std::vector<double>& freq_hz) const {
+  Frf h;
+  h.quantity = Quantity::kMobility;
+  h.method = "model";
+  h.freq_hz = freq_hz;
+  for (double f : freq_hz) h.value.push_back(At(f));
+  return h;
+}
+
+Cplx TwoMassSystem::Mobility(double f_hz) const {
+  const Cplx s(0.0, kTwoPi * f_hz);
+  const Cplx spring = c_nms_per_rad * s + k_nm_per_rad;
+  const Cplx n = j2_kg_m2 * s * s + spring;
+  return kt_nm_per_a * n / ((j1_kg_m2 * s + b1_nms_per_rad) * n + j2_kg_m2 * s * spring);
+}
+
+TwoMassResponse TwoMassSystem::Response() const {
+  const double j_tot = j1_kg_m2 + j2_kg_m2;
+  TwoMassResponse r;
+  r.gain_rad_per_s2_per_a = kt_nm_per_a / j_tot;
+  const double w_ar = std::sqrt(k_nm_per_rad / j2_kg_m2);
+  r.f_ar_hz = w_ar / kTwoPi;
+  r.f_r_hz = std::sqrt(k_nm_per_rad * j_tot / (j1_kg_m2 * j2_kg_m2)) / kTwoPi;
+  r.zeta_ar = c_nms_per_rad / (2.0 * std::sqrt(k_nm_per_rad * j2_kg_m2));
+  r.friction_per_s = b1_nms_per_rad / j_tot;
+  return r;
+}
+
+TwoMassSystem TwoMassSystem::FromResponse(const TwoMassResponse& r, double kt) {
+  TwoMassSystem m;
+  const double j_tot = kt / r.gain_rad_per_s2_per_a;
+  const double r1 = (r.f_ar_hz / r.f_r_hz) * (r.f_ar_hz / r.f_r_hz);
+  const double w_ar = kTwoPi * r.f_ar_hz;
+  m.kt_nm_per_a = kt;
+  m.j1_kg_m2 = r1 * j_tot;
+  m.j2_kg_m2 = (1.0 - r1) * j_tot;
+  m.k_nm_per_rad = m.j2_kg_m2 * w_ar * w_ar;
+  m.c_nms_per_rad = 2.0 * r.zeta_ar * w_ar * m.j2_kg_m2;
+  m.b1_nms_per_rad = r.friction_per_s * j_tot;
+  return m;
+}
+
+bool TwoMassFitOptions::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!(f_lo_hz >= 0.0 && f_hi_hz >= 0.0)) return fail("f_lo_hz and f_hi_hz must not be negative");
+  if (f_hi_hz > 0.0 && !(f_hi_hz > f_lo_hz)) return fail("f_hi_hz must be greater than f_lo_hz");
+  if (max_iterations < 1) return fail("max_iterations must be at least 1");
+  return true;
+}
+
+const FittedParameter* TwoMassFit::Find(const std::string& name) const {
+  for (const FittedParameter& p : params)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
+  TwoMassFit out;
+  out.termination = "invalid_input";
+  std::string why;
+  if (!o.IsValid(&why)) {
+    out.message = "invalid input: options: " + why;
+    return out;
+  }
+  if (!frf.Validate(&why)) {
+    out.message = "invalid input: " + why;
+    return out;
+  }
+  if (frf.quantity != Quantity::kMobility) {
+    out.message = std::string("invalid input: quantity is ") + ToString(frf.quantity) +
+                  ", the two-mass fit needs " + ToString(Quantity::kMobility);
+    return out;
+  }
+  const Layout layout{o.fit_friction, o.fit_delay};
+  Data d;
+  const bool all = o.f_lo_hz == 0.0 && o.f_hi_hz == 0.0;
+  for (std::size_t k = 0; k < frf.size(); ++k) {
+    if (!all && (frf.freq_hz[k] < o.f_lo_hz || frf.freq_hz[k] > o.f_hi_hz)) continue;
+    d.f.push_back(frf.freq_hz[k]);
+    d.h.push_back(frf.value[k]);
+    d.scale.push_back(frf.has_sigma() ? std::numbers::sqrt2 / frf.sigma[k] : std::numbers::sqrt2);
+  }
+  const std::size_t n = d.f.size();
+  if (n < static_cast<std::size_t>(2 * layout.size())) {
+    out.message = "invalid input: " + std::to_string(n) + " lines in the band, need at least " +
+                  std::to_string(2 * layout.size());
+    return out;
+  }
+
+  // Start: the |H| maximum is the resonance, the |H| minimum below it the anti-resonance.
+  std::size_t i_max = 0;
+  for (std::size_t k = 1; k < n; ++k)
+    if (std::abs(d.h[k]) > std::abs(d.h[i_max])) i_max = k;
+  if (i_max == 0) {
+    out.termination = "failed";
+    out.message = "no resonance: |H| has its maximum at the lowest line";
+    return out;
+  }
+  std::size_t i_min = 0;
+  for (std::size_t k = 1; k < i_max; ++k)
+    if (std::abs(d.h[k]) < std::abs(d.h[i_min])) i_min = k;
+  if (i_min == 0) {
+    out.termination = "failed";
+    out.message = "no anti-resonance: |H| has no minimum below its maximum at " +
+                  std::to_string(d.f[i_max]) + " Hz";
+    return out;
+  }
+  TwoMassResponse start;
+  start.f_ar_hz = d.f[i_min];
+  start.f_r_hz = d.f[i_max];
+  {
+    // Rigid body on the lowest lines: |H| ~ g / w.
+    std::vector<double> g;
+    for (std::size_t k = 0; k < std::min<std::size_t>(5, i_min); ++k)
+      g.push_back(std::abs(d.h[k]) * kTwoPi * d.f[k]);
+    std::sort(g.begin(), g.end());
+    start.gain_rad_per_s2_per_a = g[g.size() / 2];
+  }
+  double best = std::numeric_limits<double>::infinity();
+  TwoMassResponse trial = start;
+  Eigen::VectorXd r;
+  for (double zeta : {0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2}) {
+    trial.zeta_ar = zeta;
+    Residual(trial, d, &r);
+    if (r.allFinite() && r.squaredNorm() < best) {
+      best = r.squaredNorm();
+      start.zeta_ar = zeta;
+    }
+  }
+  if (layout.friction) start.friction_per_s = 0.1 * kTwoPi * d.f.front();
+
+  Eigen::VectorXd theta = ToTheta(start, layout);
+  TwoMassFunctor functor{d, layout};
+  Eigen::LevenbergMarquardt<TwoMassFunctor> lm(functor);
+  lm.parameters.ftol = 1e-12;
+  lm.parameters.xtol = 1e-10;
+  lm.parameters.maxfev = 20 * (o.max_iterations + 10);
+  using Eigen::LevenbergMarquardtSpace::Status;
+  Status status = lm.minimizeInit(theta);
+  if (status == Status::NotStarted) {
+    do {
+      status = lm.minimizeOneStep(theta);
+    } while (status == Status::Running && lm.iter - 1 < o.max_iterations);
+  }
+  const bool converged = status == Status::RelativeReductionTooSmall ||
+                         status == Status::RelativeErrorTooSmall ||
+                         status == Status::RelativeErrorAndReductionTooSmall ||
+                         status == Status::CosinusTooSmall || status == Status::FtolTooSmall ||
+                         status == Status::XtolTooSmall || status == Status::GtolTooSmall;
+  out.termination = converged ? "converged"
+                    : (status == Status::Running || status == Status::TooManyFunctionEvaluation)
+                        ? "max_iterations"
+                        : "failed";
+  out.response = FromTheta(theta, layout);
+  Residual(out.response, d, &r);
+  out.dof = static_cast<int>(2 * n) - layout.size();
+  const double chi2_raw = r.squaredNorm();
+  out.sigma_estimated = !frf.has_sigma();
+  const double noise_var = out.sigma_estimated ? chi2_raw / out.dof : 1.0;
+  out.chi2 = chi2_raw / noise_var;
+  out.chi2_per_dof = out.chi2 / out.dof;
+  double err2 = 0.0, h2 = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    err2 += std::norm(out.response.At(d.f[k]) - d.h[k]);
+    h2 += std::norm(d.h[k]);
+  }
+  out.rms_relative_error = std::sqrt(err2 / h2);
+
+  // Covariance in theta, scaled by the noise estimate and, when the model error dominates,
+  // by chi2/dof (Birge ratio).
+  Eigen::MatrixXd jac;
+  functor.df(theta, jac);
+  const double inflate = std::max(1.0, out.chi2_per_dof);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(layout.size(), layout.size(),
+                                                  std::numeric_limits<double>::quiet_NaN());
+  const Eigen::MatrixXd jtj = jac.transpose() * jac;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
+  bool cov_ok = false;
+  if (jac.allFinite() && ldlt.info() == Eigen::Success && ldlt.isPositive()) {
+    cov = ldlt.solve(Eigen::MatrixXd::Identity(layout.size(), layout.size())) * noise_var * inflate;
+    cov_ok = cov.allFinite() && cov.diagonal().minCoeff() > 0.0;
+  }
+  const TwoMassResponse& m = out.response;
+  auto add = [&](const char* name, const char* unit, double value, double sigma) {
+    out.params.push_back(FittedParameter{name, unit, value, cov_ok ? sigma : std::nan("")});
+  };
+  auto sd = [&](int i) { return std::sqrt(cov(i, i)); };
+  add("g_rad_per_s2_per_a", "rad/s^2/A", m.gain_rad_per_s2_per_a, m.gain_rad_per_s2_per_a * sd(0));
+  add("f_ar_hz", "Hz", m.f_ar_hz, m.f_ar_hz * sd(1));
+  add("f_r_hz", "Hz", m.f_r_hz, m.f_r_hz * sd(2));
+  add("zeta_ar", "1", m.zeta_ar, kZetaScale * sd(3));
+  int i = 4;
+  if (layout.friction) {
+    add("friction_per_s", "1/s", m.friction_per_s, sd(i));
+    ++i;
+  }
+  if (layout.delay) add("delay_s", "s", m.delay_s, kDelayScale * sd(i));
+
+  std::ostringstream os = Stream();
+  if (!converged) {
+    os << "Levenberg-Marquardt " << out.termination << " (MINPACK status "
+       << static_cast<int>(status) << ") from f_ar = " << start.f_ar_hz
+       << " Hz, f_r = " << start.f_r_hz << " Hz";
+    out.message = os.str();
+    return out;
+  }
+  if (!(m.f_r_hz > m.f_ar_hz)) {
+    os << "not a two-mass response: the fit put the resonance (" << m.f_r_hz
+       << " Hz) at or below the anti-resonance (" << m.f_ar_hz << " Hz)";
+    out.message = os.str();
+    return out;
+  }
+  if (!cov_ok) {
+    out.message = "covariance is not finite: the data do not determine every parameter";
+    return out;
+  }
+  if (m.zeta_ar < -2.0 * out.params[3].sigma) {
+    os << "not a passive two-mass response: zeta_ar = " << m.zeta_ar << " +- "
+       << out.params[3].sigma << " is significantly negative";
+    out.message = os.str();
+    return out;
+  }
+  out.usable = true;
+  os << "two-mass fit over " << n << " lines: anti-resonance " << m.f_ar_hz << " +- "
+     << out.params[1].sigma << " Hz, resonance " << m.f_r_hz << " +- " << out.params[2].sigma
+     << " Hz, chi2/dof " << out.chi2_per_dof << " (dof " << out.dof << "), normalised rms error "
+     << out.rms_relative_error;
+  if (m.zeta_ar < 0.0)
+    os << "; zeta_ar is negative but within 2 sigma of 0: the coupling damping is not resolved"
+          " (the friction to ground carries the damping)";
+  if (out.sigma_estimated)
+    os << "; no sigma given: noise estimated from the residual";
+  else if (out.chi2_per_dof > 1.0 + 5.0 * std::sqrt(2.0 / out.dof))
+    os << "; chi2/dof above 1: the model error exceeds the noise, sigmas scaled by sqrt(chi2/dof)";
+  out.message = os.str();
+  return out;
+}
+
+}  // namespace eol::analysis

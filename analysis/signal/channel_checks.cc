@@ -1,0 +1,45 @@
+#include "analysis/signal/channel_checks.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace eol::analysis {
+namespace {
+
+// Index of the first non-finite sample, or -1.
+long FirstNonFinite(std::span<const double> x) {
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (!std::isfinite(x[i])) return static_cast<long>(i);
+  return -1;
+}
+
+std::size_t CountClipped(std::span<const double> x, double full_scale) {
+  if (full_scale <= 0.0) return 0;
+  std::size_t n = 0;
+  for (double v : x)
+    if (std::abs(v) >= 0.999 * full_scale) ++n;
+  return n;
+}
+
+}  // namespace
+
+std::string CheckChannels(const ChannelPair& p) {
+  if (p.x.size() != p.y.size())
+    return p.y_name + " and " + p.x_name + " have different lengths (" +
+           std::to_string(p.y.size()) + " vs " + std::to_string(p.x.size()) + " samples)";
+  for (auto [name, s] : {std::pair{&p.y_name, p.y}, {&p.x_name, p.x}}) {
+    const long bad = FirstNonFinite(s);
+    if (bad >= 0) return *name + " sample " + std::to_string(bad) + " is not finite (NaN or inf)";
+  }
+  const std::size_t clipped_y = CountClipped(p.y, p.y_full_scale);
+  const std::size_t clipped_x = CountClipped(p.x, p.x_full_scale);
+  if (clipped_y + clipped_x > 0) {
+    std::ostringstream m;
+    m << "clipping: " << clipped_y << ' ' << p.y_name << " and " << clipped_x << ' ' << p.x_name
+      << " samples at full scale; lower the excitation level or raise the range";
+    return m.str();
+  }
+  return "";
+}
+
+}  // namespace eol::analysis

@@ -1,0 +1,238 @@
+#include "station/cli/gap_report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <locale>
+#include <sstream>
+
+namespace eol::station::cli {
+namespace {
+
+using nlohmann::json;
+
+const char* QuantityName(analysis::Quantity q) {
+  return q == analysis::Quantity::kMobility ? "mobility" : "impedance";
+}
+
+json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json ParamsValue(const std::vector<analysis::NamedValue>& params) {
+  json j = json::object();
+  for (const auto& p : params) j[p.name] = Num(p.value);
+  return j;
+}
+
+json ParamsSigma(const std::vector<analysis::NamedValue>& params) {
+  json j = json::object();
+  for (const auto& p : params)
+    if (std::isfinite(p.sigma)) j[p.name] = p.sigma;
+  return j;
+}
+
+json FittedParams(const std::vector<analysis::FittedParameter>& params) {
+  json j = json::object();
+  for (const auto& p : params) j[p.name] = {{"value", Num(p.value)}, {"sigma", Num(p.sigma)}};
+  return j;
+}
+
+json Bands(const std::vector<analysis::BandGap>& bands) {
+  json j = json::array();
+  for (const auto& b : bands)
+    j.push_back({{"f_lo_hz", b.band.f_lo_hz},
+                 {"f_hi_hz", b.band.f_hi_hz},
+                 {"significance", Num(b.band.significance)},
+                 {"gap_before", Num(b.gap_before)},
+                 {"gap_after", Num(b.gap_after)}});
+  return j;
+}
+
+std::string Fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+std::string ParamText(const analysis::NamedValue& p) {
+  std::string s = p.name + " = " + Fmt("%.5g", p.value);
+  if (std::isfinite(p.sigma) && p.sigma > 0.0) s += " +- " + Fmt("%.2g", p.sigma);
+  return s;
+}
+
+}  // namespace
+
+const analysis::RankedEffect* Winner(const analysis::GapSummary& gap) {
+  if (gap.winner.empty()) return nullptr;
+  for (const auto& r : gap.ranking)
+    if (r.effect == gap.effect) return &r;
+  return nullptr;
+}
+
+json GapReportJson(const GapReport& r) {
+  const analysis::GapSummary& g = r.gap;
+  json j;
+  j["quantity"] = QuantityName(r.quantity);
+  j["effect"] = g.effect;
+  json names = json::array();
+  for (const auto& e : g.winner) names.push_back(analysis::ToString(e.kind));
+  j["effects"] = names;
+  const analysis::RankedEffect* w = Winner(g);
+  j["params"] = w ? ParamsValue(w->params) : json::object();
+  j["gap_before"] = Num(g.gap_before);
+  j["gap_after"] = Num(g.gap_after);
+  j["chi2_before"] = Num(g.chi2_before);
+  j["chi2_after"] = Num(g.chi2_after);
+  j["residuals"] = g.residuals;
+  j["noise_z_before"] = Num(g.noise_z_before);
+  j["noise_z_after"] = Num(g.noise_z_after);
+  j["heldout"] = {{"gap_before", Num(g.heldout.gap_before)},
+                  {"gap_after", Num(g.heldout.gap_after)},
+                  {"method", g.heldout.method}};
+  j["where"] = Bands(g.where);
+  j["where_after"] = Bands(g.where_after);
+  json ranking = json::array();
+  for (const auto& e : g.ranking)
+    ranking.push_back({{"effect", e.effect},
+                       {"params", ParamsValue(e.params)},
+                       {"params_sigma", ParamsSigma(e.params)},
+                       {"score", Num(e.score)},
+                       {"gap_after", Num(e.gap_after)},
+                       {"plausible", e.plausible},
+                       {"rejected", e.rejected}});
+  j["ranking"] = ranking;
+  json features = json::array();
+  json refit = json::array();
+  for (std::size_t u = 0; u < r.features.size() && u < r.measured.size(); ++u) {
+    const auto& f = r.features[u];
+    for (const auto& x : f.features)
+      features.push_back({{"measurement", r.measured[u].source},
+                          {"name", x.name},
+                          {"simulated", Num(x.simulated)},
+                          {"measured", Num(x.measured)},
+                          {"gap", Num(x.gap)},
+                          {"sigma", Num(x.sigma)},
+                          {"significance", Num(x.significance)}});
+    refit.push_back({{"measurement", r.measured[u].source},
+                     {"usable", f.usable},
+                     {"message", f.message},
+                     {"params", FittedParams(f.refit.params)},
+                     {"gap_after_refit", Num(f.gap_after_refit)}});
+  }
+  j["features"] = features;
+  j["refit"] = refit;
+  j["calibration"] = {{"simulation", r.simulation.source},
+                      {"kind", r.simulation.kind},
+                      {"note", r.simulation.note},
+                      {"message", r.calibration.message},
+                      {"params", FittedParams(r.calibration.params)},
+                      {"misfit_rel_rms", Num(r.calibration.misfit_rel_rms)},
+                      {"inertia_kg_m2", Num(r.calibration.nominal.inertia_kg_m2)}};
+  json meas = json::array();
+  for (std::size_t u = 0; u < r.measured.size(); ++u) {
+    json m = {{"source", r.measured[u].source},
+              {"kind", r.measured[u].kind},
+              {"note", r.measured[u].note},
+              {"lines", r.measured[u].frf.size()},
+              {"sigma_estimated", r.measured[u].sigma_estimated}};
+    if (u < g.units.size()) {
+      m["gap_before"] = Num(g.units[u].gap_before);
+      m["gap_after"] = Num(g.units[u].gap_after);
+    }
+    meas.push_back(m);
+  }
+  j["measurements"] = meas;
+  j["sigma_pool_lines"] = r.sigma_pool;
+  if (r.prediction) {
+    const auto& p = r.prediction->prediction;
+    json effects = json::array();
+    for (const auto& e : p.effects)
+      effects.push_back({{"effect", analysis::ToString(e.kind)}, {"params", e.params}});
+    j["prediction"] = {{"simulation", r.prediction->simulation.source},
+                       {"usable", p.usable},
+                       {"f0_simulated_hz", Num(p.f0_simulated_hz)},
+                       {"f0_predicted_hz", Num(p.f0_predicted_hz)},
+                       {"sigma_f0_hz", Num(p.sigma_f0_hz)},
+                       {"q_predicted", Num(p.q_predicted)},
+                       {"effects", effects},
+                       {"message", p.message}};
+  }
+  j["score_rule"] =
+      "BIC = chi2 + p ln(2K), chi2 = 2 sum |H_meas - H_model|^2 / sigma^2; an effect is named "
+      "when it scores at least 10 below none";
+  j["message"] = g.message;
+  return j;
+}
+
+std::string GapReportText(const GapReport& r) {
+  const analysis::GapSummary& g = r.gap;
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os << "eol gap (" << QuantityName(r.quantity) << ", " << r.measured.size() << " measured unit"
+     << (r.measured.size() == 1 ? "" : "s") << ")\n";
+  os << "simulation   " << r.simulation.source << ": " << r.simulation.note << "\n";
+  os << "  nominal    ";
+  for (const auto& p : r.calibration.params) os << p.name << " " << Fmt("%.5g", p.value) << "  ";
+  os << "(misfit " << Fmt("%.2g", r.calibration.misfit_rel_rms) << " rms relative";
+  if (r.calibration.nominal.inertia_kg_m2 > 0.0)
+    os << ", J_r " << Fmt("%.4g", r.calibration.nominal.inertia_kg_m2) << " kg m^2";
+  os << ")\n";
+  for (std::size_t u = 0; u < r.measured.size(); ++u) {
+    os << "measured     " << r.measured[u].source << ": " << r.measured[u].note << "\n";
+    if (u < g.units.size())
+      os << "             g " << Fmt("%.3f", g.units[u].gap_before) << " -> "
+         << Fmt("%.3f", g.units[u].gap_after) << "\n";
+  }
+  if (r.sigma_pool > 0)
+    os << "             sigma pooled over +-" << r.sigma_pool << " lines (relative variance)\n";
+  os << "\nGAP          g = " << Fmt("%.3f", g.gap_before) << " over " << g.residuals / 2
+     << " lines (1 = within the noise; chi2 test z = " << Fmt("%.1f", g.noise_z_before) << ")\n";
+  os << "WHERE        ";
+  if (g.where.empty()) os << "no band of the residual is significant";
+  os << "\n";
+  for (std::size_t i = 0; i < g.where.size(); ++i) {
+    const auto& b = g.where[i];
+    os << "  " << i + 1 << ". " << Fmt("%.1f", b.band.f_lo_hz) << " - "
+       << Fmt("%.1f", b.band.f_hi_hz) << " Hz   significance " << Fmt("%.1f", b.band.significance)
+       << "   g " << Fmt("%.2f", b.gap_before) << " -> " << Fmt("%.2f", b.gap_after) << "\n";
+  }
+  if (!r.features.empty()) {
+    os << "  features (refit of the nominal to " << r.measured.front().source
+       << " minus simulation):\n";
+    const auto& f = r.features.front();
+    if (!f.usable) os << "    " << f.message << "\n";
+    for (const auto& x : f.features)
+      os << "    " << x.name << ": simulated " << Fmt("%.5g", x.simulated) << ", measured "
+         << Fmt("%.5g", x.measured) << ", gap " << Fmt("%+.4g", x.gap) << " +- "
+         << Fmt("%.2g", x.sigma) << " (" << Fmt("%.1f", x.significance) << " sigma)\n";
+    if (f.usable)
+      os << "    a refit of the nominal's own parameters leaves g = "
+         << Fmt("%.3f", f.gap_after_refit) << " (calibration, not an unmodelled effect)\n";
+  }
+  os << "WHICH        " << g.effect << "\n";
+  if (const analysis::RankedEffect* w = Winner(g)) {
+    for (const auto& p : w->params) os << "               " << ParamText(p) << "\n";
+  }
+  os << "  ranking (score = BIC; an effect needs 10 below none):\n";
+  int rank = 0;
+  for (const auto& e : g.ranking) {
+    os << "  " << Fmt("%3.0f", ++rank) << ". " << e.effect;
+    for (std::size_t pad = e.effect.size(); pad < 36; ++pad) os << ' ';
+    os << Fmt("%12.1f", e.score) << "   g " << Fmt("%.3f", e.gap_after);
+    if (!e.plausible) os << "   rejected: " << e.rejected;
+    os << "\n";
+  }
+  os << "HOW FAR      g " << Fmt("%.3f", g.gap_before) << " -> " << Fmt("%.3f", g.gap_after)
+     << " overall; held out (" << g.heldout.method << ") " << Fmt("%.3f", g.heldout.gap_before)
+     << " -> " << Fmt("%.3f", g.heldout.gap_after) << "\n";
+  if (!g.where_after.empty())
+    os << "  still significant after it: " << g.where_after.size() << " band(s), the first "
+       << Fmt("%.1f", g.where_after.front().band.f_lo_hz) << " - "
+       << Fmt("%.1f", g.where_after.front().band.f_hi_hz) << " Hz\n";
+  if (r.prediction) {
+    os << "PREDICTION   " << r.prediction->simulation.source << ": "
+       << r.prediction->prediction.message << "\n";
+  }
+  os << "\n" << g.message << "\n";
+  return os.str();
+}
+
+}  // namespace eol::station::cli

@@ -1,0 +1,71 @@
+// The report of `eol gap`: text for people and JSON for programs.
+//
+// JSON (stable names, SI units; NaN is written as null):
+//   quantity            "impedance" | "mobility"
+//   effect              the winner: an effect name, "a+b" for a pair, "none" (consistent with
+//                       the noise) or "unexplained" (not noise, but no candidate explains it)
+//   effects             the winner's effect names (empty for none / unexplained)
+//   params              the winner's parameters {name: value} (fitted, then derived)
+//   gap_before, gap_after        g = sqrt(mean |H_meas - H_model|^2 / sigma^2) over all lines
+//   chi2_before, chi2_after, residuals (2K), noise_z_before, noise_z_after (chi2 test z)
+//   heldout             {gap_before, gap_after, method}: "interleaved-2fold",
+//                       "leave-one-unit-out" or "none"
+//   where               [{f_lo_hz, f_hi_hz, significance, gap_before, gap_after}] bands of the
+//                       nominal's normalised residual, most significant first; significance
+//                       is the Gaussian-equivalent z of the band's chi2 (residual.h)
+//   where_after         the bands that remain after the winner
+//   ranking             [{effect, params {name: value}, params_sigma {name: sigma}, score
+//                       (BIC), gap_after, plausible, rejected}], best first, "none" included
+//   features            [{measurement, name, simulated, measured, gap, sigma, significance}]
+//                       names f0_hz, q, peak_height_ohm, r_ohm, l_h (impedance) or
+//                       gain_rad_per_s2_per_a, damping_per_s (mobility)
+//   calibration         {simulation, kind, note, params {name: {value, sigma}},
+//                       misfit_rel_rms, inertia_kg_m2}: the nominal fitted to the simulation
+//   refit               [{measurement, params {name: {value, sigma}}, gap_after_refit}]: the
+//                       nominal refitted to each measurement (not an unmodelled effect)
+//   measurements        [{source, kind, note, lines, sigma_estimated, gap_before, gap_after}]
+//   prediction          (with --predict-sim) {simulation, f0_simulated_hz, f0_predicted_hz,
+//                       sigma_f0_hz, q_predicted, effects [{effect, params}], message}
+//   score_rule, message
+// Effect parameter names: effects.h (k_fixture_ratio, fixture_loss_factor,
+// k_fixture_nm_per_rad, f_loaded_hz, delay_s, capacitance_f, resistance_ohm, l2_h, r2_ohm,
+// corner_hz, skin_r_rise_at_1khz, f_hz, q, height_ohm | height_rad_per_s_per_a, creep_lambda).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/gap/calibration.h"
+#include "analysis/gap/diagnosis.h"
+#include "analysis/gap/features.h"
+#include "analysis/gap/prediction.h"
+#include "station/files/gap_inputs.h"
+
+namespace eol::station::cli {
+
+struct GapPrediction {
+  files::GapInput simulation;
+  analysis::CalibrationSummary calibration;
+  analysis::PredictionSummary prediction;
+};
+
+struct GapReport {
+  analysis::Quantity quantity = analysis::Quantity::kImpedanceOhm;
+  files::GapInput simulation;
+  analysis::CalibrationSummary calibration;
+  std::vector<files::GapInput> measured;
+  int sigma_pool = 0;
+  analysis::GapSummary gap;
+  std::vector<analysis::FeatureSummary> features;  // per measured unit
+  std::optional<GapPrediction> prediction;
+};
+
+// The ranking entry of the winner, or nullptr for none / unexplained.
+const analysis::RankedEffect* Winner(const analysis::GapSummary& gap);
+
+nlohmann::json GapReportJson(const GapReport& report);
+std::string GapReportText(const GapReport& report);
+
+}  // namespace eol::station::cli
