@@ -24,6 +24,7 @@
 //   refit               [{measurement, params {name: {value, sigma}}, gap_after_refit}]: the
 //                       nominal refitted to each measurement (not an unmodelled effect)
 //   measurements        [{source, kind, note, lines, sigma_estimated, gap_before, gap_after}]
+//   sigma_pool_lines    the --sigma-pool half-width used (0: the files' sigma as given)
 //   prediction          (with --predict-sim) {simulation, f0_simulated_hz, f0_predicted_hz,
 //                       sigma_f0_hz, q_predicted, effects [{effect, params}], message}
 //   score_rule, message

@@ -1,0 +1,335 @@
+#include "analysis/gap/diagnosis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace eol::analysis {
+namespace {
+
+using Cplx = std::complex<double>;
+
+// chi2 and dof per distinct frequency, pooled over units.
+struct Pooled {
+  std::vector<double> f, chi2, dof;
+};
+
+Pooled Pool(const NominalNetwork& n, std::span<const AppliedEffect> effects,
+            const std::vector<GapUnit>& units) {
+  std::map<double, std::pair<double, double>> acc;
+  for (const GapUnit& u : units)
+    for (std::size_t k = 0; k < u.size(); ++k) {
+      const Cplx d = u.value[k] - EvaluateNetwork(n, effects, u.freq_hz[k]);
+      auto& a = acc[u.freq_hz[k]];
+      a.first += 2.0 * std::norm(d) / (u.sigma[k] * u.sigma[k]);
+      a.second += 2.0;
+    }
+  Pooled p;
+  for (const auto& [f, v] : acc) {
+    p.f.push_back(f);
+    p.chi2.push_back(v.first);
+    p.dof.push_back(v.second);
+  }
+  return p;
+}
+
+double BandG(const Pooled& p, const GapBand& b) {
+  double c = 0.0, d = 0.0;
+  for (int k = b.first; k <= b.last; ++k) {
+    c += p.chi2[static_cast<std::size_t>(k)];
+    d += p.dof[static_cast<std::size_t>(k)];
+  }
+  return d > 0.0 ? std::sqrt(c / d) : 0.0;
+}
+
+std::vector<BandGap> WithGaps(const std::vector<GapBand>& bands, const Pooled& before,
+                              const Pooled& after) {
+  std::vector<BandGap> out;
+  for (const GapBand& b : bands) out.push_back({b, BandG(before, b), BandG(after, b)});
+  return out;
+}
+
+std::string JoinNames(const std::vector<AppliedEffect>& effects) {
+  std::string s;
+  for (const AppliedEffect& e : effects)
+    s += (s.empty() ? "" : "+") + std::string(ToString(e.kind));
+  return s;
+}
+
+RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit) {
+  RankedEffect r;
+  r.effects = fit.effects;
+  r.effect = JoinNames(fit.effects);
+  r.chi2 = fit.chi2;
+  r.score = fit.chi2 + fit.n_params * std::log(std::max(fit.residuals, 1));
+  r.gap_after = fit.residuals > 0 ? std::sqrt(fit.chi2 / fit.residuals) : 0.0;
+  r.converged = fit.converged;
+  for (std::size_t e = 0; e < fit.effects.size(); ++e) {
+    const EffectSpec spec = fitter.Spec(fit.effects[e].kind);
+    for (std::size_t p = 0; p < spec.params.size(); ++p) {
+      const double sigma = e < fit.sigma.size() && p < fit.sigma[e].size()
+                               ? fit.sigma[e][p]
+                               : std::numeric_limits<double>::quiet_NaN();
+      r.params.push_back(
+          {spec.params[p].name, spec.params[p].unit, fit.effects[e].params[p], sigma});
+    }
+  }
+  for (const AppliedEffect& e : fit.effects) {
+    for (const DerivedParam& d : DeriveEffectParams(fitter.nominal(), e)) {
+      // First-order sigma of a derived value is not propagated here; the fitted one is.
+      r.params.push_back({d.name, d.unit, d.value, std::numeric_limits<double>::quiet_NaN()});
+    }
+  }
+  std::string why;
+  for (const AppliedEffect& e : fit.effects) {
+    if (!IsPlausible(fitter.Spec(e.kind), e, &why)) {
+      r.plausible = false;
+      r.rejected = std::string(ToString(e.kind)) + ": implausible, " + why;
+      break;
+    }
+  }
+  if (r.plausible && !fit.converged) {
+    r.plausible = false;
+    r.rejected = "the fit did not converge";
+  }
+  return r;
+}
+
+bool BetterRank(const RankedEffect& a, const RankedEffect& b) {
+  if (a.plausible != b.plausible) return a.plausible;
+  return a.score < b.score;
+}
+
+LineMask ParityMask(const std::vector<GapUnit>& units, int parity) {
+  LineMask m(units.size());
+  for (std::size_t u = 0; u < units.size(); ++u) {
+    m[u].resize(units[u].size());
+    for (std::size_t k = 0; k < units[u].size(); ++k)
+      m[u][k] = (k % 2) == static_cast<std::size_t>(parity);
+  }
+  return m;
+}
+
+LineMask UnitMask(const std::vector<GapUnit>& units, std::size_t which, bool invert) {
+  LineMask m(units.size());
+  for (std::size_t u = 0; u < units.size(); ++u)
+    m[u].assign(units[u].size(), static_cast<char>((u == which) != invert));
+  return m;
+}
+
+HeldOutGap HeldOut(const EffectFitter& fitter, const std::vector<AppliedEffect>& winner,
+                   const GapOptions& o) {
+  const std::vector<GapUnit>& units = fitter.units();
+  HeldOutGap h;
+  std::vector<std::pair<LineMask, LineMask>> folds;  // (fit on, predict)
+  if (units.size() == 1) {
+    h.method = "interleaved-2fold";
+    folds.push_back({ParityMask(units, 0), ParityMask(units, 1)});
+    folds.push_back({ParityMask(units, 1), ParityMask(units, 0)});
+  } else {
+    h.method = "leave-one-unit-out";
+    for (std::size_t u = 0; u < units.size(); ++u)
+      folds.push_back({UnitMask(units, u, true), UnitMask(units, u, false)});
+  }
+  double before = 0.0, after = 0.0;
+  int n = 0;
+  for (const auto& [fit_on, predict] : folds) {
+    const EffectFit fit = fitter.Fit(winner, fit_on, o.max_iterations);
+    int m = 0;
+    after += fitter.Chi2(fit.effects, predict, &m);
+    before += fitter.Chi2({}, predict);
+    n += m;
+  }
+  h.gap_before = n > 0 ? std::sqrt(before / n) : 0.0;
+  h.gap_after = n > 0 ? std::sqrt(after / n) : 0.0;
+  return h;
+}
+
+bool CheckUnits(const std::vector<GapUnit>& units, std::string* why) {
+  if (units.empty()) {
+    *why = "no measured unit";
+    return false;
+  }
+  for (const GapUnit& u : units) {
+    const std::string name = u.name.empty() ? "a unit" : "unit " + u.name;
+    if (u.size() < 5 || u.value.size() != u.size() || u.sigma.size() != u.size()) {
+      *why = name + ": needs at least 5 lines, each with a value and a sigma";
+      return false;
+    }
+    for (std::size_t k = 0; k < u.size(); ++k) {
+      if (!(u.freq_hz[k] > 0.0 && std::isfinite(u.freq_hz[k])) ||
+          (k > 0 && !(u.freq_hz[k] > u.freq_hz[k - 1])) || !std::isfinite(u.value[k].real()) ||
+          !std::isfinite(u.value[k].imag()) || !(u.sigma[k] > 0.0 && std::isfinite(u.sigma[k]))) {
+        std::ostringstream os;
+        os << name << ": line " << k << " (" << u.freq_hz[k]
+           << " Hz) has a bad frequency, value or sigma";
+        *why = os.str();
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool GapOptions::IsValid(std::string* why) const {
+  auto fail = [&](const char* m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!bands.IsValid(why)) return false;
+  if (!(min_score_gain >= 0.0)) return fail("min_score_gain must not be negative");
+  if (!(noise_z_max > 0.0)) return fail("noise_z_max must be positive");
+  if (pair_candidates < 2) return fail("pair_candidates must be at least 2");
+  if (max_iterations < 1) return fail("max_iterations must be at least 1");
+  return true;
+}
+
+std::vector<double> NormalisedResidual(const NominalNetwork& nominal,
+                                       std::span<const AppliedEffect> effects,
+                                       const GapUnit& unit) {
+  std::vector<double> r(unit.size());
+  for (std::size_t k = 0; k < unit.size(); ++k)
+    r[k] = std::abs(unit.value[k] - EvaluateNetwork(nominal, effects, unit.freq_hz[k])) /
+           unit.sigma[k];
+  return r;
+}
+
+GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>& units,
+                       const GapOptions& o) {
+  GapSummary s;
+  std::string why;
+  if (!o.IsValid(&why)) {
+    s.message = "invalid options: " + why;
+    return s;
+  }
+  if (!nominal.IsValid(&why)) {
+    s.message = "invalid nominal: " + why;
+    return s;
+  }
+  if (!CheckUnits(units, &why)) {
+    s.message = "invalid measurement: " + why;
+    return s;
+  }
+  const EffectFitter fitter(nominal, units);
+  const LineMask all;
+  s.chi2_before = fitter.Chi2({}, all, &s.residuals);
+  s.gap_before = std::sqrt(s.chi2_before / s.residuals);
+  s.noise_z_before = ChiSquareZ(s.chi2_before, s.residuals);
+  const Pooled pooled_before = Pool(nominal, {}, units);
+  const std::vector<GapBand> bands_before =
+      FindGapBands(pooled_before.f, pooled_before.chi2, pooled_before.dof, o.bands);
+  const bool nominal_consistent = s.noise_z_before <= o.noise_z_max && bands_before.empty();
+
+  // Singles.
+  const std::vector<EffectKind> library =
+      o.effects.empty() ? EffectsFor(nominal.quantity) : o.effects;
+  std::vector<RankedEffect> singles;
+  std::map<EffectKind, AppliedEffect> single_fit;
+  for (EffectKind kind : library) {
+    if (nominal.quantity == Quantity::kMobility && kind != EffectKind::kSecondMode &&
+        kind != EffectKind::kChannelDelay)
+      continue;
+    const EffectFit fit = fitter.FitKinds({kind}, {}, all, o.max_iterations);
+    if (fit.effects.empty()) continue;
+    single_fit[kind] = fit.effects.front();
+    singles.push_back(Rank(fitter, fit));
+  }
+  std::sort(singles.begin(), singles.end(), BetterRank);
+  RankedEffect none;
+  none.effect = "none";
+  none.chi2 = s.chi2_before;
+  none.score = s.chi2_before;
+  none.gap_after = s.gap_before;
+  std::vector<RankedEffect> ranking = singles;
+  ranking.push_back(none);
+
+  const RankedEffect* best = nullptr;
+  if (!singles.empty() && singles.front().plausible &&
+      singles.front().score <= none.score - o.min_score_gain)
+    best = &singles.front();
+  RankedEffect winner = best ? *best : none;
+
+  // Pairs, when the best single leaves a residual inconsistent with the noise.
+  if (best && o.try_pairs && library.size() >= 2) {
+    const Pooled after = Pool(nominal, best->effects, units);
+    const bool consistent = ChiSquareZ(best->chi2, s.residuals) <= o.noise_z_max &&
+                            FindGapBands(after.f, after.chi2, after.dof, o.bands).empty();
+    if (!consistent) {
+      std::set<std::pair<EffectKind, EffectKind>> pairs;
+      auto add = [&](EffectKind a, EffectKind b) {
+        if (a == b || !single_fit.count(a) || !single_fit.count(b)) return;
+        pairs.insert({std::min(a, b), std::max(a, b)});
+      };
+      const std::size_t top = std::min<std::size_t>(singles.size(), o.pair_candidates);
+      for (std::size_t i = 0; i < top; ++i)
+        for (std::size_t j = i + 1; j < top; ++j)
+          add(singles[i].effects.front().kind, singles[j].effects.front().kind);
+      for (const auto& [kind, fit] : single_fit) add(best->effects.front().kind, kind);
+      std::vector<RankedEffect> pair_ranks;
+      for (const auto& [a, b] : pairs) {
+        const EffectFit fit =
+            fitter.FitKinds({a, b}, {single_fit[a], single_fit[b]}, all, o.max_iterations);
+        if (fit.effects.size() == 2) pair_ranks.push_back(Rank(fitter, fit));
+      }
+      std::sort(pair_ranks.begin(), pair_ranks.end(), BetterRank);
+      if (!pair_ranks.empty() && pair_ranks.front().plausible &&
+          pair_ranks.front().score <= winner.score - o.min_score_gain)
+        winner = pair_ranks.front();
+      ranking.insert(ranking.end(), pair_ranks.begin(), pair_ranks.end());
+    }
+  }
+  std::stable_sort(ranking.begin(), ranking.end(), BetterRank);
+  s.ranking = ranking;
+
+  if (winner.effect == "none") {
+    s.effect = nominal_consistent ? "none" : "unexplained";
+  } else {
+    s.effect = winner.effect;
+    s.winner = winner.effects;
+  }
+  s.chi2_after = winner.effect == "none" ? s.chi2_before : winner.chi2;
+  s.gap_after = std::sqrt(s.chi2_after / s.residuals);
+  s.noise_z_after = ChiSquareZ(s.chi2_after, s.residuals);
+  const Pooled pooled_after = Pool(nominal, s.winner, units);
+  s.where = WithGaps(bands_before, pooled_before, pooled_after);
+  s.where_after =
+      WithGaps(FindGapBands(pooled_after.f, pooled_after.chi2, pooled_after.dof, o.bands),
+               pooled_before, pooled_after);
+  for (std::size_t u = 0; u < units.size(); ++u) {
+    const LineMask m = UnitMask(units, u, false);
+    int n = 0;
+    const double before = fitter.Chi2({}, m, &n);
+    const double after = fitter.Chi2(s.winner, m);
+    s.units.push_back({units[u].name, n / 2, std::sqrt(before / n), std::sqrt(after / n)});
+  }
+  if (s.winner.empty() || !o.heldout) {
+    s.heldout = {s.gap_before, s.gap_before, s.winner.empty() ? "none" : "skipped"};
+  } else {
+    s.heldout = HeldOut(fitter, s.winner, o);
+  }
+
+  std::ostringstream os;
+  os.precision(4);
+  if (s.effect == "none") {
+    os << "no unmodelled effect: the residual is consistent with the noise (g = " << s.gap_before
+       << ", chi2 test z = " << s.noise_z_before << ")";
+  } else if (s.effect == "unexplained") {
+    os << "the gap (g = " << s.gap_before << ") is not explained by any candidate effect";
+  } else {
+    os << s.effect << " explains the gap: g " << s.gap_before << " -> " << s.gap_after
+       << " (held out, " << s.heldout.method << ": " << s.heldout.gap_before << " -> "
+       << s.heldout.gap_after << ")";
+    if (s.noise_z_after > o.noise_z_max || !s.where_after.empty())
+      os << "; a significant residual remains";
+  }
+  s.message = os.str();
+  s.usable = true;
+  return s;
+}
+
+}  // namespace eol::analysis

@@ -1,0 +1,118 @@
+// Sim-to-real gap diagnosis (issue 4): where the measurement leaves the simulation, which
+// unmodelled effect explains it, and how far the gap shrinks, also on held-out data.
+//
+// Input: the nominal network calibrated to the simulation (calibration.h) and one or more
+// measured units (several units or rotor positions of one design), each line with sigma.
+// Metric: g = sqrt(mean |H_meas - H_model|^2 / sigma^2) over all lines of all units
+// (residual.h); chi2 = 2 K g^2 over 2K real residuals.
+//
+// Which (the nominal's parameters stay at the simulation's values):
+//   1. every effect of the library (effects.h) is fitted on top of the nominal, its
+//      parameters shared by all units (one fixture, one cable);
+//   2. score = BIC = chi2 + p ln(2K) (p fitted parameters; "none" scores chi2 of the
+//      nominal); a fit outside its plausibility bounds, or not converged, is rejected;
+//   3. the best plausible single effect is named when it lowers the score by at least
+//      min_score_gain below "none" (10: very strong evidence on the BIC scale). Otherwise the
+//      answer is "none" when the nominal's residual is consistent with the noise (chi2 test
+//      z <= noise_z_max and no significant band) and "unexplained" when it is not;
+//   4. when the winner still leaves a residual inconsistent with the noise, pairs are fitted
+//      (the pair_candidates best singles among themselves, and the winner with every other
+//      effect); a plausible pair wins when it lowers the score by min_score_gain more. Its
+//      name joins the two with "+" in EffectKind order ("second_mode+channel_delay").
+// Held out: one unit -> two-fold interleaved lines (fit the winner on the even lines, predict
+// the odd ones, and the reverse; every line is predicted by a fit that did not see it);
+// several units -> leave-one-unit-out. gap_before there is the nominal's g on the same lines.
+// Where: bands of the nominal's normalised residual (residual.h), with g before and after
+// the winning effect inside each band; where_after: the bands that remain after it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "analysis/gap/effect_fit.h"
+#include "analysis/gap/residual.h"
+#include "analysis/model/effects.h"
+
+namespace eol::analysis {
+
+struct GapOptions {
+  BandSearchOptions bands;
+  double min_score_gain = 10.0;  // BIC units
+  // chi2 test of "consistent with the noise": z at most this. High (near the band threshold)
+  // because sigma is itself estimated: from 4 periods pooled over 11 lines (periodic_frf.h)
+  // it carries 66 degrees of freedom, which alone lifts g^2 by ~3 % (z ~ 0.8 over 601 lines)
+  // and spreads it (z about +-1).
+  double noise_z_max = 5.0;
+  bool try_pairs = true;
+  int pair_candidates = 4;
+  int max_iterations = 200;
+  bool heldout = true;
+  std::vector<EffectKind> effects;  // the library to try; empty: EffectsFor(quantity)
+
+  bool IsValid(std::string* why) const;
+};
+
+struct NamedValue {
+  std::string name;
+  std::string unit;
+  double value = 0.0;
+  double sigma = 0.0;  // NaN when not determined; 0 for derived values without one
+};
+
+struct RankedEffect {
+  std::string effect;  // "none", a name, or "a+b"
+  std::vector<AppliedEffect> effects;
+  std::vector<NamedValue> params;  // fitted, then derived (effects.h)
+  double chi2 = 0.0;
+  double score = 0.0;  // BIC
+  double gap_after = 0.0;
+  bool plausible = true;
+  bool converged = true;
+  std::string rejected;  // why not plausible
+};
+
+struct BandGap {
+  GapBand band;
+  double gap_before = 0.0;
+  double gap_after = 0.0;
+};
+
+struct HeldOutGap {
+  double gap_before = 0.0;
+  double gap_after = 0.0;
+  std::string method;  // "interleaved-2fold", "leave-one-unit-out", "none"
+};
+
+struct UnitGap {
+  std::string name;
+  int lines = 0;
+  double gap_before = 0.0;
+  double gap_after = 0.0;
+};
+
+struct GapSummary {
+  bool usable = false;
+  std::string message;
+  std::string effect = "none";        // winner, "none" or "unexplained"
+  std::vector<AppliedEffect> winner;  // empty for none / unexplained
+  double gap_before = 0.0, gap_after = 0.0;
+  double chi2_before = 0.0, chi2_after = 0.0;
+  int residuals = 0;                                 // 2K
+  double noise_z_before = 0.0, noise_z_after = 0.0;  // chi2 test z (residual.h)
+  HeldOutGap heldout;
+  std::vector<BandGap> where;
+  std::vector<BandGap> where_after;
+  std::vector<RankedEffect> ranking;  // best score first; rejected fits last
+  std::vector<UnitGap> units;
+};
+
+// Never throws for bad data; usable == false with the reason (bad units, no lines, invalid
+// options or nominal).
+GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>& units,
+                       const GapOptions& options);
+
+// Normalised residual |r_k| of every line of one unit against nominal + effects.
+std::vector<double> NormalisedResidual(const NominalNetwork& nominal,
+                                       std::span<const AppliedEffect> effects, const GapUnit& unit);
+
+}  // namespace eol::analysis

@@ -1,0 +1,380 @@
+#include "analysis/gap/effect_fit.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <numbers>
+
+#include "analysis/fit/least_squares.h"
+
+namespace eol::analysis {
+namespace {
+
+using Cplx = std::complex<double>;
+
+constexpr double kLmTol = 1e-10;
+
+double TwoPi() { return 2.0 * std::numbers::pi; }
+
+// Lines selected by a mask, flattened over units, with the base model's values there.
+struct Lines {
+  std::vector<double> f;
+  std::vector<Cplx> meas, base;
+  std::vector<double> weight;  // 2 / sigma^2
+  double chi2 = 0.0;           // of the base
+};
+
+Lines Collect(const NominalNetwork& n, const std::vector<GapUnit>& units,
+              std::span<const AppliedEffect> base, const LineMask& mask) {
+  Lines l;
+  for (std::size_t u = 0; u < units.size(); ++u) {
+    const GapUnit& unit = units[u];
+    for (std::size_t k = 0; k < unit.size(); ++k) {
+      if (!Selected(mask, u, k)) continue;
+      l.f.push_back(unit.freq_hz[k]);
+      l.meas.push_back(unit.value[k]);
+      l.base.push_back(EvaluateNetwork(n, base, unit.freq_hz[k]));
+      l.weight.push_back(2.0 / (unit.sigma[k] * unit.sigma[k]));
+      l.chi2 += l.weight.back() * std::norm(l.meas.back() - l.base.back());
+    }
+  }
+  return l;
+}
+
+// Weighted least-squares real amplitude c of r ~ c B; returns c, *reduction = chi2 decrease.
+double Amplitude(const Lines& l, const std::vector<Cplx>& shape, double* reduction) {
+  double num = 0.0, den = 0.0;
+  for (std::size_t k = 0; k < l.f.size(); ++k) {
+    const Cplx r = l.meas[k] - l.base[k];
+    num += l.weight[k] * std::real(std::conj(shape[k]) * r);
+    den += l.weight[k] * std::norm(shape[k]);
+  }
+  if (!(den > 0.0)) {
+    if (reduction) *reduction = 0.0;
+    return 0.0;
+  }
+  if (reduction) *reduction = num * num / den;
+  return num / den;
+}
+
+std::vector<Cplx> Shape(const Lines& l, const std::function<Cplx(double f, Cplx h)>& fn) {
+  std::vector<Cplx> b(l.f.size());
+  for (std::size_t k = 0; k < l.f.size(); ++k) b[k] = fn(l.f[k], l.base[k]);
+  return b;
+}
+
+struct Candidate {
+  double reduction;
+  std::vector<double> params;
+};
+
+std::vector<std::vector<double>> Best(std::vector<Candidate> c, std::size_t n) {
+  std::sort(c.begin(), c.end(),
+            [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
+  std::vector<std::vector<double>> out;
+  for (std::size_t i = 0; i < c.size() && out.size() < n; ++i) out.push_back(c[i].params);
+  return out;
+}
+
+std::vector<double> LogSpace(double lo, double hi, int n) {
+  std::vector<double> v(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i)
+    v[static_cast<std::size_t>(i)] = lo * std::pow(hi / lo, static_cast<double>(i) / (n - 1));
+  return v;
+}
+
+// theta <-> natural parameters of a list of effects.
+struct Layout {
+  std::vector<EffectSpec> specs;
+  std::vector<AppliedEffect> shape;  // kinds and parameter counts
+
+  int size() const {
+    int n = 0;
+    for (const auto& e : shape) n += static_cast<int>(e.params.size());
+    return n;
+  }
+  Eigen::VectorXd ToTheta(const std::vector<AppliedEffect>& effects) const {
+    Eigen::VectorXd t(size());
+    int i = 0;
+    for (std::size_t e = 0; e < effects.size(); ++e)
+      for (std::size_t p = 0; p < effects[e].params.size(); ++p, ++i) {
+        const EffectParamSpec& ps = specs[e].params[p];
+        const double v = effects[e].params[p];
+        t(i) = ps.log_scale ? std::log(std::max(v, 1e-9 * ps.scale)) : v / ps.scale;
+      }
+    return t;
+  }
+  std::vector<AppliedEffect> FromTheta(const Eigen::VectorXd& t) const {
+    std::vector<AppliedEffect> out = shape;
+    int i = 0;
+    for (std::size_t e = 0; e < out.size(); ++e)
+      for (std::size_t p = 0; p < out[e].params.size(); ++p, ++i) {
+        const EffectParamSpec& ps = specs[e].params[p];
+        out[e].params[p] = ps.log_scale ? std::exp(t(i)) : t(i) * ps.scale;
+      }
+    return out;
+  }
+  // d natural / d theta at the point.
+  double Slope(const std::vector<AppliedEffect>& at, std::size_t e, std::size_t p) const {
+    const EffectParamSpec& ps = specs[e].params[p];
+    return ps.log_scale ? at[e].params[p] : ps.scale;
+  }
+};
+
+// The weighted real residual of nominal + effects(theta) on the lines (effect_fit.h).
+void Residual(const NominalNetwork& n, const Lines& lines, const Layout& layout,
+              const Eigen::VectorXd& theta, Eigen::VectorXd* r) {
+  r->resize(static_cast<long>(2 * lines.f.size()));
+  const std::vector<AppliedEffect> e = layout.FromTheta(theta);
+  for (std::size_t k = 0; k < lines.f.size(); ++k) {
+    const Cplx d = (EvaluateNetwork(n, e, lines.f[k]) - lines.meas[k]) * std::sqrt(lines.weight[k]);
+    (*r)(static_cast<long>(2 * k)) = d.real();
+    (*r)(static_cast<long>(2 * k + 1)) = d.imag();
+  }
+}
+
+// Central differences in theta (every theta is O(1): a logarithm or value / scale).
+void Jacobian(const NominalNetwork& n, const Lines& lines, const Layout& layout,
+              const Eigen::VectorXd& theta, Eigen::MatrixXd* jac) {
+  jac->resize(static_cast<long>(2 * lines.f.size()), theta.size());
+  Eigen::VectorXd up, down;
+  for (long i = 0; i < theta.size(); ++i) {
+    const double h = 1e-6 * std::max(1.0, std::abs(theta(i)));
+    Eigen::VectorXd t = theta;
+    t(i) = theta(i) + h;
+    Residual(n, lines, layout, t, &up);
+    t(i) = theta(i) - h;
+    Residual(n, lines, layout, t, &down);
+    jac->col(i) = (up - down) / (2.0 * h);
+  }
+}
+
+}  // namespace
+
+bool Selected(const LineMask& mask, std::size_t unit, std::size_t line) {
+  return mask.empty() || (unit < mask.size() && line < mask[unit].size() && mask[unit][line]);
+}
+
+EffectFitter::EffectFitter(const NominalNetwork& nominal, const std::vector<GapUnit>& units)
+    : nominal_(nominal), units_(units) {
+  f_lo_ = std::numeric_limits<double>::infinity();
+  f_hi_ = 0.0;
+  for (const GapUnit& u : units_) {
+    if (u.size() == 0) continue;
+    f_lo_ = std::min(f_lo_, u.freq_hz.front());
+    f_hi_ = std::max(f_hi_, u.freq_hz.back());
+  }
+  if (!(f_hi_ > 0.0)) f_lo_ = f_hi_ = 1.0;
+}
+
+double EffectFitter::Chi2(std::span<const AppliedEffect> effects, const LineMask& mask,
+                          int* residuals) const {
+  double chi2 = 0.0;
+  int n = 0;
+  for (std::size_t u = 0; u < units_.size(); ++u) {
+    const GapUnit& unit = units_[u];
+    for (std::size_t k = 0; k < unit.size(); ++k) {
+      if (!Selected(mask, u, k)) continue;
+      const Cplx d = unit.value[k] - EvaluateNetwork(nominal_, effects, unit.freq_hz[k]);
+      chi2 += 2.0 * std::norm(d) / (unit.sigma[k] * unit.sigma[k]);
+      n += 2;
+    }
+  }
+  if (residuals) *residuals = n;
+  return chi2;
+}
+
+std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
+                                                      std::span<const AppliedEffect> base,
+                                                      const LineMask& mask) const {
+  const Lines l = Collect(nominal_, units_, base, mask);
+  const EffectSpec spec = Spec(kind);
+  const MotionalImpedance& m = nominal_.motional;
+  auto s_of = [](double f) { return Cplx(0.0, TwoPi() * f); };
+  double red = 0.0;
+  switch (kind) {
+    case EffectKind::kSeriesResistance:
+      return {{Amplitude(l, Shape(l, [](double, Cplx) { return Cplx(1.0); }), &red)}};
+    case EffectKind::kChannelDelay:
+      return {{Amplitude(l, Shape(l, [&](double f, Cplx h) { return -s_of(f) * h; }), &red)},
+              {0.0}};
+    case EffectKind::kStrayCapacitance: {
+      const double c =
+          Amplitude(l, Shape(l, [&](double f, Cplx h) { return -s_of(f) * h * h; }), &red);
+      const double scale = spec.params[0].scale;
+      return {{c > 0.0 ? c : scale}, {scale * 1e-2}};
+    }
+    case EffectKind::kSkinEffect: {
+      const double a =
+          Amplitude(l, Shape(l, [&](double f, Cplx) { return Cplx(m.r_ohm * f * f / 1e6); }), &red);
+      return {{std::max(a, 0.0)}};
+    }
+    case EffectKind::kLossyInductance: {
+      std::vector<Candidate> c;
+      for (double fc : LogSpace(0.2 * f_lo_, 50.0 * f_hi_, 18)) {
+        const double wc = TwoPi() * fc;
+        const double l2 = Amplitude(
+            l, Shape(l, [&](double f, Cplx) { return -s_of(f) * s_of(f) / (s_of(f) + wc); }), &red);
+        if (l2 > 0.0)
+          c.push_back({red, {std::min(l2, 0.8 * m.l_h), wc * std::min(l2, 0.8 * m.l_h)}});
+      }
+      if (c.empty()) c.push_back({0.0, {spec.params[0].scale, spec.params[1].scale}});
+      return Best(c, 2);
+    }
+    case EffectKind::kFixtureCompliance: {
+      std::vector<Candidate> c;
+      std::vector<AppliedEffect> trial(base.begin(), base.end());
+      trial.push_back({kind, {1.0, 1.0 / m.q}});
+      // The loaded peak must land within a fraction of its bandwidth: one trial per line
+      // below f0 (kappa = r^2 / (1 - r^2), r = f' / f0), then a log grid for small shifts.
+      std::vector<double> kappas = LogSpace(30.0, 1e5, 24);
+      std::vector<double> fs = l.f;
+      std::sort(fs.begin(), fs.end());
+      fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+      const std::size_t stride = std::max<std::size_t>(1, fs.size() / 400);
+      for (std::size_t i = 0; i < fs.size(); i += stride) {
+        const double r = fs[i] / m.f0_hz;
+        if (r > 0.14 && r < 0.995) kappas.push_back(r * r / (1.0 - r * r));
+      }
+      for (double kappa : LogSpace(0.02, 30.0, 24)) kappas.push_back(kappa);
+      for (double kappa : kappas) {
+        trial.back().params = {kappa, FixtureLossKeepingQ(kappa, m.q)};
+        c.push_back({-Chi2(trial, mask), trial.back().params});
+      }
+      return Best(c, 2);
+    }
+    case EffectKind::kAdhesiveCreep: {
+      std::vector<Candidate> c;
+      std::vector<AppliedEffect> trial(base.begin(), base.end());
+      trial.push_back({kind, {0.0}});
+      for (double lambda : {0.003, 0.01, 0.03, 0.1, 0.25}) {
+        trial.back().params[0] = lambda;
+        c.push_back({-Chi2(trial, mask), {lambda}});
+      }
+      return Best(c, 2);
+    }
+    case EffectKind::kSecondMode: {
+      std::vector<Candidate> c;
+      // Every distinct line frequency (at most 400 of them) times a few Q.
+      std::vector<double> fs = l.f;
+      std::sort(fs.begin(), fs.end());
+      fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+      const std::size_t stride = std::max<std::size_t>(1, fs.size() / 400);
+      for (std::size_t i = 0; i < fs.size(); i += stride) {
+        const double f2 = fs[i];
+        for (double q : {3.0, 10.0, 30.0, 100.0, 300.0}) {
+          const double h = Amplitude(
+              l, Shape(l, [&](double f, Cplx) { return 1.0 / Cplx(1.0, q * (f / f2 - f2 / f)); }),
+              &red);
+          if (h > 0.0) c.push_back({red, {f2, q, h}});
+        }
+      }
+      if (c.empty()) {
+        const double f2 = std::sqrt(f_lo_ * f_hi_);
+        return {{f2, 30.0, spec.params[2].scale}};
+      }
+      // The best three starts at clearly different frequencies.
+      std::sort(c.begin(), c.end(),
+                [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
+      std::vector<std::vector<double>> out;
+      for (const Candidate& cand : c) {
+        bool distinct = true;
+        for (const auto& o : out)
+          if (std::abs(o[0] - cand.params[0]) < 0.02 * o[0]) distinct = false;
+        if (distinct) out.push_back(cand.params);
+        if (out.size() == 3) break;
+      }
+      return out;
+    }
+  }
+  return {};
+}
+
+EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineMask& mask,
+                            int max_iterations) const {
+  EffectFit out;
+  out.effects = start;
+  const Lines lines = Collect(nominal_, units_, {}, mask);
+  out.residuals = static_cast<int>(2 * lines.f.size());
+  Layout layout;
+  layout.shape = start;
+  for (const AppliedEffect& e : start) layout.specs.push_back(Spec(e.kind));
+  out.n_params = layout.size();
+  if (out.n_params == 0 || lines.f.empty()) {
+    out.chi2 = Chi2(start, mask);
+    out.converged = true;
+    return out;
+  }
+  LeastSquaresProblem problem;
+  problem.parameters = layout.size();
+  problem.residuals = out.residuals;
+  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
+    Residual(nominal_, lines, layout, t, r);
+  };
+  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* j) {
+    Jacobian(nominal_, lines, layout, t, j);
+  };
+  LeastSquaresSettings settings;
+  settings.max_iterations = max_iterations;
+  settings.ftol = kLmTol;
+  settings.xtol = kLmTol;
+  Eigen::VectorXd theta = layout.ToTheta(start);
+  const LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, &theta, settings);
+  out.iterations = outcome.iterations;
+  out.converged = outcome.converged;
+  out.effects = layout.FromTheta(theta);
+  Eigen::VectorXd r;
+  problem.residual(theta, &r);
+  out.chi2 = r.squaredNorm();
+  // Covariance in theta from the Jacobian at the optimum, then natural units.
+  Eigen::MatrixXd jac;
+  problem.jacobian(theta, &jac);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(problem.parameters, problem.parameters,
+                                                  std::numeric_limits<double>::quiet_NaN());
+  Eigen::MatrixXd inverse;
+  if (InvertInformation(jac.transpose() * jac, &inverse)) cov = inverse;
+  int i = 0;
+  out.sigma.resize(out.effects.size());
+  for (std::size_t e = 0; e < out.effects.size(); ++e)
+    for (std::size_t p = 0; p < out.effects[e].params.size(); ++p, ++i)
+      out.sigma[e].push_back(std::abs(layout.Slope(out.effects, e, p)) * std::sqrt(cov(i, i)));
+  return out;
+}
+
+EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
+                                 const std::vector<AppliedEffect>& seeds, const LineMask& mask,
+                                 int max_iterations) const {
+  std::vector<std::vector<AppliedEffect>> starts;
+  auto sorted = [](std::vector<AppliedEffect> v) {
+    std::sort(v.begin(), v.end(),
+              [](const AppliedEffect& a, const AppliedEffect& b) { return a.kind < b.kind; });
+    return v;
+  };
+  if (kinds.size() == 1) {
+    for (auto& p : Starts(kinds[0], {}, mask)) starts.push_back({{kinds[0], p}});
+  } else {
+    // Each kind's starts on top of the other kinds' seeds, and all the seeds together.
+    starts.push_back(sorted(seeds));
+    for (std::size_t i = 0; i < kinds.size(); ++i) {
+      std::vector<AppliedEffect> others;
+      for (std::size_t j = 0; j < seeds.size(); ++j)
+        if (j != i) others.push_back(seeds[j]);
+      for (auto& p : Starts(kinds[i], others, mask)) {
+        std::vector<AppliedEffect> s = others;
+        s.push_back({kinds[i], p});
+        starts.push_back(sorted(s));
+      }
+    }
+  }
+  EffectFit best;
+  best.chi2 = std::numeric_limits<double>::infinity();
+  for (const auto& s : starts) {
+    EffectFit f = Fit(s, mask, max_iterations);
+    if (std::isfinite(f.chi2) && f.chi2 < best.chi2) best = std::move(f);
+  }
+  return best;
+}
+
+}  // namespace eol::analysis

@@ -1,0 +1,91 @@
+// Fitting unmodelled effects (analysis/model/effects.h) on top of a fixed nominal network.
+//
+// The nominal's parameters stay at the simulation's values; only the effects' parameters are
+// fitted, by weighted least squares on every (selected) line of every unit:
+//   chi2 = 2 sum_{u,k} |H_meas(u,k) - H_model(f_uk; effects)|^2 / sigma_uk^2
+// (the fit module's convention, resonance_fit.h: 2K real residuals of unit variance).
+// Parameters are fitted as ln(value) (positive, wide-ranging ones) or value / scale, with
+// analysis::MinimizeLeastSquares (fit/least_squares.h: MINPACK Levenberg-Marquardt) on
+// central-difference Jacobians; the covariance (Jr^T Jr)^-1 at the optimum
+// (fit/least_squares.h InvertInformation) is mapped to natural units to first order.
+//
+// Starting values (Starts) come from the residual against a base model (the nominal plus any
+// effects already fitted, for pairs), mostly by variable projection: where an effect enters
+// as amplitude c times a fixed shape B_k, dH ~ c B_k gives c by weighted linear least squares:
+//   series_resistance B = 1;  channel_delay B = -s H;  stray_capacitance B = -s H^2;
+//   skin_effect B = R (f / 1 kHz)^2;  lossy_inductance B = -s^2 / (s + w_c) on a grid of
+//   corners w_c (c = L2, R2 = w_c L2);  second_mode B = 1 / (1 + j q x) on a grid of (f, q)
+//   (c = height > 0);  fixture_compliance and adhesive_creep on a grid of their parameter.
+#pragma once
+
+#include <complex>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "analysis/model/effects.h"
+
+namespace eol::analysis {
+
+// One measured unit, ready for the gap: every line has a positive sigma.
+struct GapUnit {
+  std::string name;
+  std::vector<double> freq_hz;
+  std::vector<std::complex<double>> value;
+  std::vector<double> sigma;
+
+  std::size_t size() const { return freq_hz.size(); }
+};
+
+// mask[u][k] != 0: line k of unit u takes part. An empty mask selects every line.
+using LineMask = std::vector<std::vector<char>>;
+
+struct EffectFit {
+  std::vector<AppliedEffect> effects;
+  std::vector<std::vector<double>> sigma;  // per effect, per parameter, natural units (NaN:
+                                           // not determined)
+  double chi2 = 0.0;                       // on the selected lines
+  int residuals = 0;                       // 2 x selected lines
+  int n_params = 0;
+  bool converged = false;
+  int iterations = 0;
+};
+
+class EffectFitter {
+ public:
+  // f_lo_hz, f_hi_hz: the band the plausibility bounds refer to (the units' band).
+  EffectFitter(const NominalNetwork& nominal, const std::vector<GapUnit>& units);
+
+  const NominalNetwork& nominal() const { return nominal_; }
+  const std::vector<GapUnit>& units() const { return units_; }
+  double f_lo_hz() const { return f_lo_; }
+  double f_hi_hz() const { return f_hi_; }
+  EffectSpec Spec(EffectKind kind) const { return DescribeEffect(kind, nominal_, f_lo_, f_hi_); }
+
+  // chi2 of nominal + effects on the selected lines; *residuals gets 2 x lines when given.
+  double Chi2(std::span<const AppliedEffect> effects, const LineMask& mask,
+              int* residuals = nullptr) const;
+
+  // Starting parameter vectors for `kind` on top of `base` (at most a few, best first).
+  std::vector<std::vector<double>> Starts(EffectKind kind, std::span<const AppliedEffect> base,
+                                          const LineMask& mask) const;
+
+  // Levenberg-Marquardt from `start` (every parameter of every effect is free).
+  EffectFit Fit(const std::vector<AppliedEffect>& start, const LineMask& mask,
+                int max_iterations) const;
+
+  // The best of the fits started from Starts(kind) for each kind in `kinds`, the kinds
+  // fitted jointly; for a pair the second kind's starts are taken on top of `seeds` (the
+  // kinds' single fits, same order as kinds) and vice versa.
+  EffectFit FitKinds(const std::vector<EffectKind>& kinds, const std::vector<AppliedEffect>& seeds,
+                     const LineMask& mask, int max_iterations) const;
+
+ private:
+  NominalNetwork nominal_;
+  std::vector<GapUnit> units_;
+  double f_lo_ = 0.0, f_hi_ = 0.0;
+};
+
+bool Selected(const LineMask& mask, std::size_t unit, std::size_t line);
+
+}  // namespace eol::analysis

@@ -1,0 +1,148 @@
+// The gap metric's building blocks: the chi-square z, the band search, the noise estimate
+// and pooling (analysis/gap/residual.h, noise.h), the calibration (calibration.h) and the
+// prediction carried to a second simulation (prediction.h). Fixed seeds.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "analysis/gap/calibration.h"
+#include "analysis/gap/noise.h"
+#include "analysis/gap/prediction.h"
+#include "analysis/gap/residual.h"
+#include "analysis/sim/population.h"
+
+namespace eol::analysis {
+namespace {
+
+// chi2 per line of 2 |r|^2 with r circular complex Gaussian of unit variance (dof 2 each).
+std::vector<double> NoiseChi2(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::exponential_distribution<double> e(0.5);  // chi2 with 2 dof: mean 2
+  std::vector<double> c(n);
+  for (double& x : c) x = e(rng);
+  return c;
+}
+
+std::vector<double> Freqs(std::size_t n) {
+  std::vector<double> f(n);
+  for (std::size_t k = 0; k < n; ++k) f[k] = 200.0 + static_cast<double>(k);
+  return f;
+}
+
+TEST(GapResidual, ChiSquareZ) {
+  EXPECT_NEAR(ChiSquareZ(1200.0, 1200.0), 0.0, 0.02);
+  // chi2 = d + 3 sqrt(2 d) is 2.90 sigma, not 3: the chi-square is skewed (exact tail
+  // probability 1.87e-3 for d = 1200; Wilson-Hilferty gives z = 2.899).
+  EXPECT_NEAR(ChiSquareZ(1200.0 + 3.0 * std::sqrt(2400.0), 1200.0), 2.90, 0.01);
+  EXPECT_LT(ChiSquareZ(800.0, 1200.0), -5.0);
+  EXPECT_EQ(ChiSquareZ(1.0, 0.0), 0.0);
+}
+
+TEST(GapResidual, NoBandInNoiseANarrowOneAtAPeakAOneWideForAnOffset) {
+  const std::size_t n = 601;
+  const std::vector<double> f = Freqs(n), dof(n, 2.0);
+  BandSearchOptions o;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed)
+    EXPECT_TRUE(FindGapBands(f, NoiseChi2(n, seed), dof, o).empty()) << seed;
+  // A peak of excess at 400-409 Hz.
+  std::vector<double> c = NoiseChi2(n, 7);
+  for (std::size_t k = 200; k < 210; ++k) c[k] += 60.0;
+  std::vector<GapBand> b = FindGapBands(f, c, dof, o);
+  ASSERT_FALSE(b.empty());
+  // Edges are fuzzy by a few lines: a noise line with some excess still raises the z.
+  EXPECT_NEAR(b[0].f_lo_hz, 400.0, 8.0);
+  EXPECT_NEAR(b[0].f_hi_hz, 409.0, 8.0);
+  EXPECT_GT(b[0].significance, 20.0);
+  // A uniform excess: one broad band (its ends move with the noise's random walk).
+  c = NoiseChi2(n, 8);
+  for (double& x : c) x *= 1.3;
+  b = FindGapBands(f, c, dof, o);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_GT(b[0].f_hi_hz - b[0].f_lo_hz, 300.0);
+}
+
+TEST(GapResidual, NoiseEstimateAndPooling) {
+  MotionalImpedance m{0.5, 2e-3, 0.51, 390.0, 50.0};
+  Frf h = m.Evaluate(Freqs(601));
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> g(0.0, std::sqrt(0.5));
+  std::vector<double> truth;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    truth.push_back(1e-3 * std::abs(h.value[k]));  // noise proportional to |H|
+    h.value[k] += truth.back() * std::complex<double>(g(rng), g(rng));
+  }
+  const std::vector<double> est = EstimateLineSigma(h);
+  double ratio2 = 0.0;
+  for (std::size_t k = 0; k < h.size(); ++k) ratio2 += est[k] * est[k] / (truth[k] * truth[k]);
+  EXPECT_NEAR(std::sqrt(ratio2 / static_cast<double>(h.size())), 1.0, 0.1);
+  // Pooling keeps the scale and smooths: a sigma with scatter becomes steadier.
+  h.sigma = truth;
+  for (std::size_t k = 0; k < h.size(); k += 2) h.sigma[k] *= 1.5;
+  const std::vector<double> pooled = PoolLineSigma(h, 3);
+  for (std::size_t k = 10; k + 10 < h.size(); ++k)
+    EXPECT_NEAR(pooled[k] / truth[k], std::sqrt((1.0 + 2.25) / 2.0), 0.1) << k;
+  EXPECT_EQ(PoolLineSigma(h, 0), h.sigma);
+}
+
+TEST(GapCalibration, RigidShaftAndMotionalNominalsAreRecovered) {
+  Frf m;
+  m.quantity = Quantity::kMobility;
+  const RigidShaftMobility rigid{100.0, 13.8};
+  for (double f = 11.0; f <= 250.0; f += 1.0) {
+    m.freq_hz.push_back(f);
+    m.value.push_back(rigid.At(f));
+  }
+  CalibrationSummary c = CalibrateNominal(m, CalibrationOptions{});
+  ASSERT_TRUE(c.usable) << c.message;
+  EXPECT_NEAR(c.nominal.rigid.gain_rad_per_s2_per_a, 100.0, 1e-6);
+  EXPECT_NEAR(c.nominal.rigid.damping_per_s, 13.8, 1e-6);
+  const MotionalImpedance z{0.5, 2e-3, 0.28, 706.0, 50.0};
+  CalibrationOptions o;
+  o.inertia_kg_m2 = 1e-4;
+  c = CalibrateNominal(z.Evaluate(Freqs(601)), o);
+  ASSERT_TRUE(c.usable) << c.message;
+  EXPECT_NEAR(c.nominal.motional.f0_hz, 706.0, 1e-6);
+  EXPECT_LT(c.misfit_rel_rms, 1e-9);
+  EXPECT_EQ(c.nominal.inertia_kg_m2, 1e-4);
+  Frf bad = z.Evaluate(Freqs(5));
+  EXPECT_FALSE(CalibrateNominal(bad, o).usable);
+}
+
+// The paper's numbers: the fixture found against the rigid 706 Hz rotor carried over to the
+// poorly cemented rotor (529 Hz rigid) lands where analysis::ClampedRotor puts it (~350 Hz).
+TEST(GapPrediction, FixtureCarriesOverToTheDefectiveRotor) {
+  const MotorPopulation p;
+  const double rigid = std::numeric_limits<double>::infinity();
+  auto nominal = [&](bool defective) {
+    ClampedRotor r{p.inertia_kg_m2, p.KRotorNmPerRad(defective), rigid,
+                   defective ? p.q_defect : p.q_good, p.transmission_nm_per_a};
+    NominalNetwork n;
+    n.motional = r.Electrical(p.r_ohm, p.l_h);
+    n.inertia_kg_m2 = p.inertia_kg_m2;
+    return n;
+  };
+  const NominalNetwork good = nominal(false), defect = nominal(true);
+  const double kappa = p.KFixtureNmPerRad() / p.KRotorNmPerRad(false);
+  RankedEffect fit;
+  fit.effect = "fixture_compliance";
+  fit.effects = {{EffectKind::kFixtureCompliance, {kappa, FixtureLossKeepingQ(kappa, 50.0)}}};
+  fit.params = {{"k_fixture_ratio", "1", kappa, 1e-4 * kappa},
+                {"fixture_loss_factor", "1", 0.024, 1e-4}};
+  const PredictionSummary s = PredictWithEffects(good, fit, defect, Freqs(601));
+  ASSERT_TRUE(s.usable) << s.message;
+  ClampedRotor truth{p.inertia_kg_m2, p.KRotorNmPerRad(true), p.KFixtureNmPerRad(), p.q_defect,
+                     p.transmission_nm_per_a};
+  EXPECT_NEAR(s.f0_simulated_hz, 529.0, 1e-6);
+  EXPECT_NEAR(s.f0_predicted_hz, truth.NaturalFrequencyHz(), 0.2);
+  EXPECT_GT(s.sigma_f0_hz, 0.0);
+  EXPECT_LT(s.sigma_f0_hz, 0.1);
+  // Equal inertias: the ratio rule without J gives the same.
+  NominalNetwork good_no_j = good, defect_no_j = defect;
+  good_no_j.inertia_kg_m2 = defect_no_j.inertia_kg_m2 = 0.0;
+  EXPECT_NEAR(PredictWithEffects(good_no_j, fit, defect_no_j, Freqs(601)).f0_predicted_hz,
+              s.f0_predicted_hz, 1e-6);
+}
+
+}  // namespace
+}  // namespace eol::analysis

@@ -1,0 +1,207 @@
+// `eol gap` and `eol gap-bench` through the binary: the JSON's stable names, noise estimation
+// when a file has no sigma, several units (leave-one-unit-out), the plot, errors that name
+// the file, and a small blind benchmark (sanity only; the full one is a CLI benchmark,
+// README "Benchmarks: gap diagnosis").
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "analysis/gap/measurement_sim.h"
+#include "analysis/model/effects.h"
+#include "station/files/frf_files.h"
+#include "station/files/recording_files.h"
+#include "tests/support/child_process.h"
+
+namespace eol {
+namespace {
+
+using testing::ChildProcess;
+using testing::TempDir;
+
+struct EolRun {
+  int code = -1;
+  std::string output;
+};
+
+EolRun Eol(const std::vector<std::string>& args, int timeout_s = 120) {
+  std::vector<std::string> argv = {EOL_BINARY};
+  argv.insert(argv.end(), args.begin(), args.end());
+  ChildProcess p(argv);
+  EolRun r;
+  r.code = p.Wait(std::chrono::seconds(timeout_s)).value_or(-1);
+  r.output = p.output();
+  return r;
+}
+
+nlohmann::json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+analysis::NominalNetwork Nominal() {
+  analysis::NominalNetwork n;
+  n.motional = {0.5, 2e-3, 0.51, 390.0, 50.0};
+  return n;
+}
+
+// Nominal + effects measured through the simulator (4 periods, DAQ noise).
+analysis::Frf Measured(const std::vector<analysis::AppliedEffect>& effects, std::uint64_t seed) {
+  const analysis::NominalNetwork n = Nominal();
+  const analysis::Excitation ex = analysis::DesignMultisine(analysis::MultisineOptions{});
+  analysis::SimulatedMeasurementOptions o;
+  o.seed = seed;
+  return analysis::SimulateImpedanceMeasurement(
+             [&](double f) { return analysis::EvaluateNetwork(n, effects, f); }, ex, o)
+      .frf;
+}
+
+class GapCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::vector<double> f;
+    for (double x = 200.0; x <= 800.0; x += 1.0) f.push_back(x);
+    station::files::WriteFrfCsv(dir_ / "sim.csv", Nominal().motional.Evaluate(f));
+  }
+  TempDir dir_;
+};
+
+TEST_F(GapCli, JsonHasTheStableNames) {
+  station::files::WriteFrfCsv(dir_ / "meas.csv",
+                              Measured({{analysis::EffectKind::kChannelDelay, {6e-6}}}, 3));
+  const EolRun r = Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "meas.csv", "--json",
+                        dir_ / "out.json"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json j = ReadJson(dir_ / "out.json");
+  EXPECT_EQ(j["effect"], "channel_delay") << r.output;
+  for (const char* key : {"effect", "gap_before", "gap_after", "heldout", "where", "ranking",
+                          "features", "calibration", "measurements", "params"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  for (const char* key : {"gap_before", "gap_after", "method"})
+    EXPECT_TRUE(j["heldout"].contains(key)) << key;
+  ASSERT_FALSE(j["where"].empty());
+  for (const char* key : {"f_lo_hz", "f_hi_hz", "significance"})
+    EXPECT_TRUE(j["where"][0].contains(key)) << key;
+  ASSERT_FALSE(j["ranking"].empty());
+  for (const char* key : {"effect", "params", "score", "gap_after"})
+    EXPECT_TRUE(j["ranking"][0].contains(key)) << key;
+  EXPECT_EQ(j["ranking"][0]["effect"], "channel_delay");
+  EXPECT_NEAR(j["params"]["delay_s"].get<double>(), 6e-6, 0.3e-6);
+  EXPECT_LT(j["heldout"]["gap_after"].get<double>(), 1.3);
+  bool none_ranked = false;
+  for (const auto& e : j["ranking"]) none_ranked |= e["effect"] == "none";
+  EXPECT_TRUE(none_ranked);
+  EXPECT_NE(r.output.find("WHICH        channel_delay"), std::string::npos) << r.output;
+}
+
+TEST_F(GapCli, MissingSigmaIsEstimatedAndSaid) {
+  analysis::Frf m = Measured({{analysis::EffectKind::kStrayCapacitance, {2e-7}}}, 5);
+  m.sigma.clear();
+  station::files::WriteZma(dir_ / "meas.zma", m);
+  const EolRun r = Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "meas.zma", "--json",
+                        dir_ / "out.json"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json j = ReadJson(dir_ / "out.json");
+  EXPECT_TRUE(j["measurements"][0]["sigma_estimated"].get<bool>());
+  EXPECT_NE(r.output.find("noise estimated"), std::string::npos) << r.output;
+  EXPECT_EQ(j["effect"], "stray_capacitance") << r.output;
+  // The estimated noise is close to the real one: g after near 1.
+  EXPECT_NEAR(j["gap_after"].get<double>(), 1.0, 0.25);
+}
+
+TEST_F(GapCli, SeveralUnitsAndAPlot) {
+  const std::vector<analysis::AppliedEffect> truth = {
+      {analysis::EffectKind::kSeriesResistance, {0.015}}};
+  std::vector<std::string> args = {
+      "gap", "--sim", dir_ / "sim.csv", "--json", dir_ / "out.json", "--plot", dir_ / "gap.svg"};
+  for (int u = 0; u < 3; ++u) {
+    const std::string path = dir_ / ("unit" + std::to_string(u) + ".csv");
+    station::files::WriteFrfCsv(path, Measured(truth, 10 + u));
+    args.push_back("--measured");
+    args.push_back(path);
+  }
+  const EolRun r = Eol(args);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json j = ReadJson(dir_ / "out.json");
+  EXPECT_EQ(j["effect"], "series_resistance") << r.output;
+  EXPECT_EQ(j["heldout"]["method"], "leave-one-unit-out");
+  EXPECT_EQ(j["measurements"].size(), 3u);
+  EXPECT_NEAR(j["params"]["resistance_ohm"].get<double>(), 0.015, 0.002);
+  std::ifstream svg(dir_ / "gap.svg");
+  const std::string s((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(s.rfind("<?xml", 0), 0u);
+  EXPECT_NE(s.find("<polyline"), std::string::npos);
+  EXPECT_NE(s.find("|residual| / sigma"), std::string::npos);
+}
+
+TEST_F(GapCli, PureNoiseIsNoneAndJsonToStdout) {
+  station::files::WriteFrfCsv(dir_ / "meas.csv", Measured({}, 8));
+  const EolRun r =
+      Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "meas.csv", "--json", "-"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("\"effect\": \"none\""), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\"method\": \"none\""), std::string::npos);
+}
+
+TEST_F(GapCli, RawRecordingPeriodAndLinesAreDetected) {
+  const analysis::NominalNetwork n = Nominal();
+  const std::vector<analysis::AppliedEffect> truth = {
+      {analysis::EffectKind::kSeriesResistance, {0.02}}};
+  const analysis::Excitation ex = analysis::DesignMultisine(analysis::MultisineOptions{});
+  analysis::SimulatedMeasurementOptions o;
+  o.seed = 12;
+  station::files::WriteRecordingCsv(
+      dir_ / "rec.csv",
+      analysis::SimulateImpedanceRecording(
+          [&](double f) { return analysis::EvaluateNetwork(n, truth, f); }, ex, o));
+  const EolRun r = Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "rec.csv", "--json",
+                        dir_ / "out.json"});
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json j = ReadJson(dir_ / "out.json");
+  EXPECT_EQ(j["measurements"][0]["kind"], "recording");
+  EXPECT_EQ(j["measurements"][0]["lines"], 601);
+  EXPECT_NE(r.output.find("period 8000 samples"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("excited lines detected in i_a"), std::string::npos) << r.output;
+  EXPECT_EQ(j["effect"], "series_resistance") << r.output;
+}
+
+TEST_F(GapCli, ErrorsNameTheFile) {
+  EolRun r = Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "missing.csv"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("missing.csv"), std::string::npos) << r.output;
+  std::ofstream(dir_ / "bad.csv") << "f_hz,re_ohm,im_ohm\n200,1,2\n100,1,2\n";
+  r = Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "bad.csv"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("bad.csv:3"), std::string::npos) << r.output;
+  r = Eol(
+      {"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "sim.csv", "--quantity", "mobility"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--quantity is mobility"), std::string::npos) << r.output;
+  r = Eol(
+      {"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "sim.csv", "--effects", "gremlins"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("gremlins"), std::string::npos) << r.output;
+}
+
+TEST(GapBenchCli, SmallRunIsSane) {
+  const EolRun r = Eol({"gap-bench", "--cases", "9", "--seed", "5", "--json"}, 300);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string out = r.output;
+  const auto brace = out.rfind("\n{");
+  ASSERT_NE(brace, std::string::npos) << out;
+  const nlohmann::json j = nlohmann::json::parse(out.substr(brace + 1));
+  EXPECT_EQ(j["cases"], 9);
+  int total = 0;
+  for (const auto& row : j["confusion"])
+    for (int v : row) total += v;
+  EXPECT_EQ(total, 9);
+  EXPECT_EQ(j["per_case"].size(), 9u);
+  EXPECT_GE(j["top1"].get<double>(), 0.5);
+  EXPECT_EQ(j["none_for_strong"], 0);
+  EXPECT_EQ(j["errors"], 0);
+  EXPECT_NE(out.find("confusion matrix"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace eol
