@@ -108,7 +108,9 @@ TEST_F(SequencerTest, RetestLimitRefusesASerialBeforeClamping) {
   for (int i = 0; i < recipe_.max_tests_per_serial; ++i) {
     const db::TestRecord r = Test("RETEST-1", true);
     EXPECT_EQ(r.outcome, Outcome::kFail);
-    if (i > 0) EXPECT_TRUE(r.retest_of.has_value());
+    if (i > 0) {
+      EXPECT_TRUE(r.retest_of.has_value());
+    }
   }
   const db::TestRecord refused = Test("RETEST-1", true);
   EXPECT_EQ(refused.outcome, Outcome::kError);
