@@ -9,6 +9,7 @@
 
 #include "analysis/fit/least_squares.h"
 #include "analysis/fit/motional_jacobian.h"
+#include "analysis/text.h"
 
 namespace eol::analysis {
 namespace {
@@ -19,21 +20,6 @@ constexpr int kRefineSteps = 21;  // as resonance_fit.cc
 constexpr int kRefinePasses = 2;
 constexpr double kExcludeBandwidths = 0.25;
 constexpr double kDistinctSigmas = 3.0;
-
-std::ostringstream Stream() {
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
-  os.precision(6);
-  return os;
-}
-
-std::vector<double> LogSpace(double lo, double hi, int n) {
-  std::vector<double> v(static_cast<std::size_t>(n));
-  const double step = std::log(hi / lo) / (n - 1);
-  for (int i = 0; i < n; ++i) v[static_cast<std::size_t>(i)] = lo * std::exp(step * i);
-  v.back() = hi;
-  return v;
-}
 
 int ParamCount(int modes) { return 2 + 3 * modes; }
 
@@ -246,7 +232,7 @@ FitSummary AddMode(const Data& d, const MultiModeImpedance& fitted, const ModesF
   s.sigma_estimated = !sigma_known;
   s.dof = static_cast<int>(2 * k_lines) - ParamCount(m);
   candidate->modes = m;
-  std::ostringstream os = Stream();
+  std::ostringstream os = MessageStream();
 
   const ModeSearch search(d, fitted);
   std::vector<double> fs = LogSpace(f0_lo, f0_hi, o.single.grid_f0);
@@ -438,7 +424,7 @@ ModesFitSummary FitMotionalModes(const Frf& z, const ModesFitOptions& options) {
   const double f0_hi = auto_range ? z.freq_hz.back() : options.single.f0_max_hz;
 
   MultiModeImpedance current = FromSingle(out.fit);
-  std::ostringstream decision = Stream();
+  std::ostringstream decision = MessageStream();
   decision << "1 mode";
   for (int m = 2; m <= options.max_modes; ++m) {
     ModeOrderCandidate cand;

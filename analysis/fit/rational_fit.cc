@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "analysis/fit/least_squares.h"
+#include "analysis/text.h"
 
 namespace eol::analysis {
 namespace {
@@ -45,13 +46,6 @@ Cplx Horner(const Eigen::VectorXd& c, Cplx x) {
   Cplx y = 0.0;
   for (Eigen::Index i = c.size() - 1; i >= 0; --i) y = y * x + c[i];
   return y;
-}
-
-std::ostringstream Stream() {
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
-  os.precision(6);
-  return os;
 }
 
 RationalFitSummary Invalid(const std::string& why) {
@@ -217,7 +211,7 @@ RationalFitSummary FitRational(const std::vector<double>& freq_hz, const std::ve
     s.coefficients.push_back(fp);
   }
 
-  std::ostringstream os = Stream();
+  std::ostringstream os = MessageStream();
   if (!lm.converged) {
     os << "Levenberg-Marquardt on the output error did not converge (" << lm.termination
        << " after " << lm.iterations << " iterations, MINPACK status " << lm.minpack_status << ")";

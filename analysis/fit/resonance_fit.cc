@@ -7,9 +7,10 @@
 #include <locale>
 #include <numbers>
 #include <sstream>
-#include <unsupported/Eigen/NonLinearOptimization>
 
+#include "analysis/fit/least_squares.h"
 #include "analysis/fit/motional_jacobian.h"
+#include "analysis/text.h"
 
 namespace eol::analysis {
 namespace {
@@ -21,24 +22,6 @@ constexpr int kRefineSteps = 21;   // points per axis of each local refinement g
 constexpr int kRefinePasses = 2;   // successive refinements around the best cell
 constexpr double kLmFtol = 1e-12;  // MINPACK relative reduction of chi2
 constexpr double kLmXtol = 1e-10;  // MINPACK relative step in scaled theta
-// Residual given to MINPACK for a trial step where the model overflows: the step is rejected.
-constexpr double kRejectResidual = 1e100;
-
-std::ostringstream Stream() {
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
-  os.precision(6);
-  return os;
-}
-
-// Log-spaced points from lo to hi inclusive (n >= 2).
-std::vector<double> LogSpace(double lo, double hi, int n) {
-  std::vector<double> v(static_cast<std::size_t>(n));
-  const double step = std::log(hi / lo) / (n - 1);
-  for (int i = 0; i < n; ++i) v[static_cast<std::size_t>(i)] = lo * std::exp(step * i);
-  v.back() = hi;
-  return v;
-}
 
 // R, L, Rp of the weighted linear least-squares solution at one (f0, Q) grid point.
 struct GridPoint {
@@ -160,37 +143,6 @@ class VarProGrid {
   std::vector<double> q2_, s0_, s1_, s2_, s3_;
 };
 
-// Levenberg-Marquardt functor (Eigen NonLinearOptimization) on theta = ln(R, L, Rp, f0, Q).
-struct MotionalFunctor {
-  using Scalar = double;
-  enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
-  using InputType = Eigen::VectorXd;
-  using ValueType = Eigen::VectorXd;
-  using JacobianType = Eigen::MatrixXd;
-
-  const std::vector<double>& freq_hz;
-  const std::vector<Cplx>& value;
-  const std::vector<double>& scale;
-
-  int inputs() const { return kMotionalParamCount; }
-  int values() const { return static_cast<int>(2 * freq_hz.size()); }
-
-  int operator()(const Eigen::VectorXd& theta, Eigen::VectorXd& r) const {
-    if (!theta.allFinite()) {
-      r.setConstant(values(), kRejectResidual);
-      return 0;
-    }
-    MotionalResidual(FromLogParams(theta), freq_hz, value, scale, &r);
-    if (!r.allFinite()) r.setConstant(kRejectResidual);
-    return 0;
-  }
-
-  int df(const Eigen::VectorXd& theta, Eigen::MatrixXd& jacobian) const {
-    MotionalJacobian(FromLogParams(theta), freq_hz, scale, &jacobian);
-    return jacobian.allFinite() ? 0 : -1;
-  }
-};
-
 FitSummary Invalid(const std::string& why) {
   FitSummary s;
   s.usable = false;
@@ -258,7 +210,7 @@ FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options
   const double f0_lo = auto_range ? z.freq_hz.front() : options.f0_min_hz;
   const double f0_hi = auto_range ? z.freq_hz.back() : options.f0_max_hz;
   if (!(f0_lo < z.freq_hz.back() && f0_hi > z.freq_hz.front())) {
-    std::ostringstream os = Stream();
+    std::ostringstream os = MessageStream();
     os << "f0 search range [" << f0_lo << ", " << f0_hi << "] Hz does not overlap the data band ["
        << z.freq_hz.front() << ", " << z.freq_hz.back() << "] Hz";
     return Invalid(os.str());
@@ -273,7 +225,7 @@ FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options
   s.dof = static_cast<int>(2 * k_lines) - kMotionalParamCount;
 
   auto no_resonance = [&]() {
-    std::ostringstream os = Stream();
+    std::ostringstream os = MessageStream();
     os << "no resonance found between " << f0_lo << " and " << f0_hi << " Hz";
     return os.str();
   };
@@ -315,41 +267,23 @@ FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options
   p0.f0_hz = start.f0_hz;
   p0.q = start.q;
   Eigen::VectorXd theta = ToLogParams(p0);
-  MotionalFunctor functor{z.freq_hz, z.value, scale};
-  Eigen::LevenbergMarquardt<MotionalFunctor> lm(functor);
-  lm.parameters.ftol = kLmFtol;
-  lm.parameters.xtol = kLmXtol;
-  // Iterations are bounded below; this only stops a step search that never succeeds.
-  lm.parameters.maxfev = 20 * (options.max_iterations + 10);
-  using Eigen::LevenbergMarquardtSpace::Status;
-  Status status = lm.minimizeInit(theta);
-  if (status == Status::NotStarted) {
-    do {
-      status = lm.minimizeOneStep(theta);
-    } while (status == Status::Running && lm.iter - 1 < options.max_iterations);
-  }
-  s.iterations = static_cast<int>(lm.iter > 0 ? lm.iter - 1 : 0);
-  bool converged = false;
-  switch (status) {
-    case Status::RelativeReductionTooSmall:
-    case Status::RelativeErrorTooSmall:
-    case Status::RelativeErrorAndReductionTooSmall:
-    case Status::CosinusTooSmall:
-    // Tolerances below machine precision: no further improvement is possible, a solution.
-    case Status::FtolTooSmall:
-    case Status::XtolTooSmall:
-    case Status::GtolTooSmall:
-      s.termination = "converged";
-      converged = true;
-      break;
-    case Status::Running:
-    case Status::TooManyFunctionEvaluation:
-      s.termination = "max_iterations";
-      break;
-    default:
-      s.termination = "failed";
-      break;
-  }
+  LeastSquaresProblem problem;
+  problem.parameters = kMotionalParamCount;
+  problem.residuals = static_cast<int>(2 * z.freq_hz.size());
+  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
+    MotionalResidual(FromLogParams(t), z.freq_hz, z.value, scale, r);
+  };
+  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jacobian) {
+    MotionalJacobian(FromLogParams(t), z.freq_hz, scale, jacobian);
+  };
+  LeastSquaresSettings settings;
+  settings.max_iterations = options.max_iterations;
+  settings.ftol = kLmFtol;
+  settings.xtol = kLmXtol;
+  const LeastSquaresOutcome lm = MinimizeLeastSquares(problem, &theta, settings);
+  s.iterations = lm.iterations;
+  s.termination = lm.termination;
+  const bool converged = lm.converged;
 
   const MotionalImpedance fit = FromLogParams(theta);
   Eigen::VectorXd r;
@@ -389,11 +323,11 @@ FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options
   }
   if (covariance_ok) s.covariance = c_nat;
 
-  std::ostringstream os = Stream();
+  std::ostringstream os = MessageStream();
   if (!converged) {
     os << (s.termination == "max_iterations" ? "Levenberg-Marquardt did not converge in "
                                              : "Levenberg-Marquardt failed after ")
-       << s.iterations << " iterations (MINPACK status " << static_cast<int>(status)
+       << s.iterations << " iterations (MINPACK status " << lm.minpack_status
        << "); started from the grid at f0 = " << start.f0_hz << " Hz, Q = " << start.q;
     s.message = os.str();
     return s;

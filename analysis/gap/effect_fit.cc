@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "analysis/fit/least_squares.h"
+#include "analysis/text.h"
 
 namespace eol::analysis {
 namespace {
@@ -76,13 +77,6 @@ std::vector<std::vector<double>> Best(std::vector<Candidate> c, std::size_t n) {
   std::vector<std::vector<double>> out;
   for (std::size_t i = 0; i < c.size() && out.size() < n; ++i) out.push_back(c[i].params);
   return out;
-}
-
-std::vector<double> LogSpace(double lo, double hi, int n) {
-  std::vector<double> v(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i)
-    v[static_cast<std::size_t>(i)] = lo * std::pow(hi / lo, static_cast<double>(i) / (n - 1));
-  return v;
 }
 
 // theta <-> natural parameters of a list of effects.

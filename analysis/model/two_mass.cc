@@ -6,14 +6,15 @@
 #include <locale>
 #include <numbers>
 #include <sstream>
-#include <unsupported/Eigen/NonLinearOptimization>
+
+#include "analysis/fit/least_squares.h"
+#include "analysis/text.h"
 
 namespace eol::analysis {
 namespace {
 
 using Cplx = std::complex<double>;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr double kRejectResidual = 1e100;
 constexpr double kDelayScale = 1e-3;  // tau is fitted in ms: theta = tau / 1 ms
 constexpr double kZetaScale = 1e-2;   // zeta_ar is fitted in %
 
@@ -66,51 +67,31 @@ void Residual(const TwoMassResponse& m, const Data& d, Eigen::VectorXd* r) {
   }
 }
 
-struct TwoMassFunctor {
-  using Scalar = double;
-  enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
-  using InputType = Eigen::VectorXd;
-  using ValueType = Eigen::VectorXd;
-  using JacobianType = Eigen::MatrixXd;
-
-  const Data& data;
-  Layout layout;
-
-  int inputs() const { return layout.size(); }
-  int values() const { return static_cast<int>(2 * data.f.size()); }
-
-  int operator()(const Eigen::VectorXd& theta, Eigen::VectorXd& r) const {
-    if (!theta.allFinite() || theta.head(3).cwiseAbs().maxCoeff() > 700.0) {
-      r.setConstant(values(), kRejectResidual);
-      return 0;
-    }
-    Residual(FromTheta(theta, layout), data, &r);
-    if (!r.allFinite()) r.setConstant(kRejectResidual);
-    return 0;
+// Rejects theta whose log-parameters overflow exp(); the minimiser then shortens the step.
+void GuardedResidual(const Eigen::VectorXd& theta, const Data& data, const Layout& layout,
+                     Eigen::VectorXd* r) {
+  if (!theta.allFinite() || theta.head(3).cwiseAbs().maxCoeff() > 700.0) {
+    r->setConstant(static_cast<Eigen::Index>(2 * data.f.size()),
+                   std::numeric_limits<double>::quiet_NaN());
+    return;
   }
+  Residual(FromTheta(theta, layout), data, r);
+}
 
-  // Central differences: the model is cheap and smooth in theta.
-  int df(const Eigen::VectorXd& theta, Eigen::MatrixXd& jac) const {
-    jac.resize(values(), inputs());
-    Eigen::VectorXd rp, rm;
-    for (int i = 0; i < inputs(); ++i) {
-      const double h = 1e-6 * std::max(1.0, std::abs(theta[i]));
-      Eigen::VectorXd tp = theta, tm = theta;
-      tp[i] += h;
-      tm[i] -= h;
-      (*this)(tp, rp);
-      (*this)(tm, rm);
-      jac.col(i) = (rp - rm) / (2.0 * h);
-    }
-    return jac.allFinite() ? 0 : -1;
+// Central differences: the model is cheap and smooth in theta.
+void CentralDifferenceJacobian(const Eigen::VectorXd& theta, const Data& data,
+                               const Layout& layout, Eigen::MatrixXd* jac) {
+  jac->resize(static_cast<Eigen::Index>(2 * data.f.size()), layout.size());
+  Eigen::VectorXd rp, rm;
+  for (int i = 0; i < layout.size(); ++i) {
+    const double h = 1e-6 * std::max(1.0, std::abs(theta[i]));
+    Eigen::VectorXd tp = theta, tm = theta;
+    tp[i] += h;
+    tm[i] -= h;
+    GuardedResidual(tp, data, layout, &rp);
+    GuardedResidual(tm, data, layout, &rm);
+    jac->col(i) = (rp - rm) / (2.0 * h);
   }
-};
-
-std::ostringstream Stream() {
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
-  os.precision(6);
-  return os;
 }
 
 }  // namespace
@@ -261,27 +242,20 @@ TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
   if (layout.friction) start.friction_per_s = 0.1 * kTwoPi * d.f.front();
 
   Eigen::VectorXd theta = ToTheta(start, layout);
-  TwoMassFunctor functor{d, layout};
-  Eigen::LevenbergMarquardt<TwoMassFunctor> lm(functor);
-  lm.parameters.ftol = 1e-12;
-  lm.parameters.xtol = 1e-10;
-  lm.parameters.maxfev = 20 * (o.max_iterations + 10);
-  using Eigen::LevenbergMarquardtSpace::Status;
-  Status status = lm.minimizeInit(theta);
-  if (status == Status::NotStarted) {
-    do {
-      status = lm.minimizeOneStep(theta);
-    } while (status == Status::Running && lm.iter - 1 < o.max_iterations);
-  }
-  const bool converged = status == Status::RelativeReductionTooSmall ||
-                         status == Status::RelativeErrorTooSmall ||
-                         status == Status::RelativeErrorAndReductionTooSmall ||
-                         status == Status::CosinusTooSmall || status == Status::FtolTooSmall ||
-                         status == Status::XtolTooSmall || status == Status::GtolTooSmall;
-  out.termination = converged ? "converged"
-                    : (status == Status::Running || status == Status::TooManyFunctionEvaluation)
-                        ? "max_iterations"
-                        : "failed";
+  LeastSquaresProblem problem;
+  problem.parameters = layout.size();
+  problem.residuals = static_cast<int>(2 * n);
+  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* res) {
+    GuardedResidual(t, d, layout, res);
+  };
+  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jac) {
+    CentralDifferenceJacobian(t, d, layout, jac);
+  };
+  LeastSquaresSettings settings;
+  settings.max_iterations = o.max_iterations;
+  const LeastSquaresOutcome lm = MinimizeLeastSquares(problem, &theta, settings);
+  out.termination = lm.termination;
+  const bool converged = lm.converged;
   out.response = FromTheta(theta, layout);
   Residual(out.response, d, &r);
   out.dof = static_cast<int>(2 * n) - layout.size();
@@ -300,7 +274,7 @@ TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
   // Covariance in theta, scaled by the noise estimate and, when the model error dominates,
   // by chi2/dof (Birge ratio).
   Eigen::MatrixXd jac;
-  functor.df(theta, jac);
+  CentralDifferenceJacobian(theta, d, layout, &jac);
   const double inflate = std::max(1.0, out.chi2_per_dof);
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(layout.size(), layout.size(),
                                                   std::numeric_limits<double>::quiet_NaN());
@@ -327,10 +301,10 @@ TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
   }
   if (layout.delay) add("delay_s", "s", m.delay_s, kDelayScale * sd(i));
 
-  std::ostringstream os = Stream();
+  std::ostringstream os = MessageStream();
   if (!converged) {
     os << "Levenberg-Marquardt " << out.termination << " (MINPACK status "
-       << static_cast<int>(status) << ") from f_ar = " << start.f_ar_hz
+       << lm.minpack_status << ") from f_ar = " << start.f_ar_hz
        << " Hz, f_r = " << start.f_r_hz << " Hz";
     out.message = os.str();
     return out;

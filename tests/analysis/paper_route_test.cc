@@ -9,6 +9,7 @@
 #include <random>
 
 #include "analysis/model/rotor_chain.h"
+#include "tests/support/paper_motor.h"
 
 namespace eol::analysis {
 namespace {
@@ -16,17 +17,7 @@ namespace {
 using Cplx = std::complex<double>;
 constexpr double kPi = std::numbers::pi;
 
-PmsmParams Motor() {
-  PmsmParams p;
-  p.r_ohm = 0.5;
-  p.l_h = 2e-3;
-  p.transmission_nm_per_a = 0.05;
-  p.inertia_kg_m2 = 1e-4;
-  const double w0 = 2 * kPi * 390.0;
-  p.compliance_rad_per_nm = 1.0 / (p.inertia_kg_m2 * w0 * w0);
-  p.damping_nms_per_rad = p.inertia_kg_m2 * w0 / 50.0;
-  return p;
-}
+PmsmParams Motor() { return testing::PaperMotor(); }
 
 std::vector<double> Lines() {
   std::vector<double> f;

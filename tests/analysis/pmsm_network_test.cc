@@ -7,24 +7,15 @@
 #include <cmath>
 #include <numbers>
 
+#include "tests/support/paper_motor.h"
+
 namespace eol::analysis {
 namespace {
 
 using Cplx = std::complex<double>;
 constexpr double kPi = std::numbers::pi;
 
-// The paper's ten-pole motor in the regime of NOTES.md 2: f0 = 390 Hz, Q = 50.
-PmsmParams Motor() {
-  PmsmParams p;
-  p.r_ohm = 0.5;
-  p.l_h = 2e-3;
-  p.transmission_nm_per_a = 0.05;
-  p.inertia_kg_m2 = 1e-4;
-  const double w0 = 2 * kPi * 390.0;
-  p.compliance_rad_per_nm = 1.0 / (p.inertia_kg_m2 * w0 * w0);
-  p.damping_nms_per_rad = p.inertia_kg_m2 * w0 / 50.0;
-  return p;
-}
+PmsmParams Motor() { return testing::PaperMotor(); }
 
 void ExpectRelNear(double a, double b, double rel) { EXPECT_NEAR(a, b, rel * std::abs(b)); }
 void ExpectRelNear(Cplx a, Cplx b, double rel) { EXPECT_LE(std::abs(a - b), rel * std::abs(b)); }

@@ -1,0 +1,29 @@
+// Small helpers shared by the analysis code's messages and search grids.
+#pragma once
+
+#include <cmath>
+#include <locale>
+#include <sstream>
+#include <vector>
+
+namespace eol::analysis {
+
+// A stream for human messages: classic locale (a machine's locale must never turn 1.5 into
+// "1,5" in a stored record), 6 significant digits.
+inline std::ostringstream MessageStream() {
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os.precision(6);
+  return os;
+}
+
+// n >= 2 log-spaced points from lo to hi inclusive (lo, hi > 0); the last point is exactly hi.
+inline std::vector<double> LogSpace(double lo, double hi, int n) {
+  std::vector<double> v(static_cast<std::size_t>(n));
+  const double step = std::log(hi / lo) / (n - 1);
+  for (int i = 0; i < n; ++i) v[static_cast<std::size_t>(i)] = lo * std::exp(step * i);
+  v.back() = hi;
+  return v;
+}
+
+}  // namespace eol::analysis
