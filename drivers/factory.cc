@@ -65,6 +65,9 @@ SimDaqSettings ParseSimDaqSettings(const JsonObject& o) {
   s.voltage_full_scale_v = o.Number("voltage_full_scale_v", s.voltage_full_scale_v);
   s.current_full_scale_a = o.Number("current_full_scale_a", s.current_full_scale_a);
   s.seed = static_cast<std::uint64_t>(o.Integer("seed", static_cast<int>(s.seed)));
+  const std::string relay = o.String("relay", "bench");
+  o.Require(relay == "bench" || relay == "external", "relay", "must be \"bench\" or \"external\"");
+  s.relay_external = relay == "external";
   o.Require(s.time_scale >= 0.0, "time_scale", "must not be negative");
   o.Require(s.voltage_noise_v >= 0.0, "voltage_noise_v", "must not be negative");
   o.Require(s.current_noise_a >= 0.0, "current_noise_a", "must not be negative");

@@ -73,7 +73,7 @@ analysis::Recording SimDaq::DoAcquire(const AcquisitionRequest& req,
     if (bench_->FaultActive(SimFault::kDaqFails))
       throw DeviceError("input overrun at sample " + std::to_string(first) +
                         " (simulated: daq_fails)");
-    const bool connected = bench_->excitation_connected();
+    const bool connected = settings_.relay_external || bench_->excitation_connected();
     const std::size_t last = std::min(total, first + chunk);
     u_motor.assign(last - first, 0.0);
     i_motor.assign(last - first, 0.0);

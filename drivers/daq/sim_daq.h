@@ -36,6 +36,10 @@ struct SimDaqSettings {
   double voltage_full_scale_v = 10.0;
   double current_full_scale_a = 2.0;
   double chunk_s = 0.02;  // relay state, faults and abort are checked per chunk
+  // The excitation relay lives in a fixture controller this process cannot see (a fixture
+  // over Modbus or CAN to `eol fixture-sim` in another process): the simulated motor is
+  // taken as connected while acquiring. Config "relay": "bench" (default) or "external".
+  bool relay_external = false;
   std::uint64_t seed = 7;
   Calibration calibration;
 };

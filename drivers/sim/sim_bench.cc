@@ -54,11 +54,18 @@ std::optional<analysis::SimUnit> SimBench::part() const {
   return part_;
 }
 
+std::optional<SimBench::Clock::time_point> SimBench::FaultVisibleAtLocked() const {
+  if (!fault_) return std::nullopt;
+  if (!fault_->on_excitation) return fault_->armed_at + fault_->delay;
+  if (!fault_->triggered_at) return std::nullopt;
+  return *fault_->triggered_at + fault_->delay;
+}
+
 bool SimBench::FaultActiveLocked(SimFault fault, Clock::time_point now) const {
   if (!fault_ || fault_->fault != fault) return false;
-  if (!fault_->on_excitation) return now >= fault_->armed_at + fault_->delay;
-  return excitation_on_at_ && *excitation_on_at_ >= fault_->armed_at &&
-         now >= *excitation_on_at_ + fault_->delay;
+  const auto visible = FaultVisibleAtLocked();
+  if (!visible || now < *visible) return false;
+  return !fault_->duration || now < *visible + *fault_->duration;
 }
 
 void SimBench::CheckAnsweringLocked(Clock::time_point now) const {
@@ -122,7 +129,10 @@ void SimBench::Write(FixtureOutput output, bool on) {
       }
       break;
     case FixtureOutput::kExcitationEnable:
-      if (on && !excitation_) excitation_on_at_ = now;
+      if (on && !excitation_) {
+        excitation_on_at_ = now;
+        if (fault_ && fault_->on_excitation && !fault_->triggered_at) fault_->triggered_at = now;
+      }
       if (!on && excitation_) excitation_off_at_ = now;
       excitation_ = on;
       break;
@@ -171,9 +181,10 @@ std::optional<SimBench::Clock::time_point> SimBench::last_excitation_off() const
   return excitation_off_at_;
 }
 
-void SimBench::InjectFault(SimFault fault, std::chrono::milliseconds delay, bool on_excitation) {
+void SimBench::InjectFault(SimFault fault, std::chrono::milliseconds delay, bool on_excitation,
+                           std::optional<std::chrono::milliseconds> duration) {
   std::lock_guard<std::mutex> lock(mu_);
-  fault_ = PendingFault{fault, delay, on_excitation, Clock::now()};
+  fault_ = PendingFault{fault, delay, on_excitation, Clock::now(), duration, std::nullopt};
 }
 
 void SimBench::ClearFaults() {
@@ -188,10 +199,7 @@ bool SimBench::FaultActive(SimFault fault) const {
 
 std::optional<SimBench::Clock::time_point> SimBench::fault_visible_at() const {
   std::lock_guard<std::mutex> lock(mu_);
-  if (!fault_) return std::nullopt;
-  if (!fault_->on_excitation) return fault_->armed_at + fault_->delay;
-  if (!excitation_on_at_ || *excitation_on_at_ < fault_->armed_at) return std::nullopt;
-  return *excitation_on_at_ + fault_->delay;
+  return FaultVisibleAtLocked();
 }
 
 }  // namespace eol::drivers

@@ -66,8 +66,11 @@ class SimBench {
   std::optional<Clock::time_point> last_excitation_off() const;
 
   // A fault becomes active `delay` after the next excitation-enable edge (or now, when
-  // `on_excitation` is false) and stays until ClearFaults().
-  void InjectFault(SimFault fault, std::chrono::milliseconds delay, bool on_excitation = true);
+  // `on_excitation` is false), once: later excitation edges do not trigger it again. It stays
+  // for `duration` (then the fixture is healthy again, as when a cable is plugged back in), or
+  // until ClearFaults() when no duration is given.
+  void InjectFault(SimFault fault, std::chrono::milliseconds delay, bool on_excitation = true,
+                   std::optional<std::chrono::milliseconds> duration = std::nullopt);
   void ClearFaults();
   bool FaultActive(SimFault fault) const;
   // When the injected fault became visible (for reaction-time measurements).
@@ -94,7 +97,10 @@ class SimBench {
     std::chrono::milliseconds delay;
     bool on_excitation;
     Clock::time_point armed_at;
+    std::optional<std::chrono::milliseconds> duration;
+    std::optional<Clock::time_point> triggered_at;  // the excitation edge (on_excitation)
   };
+  std::optional<Clock::time_point> FaultVisibleAtLocked() const;
   std::optional<PendingFault> fault_;
   std::uint32_t frozen_heartbeat_ = 0;
 };

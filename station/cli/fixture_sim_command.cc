@@ -39,6 +39,7 @@ struct FixtureSimOptions {
   bool load_part_on_clamp = false;
   std::string fault;
   int fault_after_ms = 0;
+  int fault_duration_ms = 0;  // 0: until the emulator stops
   bool fault_on_excitation = false;
   std::string ready_file;
 };
@@ -90,8 +91,10 @@ int RunFixtureSim(const FixtureSimOptions& opt) {
     if (!fault)
       throw std::runtime_error("--fault: unknown fault '" + opt.fault +
                                "' (known: " + FaultNames() + ")");
+    std::optional<std::chrono::milliseconds> duration;
+    if (opt.fault_duration_ms > 0) duration = std::chrono::milliseconds(opt.fault_duration_ms);
     bench->InjectFault(*fault, std::chrono::milliseconds(opt.fault_after_ms),
-                       opt.fault_on_excitation);
+                       opt.fault_on_excitation, duration);
   }
 
   drivers::ModbusFixtureServerSettings tcp;
@@ -170,6 +173,11 @@ void AddFixtureSimCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--fault-on-excitation", opt->fault_on_excitation,
                 "Count --fault-after-ms from the next excitation-enable edge");
+  cmd->add_option("--fault-duration-ms", opt->fault_duration_ms,
+                  "How long the fault lasts once shown, then the fixture is healthy again "
+                  "(0: until the emulator stops); the fault shows once")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--ready-file", opt->ready_file,
                   "Once serving, write the TCP port number here (written atomically)");
   cmd->callback([opt] { RunGuarded("fixture-sim", [opt] { return RunFixtureSim(*opt); }); });

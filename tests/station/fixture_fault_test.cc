@@ -1,0 +1,158 @@
+// Faults injected through `eol fixture-sim` over real Modbus TCP, against the station daemon
+// (`eol station`) in its own process: each fault during excitation must end the test as ERROR
+// with its cause in the stored record, never PASS; the excitation coil must be off at the
+// fixture; and once the fixture is healthy again the next test runs to a verdict without a
+// restart of the daemon.
+#include <httplib.h>
+#include <gtest/gtest.h>
+#include <modbus/modbus.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <thread>
+
+#include "db/store.h"
+#include "tests/support/child_process.h"
+
+namespace eol {
+namespace {
+
+using namespace std::chrono_literals;
+using eol::testing::ChildProcess;
+using eol::testing::TempDir;
+
+struct FaultCase {
+  std::string fault;
+  std::string cause;  // a word the stored reason must contain
+};
+
+std::ostream& operator<<(std::ostream& os, const FaultCase& c) { return os << c.fault; }
+
+int PortFromReadyLine(const std::string& out) {
+  std::smatch m;
+  static const std::regex re("ready, .* http://127\\.0\\.0\\.1:([0-9]+)/");
+  return std::regex_search(out, m, re) ? std::stoi(m[1]) : 0;
+}
+
+int ReadPortFile(const std::string& path) {
+  std::ifstream in(path);
+  int port = 0;
+  in >> port;
+  return port;
+}
+
+// Coil 1 of the default map: excitation_enable, read by an independent client.
+int ReadExcitationCoil(int port) {
+  modbus_t* ctx = modbus_new_tcp("127.0.0.1", port);
+  if (ctx == nullptr) return -1;
+  modbus_set_slave(ctx, 1);
+  std::uint8_t bit = 2;
+  const int rc = modbus_connect(ctx) == 0 ? modbus_read_bits(ctx, 1, 1, &bit) : -1;
+  modbus_close(ctx);
+  modbus_free(ctx);
+  return rc == 1 ? bit : -1;
+}
+
+// Waits until the serial's latest test has finished; returns it (null on timeout).
+nlohmann::json WaitForFinishedTest(httplib::Client& http, const std::string& serial,
+                                   std::chrono::seconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    const auto res = http.Get(("/api/units/" + serial).c_str());
+    if (res && res->status == 200) {
+      const auto unit = nlohmann::json::parse(res->body);
+      if (!unit["tests"].empty() && !unit["tests"].back()["finished_at"].get<std::string>().empty())
+        return unit["tests"].back();
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  return nullptr;
+}
+
+class FixtureFault : public ::testing::TestWithParam<FaultCase> {};
+
+TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
+  const FaultCase& c = GetParam();
+  TempDir dir;
+  const std::string db_path = dir / "station.sqlite";
+  const nlohmann::json sim = {{"clamp_close_s", 0.1}, {"clamp_open_s", 0.05}};
+  // The fault shows 300 ms into the excitation (5 periods of 1 s played at 0.5 x real time)
+  // and lasts 2.5 s: longer than the Modbus driver's retries and than the heartbeat timeout
+  // (1 s: the controller's heartbeat moves at least every 500 ms), so every fault is seen
+  // while the stator is excited.
+  ChildProcess fixture({EOL_BINARY, "fixture-sim", "--port", "0", "--ready-file",
+                        dir / "fixture.port", "--part", "ROTOR-ON-FIXTURE", "--fault", c.fault,
+                        "--fault-on-excitation", "--fault-after-ms", "300",
+                        "--fault-duration-ms", "2500"});
+  ASSERT_TRUE(fixture.WaitFor([&](const std::string&) {
+    return std::filesystem::exists(dir / "fixture.port");
+  }, 30s)) << fixture.output();
+  const int fixture_port = ReadPortFile(dir / "fixture.port");
+  ASSERT_GT(fixture_port, 0);
+
+  std::ofstream(dir / "station.json") << nlohmann::json{
+      {"station_id", "faults"},
+      {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
+      {"db", db_path},
+      {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
+      {"fixture", {{"driver", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", fixture_port}}},
+      {"daq", {{"driver", "sim"}, {"time_scale", 0.5}, {"relay", "external"}}},
+      {"safety", {{"heartbeat_timeout_ms", 1000}}},
+      {"sim", sim}}.dump();
+  ChildProcess station({EOL_BINARY, "station", "--config", dir / "station.json"});
+  ASSERT_TRUE(station.WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; }, 30s))
+      << station.output();
+  httplib::Client http("127.0.0.1", PortFromReadyLine(station.output()));
+
+  const auto started = http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-1"}}.dump(),
+                                 "application/json");
+  ASSERT_TRUE(started && started->status == 202) << (started ? started->body : "no answer");
+  const nlohmann::json faulted = WaitForFinishedTest(http, "FAULT-1", 60s);
+  ASSERT_FALSE(faulted.is_null()) << station.output();
+  EXPECT_EQ(faulted["outcome"], "ERROR") << faulted.dump();
+  const std::string reasons = faulted["reasons"].dump();
+  EXPECT_NE(reasons.find(c.cause), std::string::npos) << "reasons: " << reasons;
+
+  // The stored record says the same; the daemon wrote it before it published the verdict.
+  {
+    auto reader = db::Store::Open(db_path, db::Store::Role::kReader);
+    const auto tests = reader->TestsOfSerial("FAULT-1");
+    ASSERT_EQ(tests.size(), 1u);
+    EXPECT_EQ(tests.front().outcome, analysis::Outcome::kError);
+    ASSERT_FALSE(tests.front().reasons.empty());
+    EXPECT_NE(tests.front().reasons.front().find(c.cause), std::string::npos)
+        << tests.front().reasons.front();
+  }
+
+  // Excitation off at the fixture: read once the fixture answers again.
+  int coil = -1;
+  for (int i = 0; i < 100 && coil < 0; ++i) {
+    coil = ReadExcitationCoil(fixture_port);
+    if (coil < 0) std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_EQ(coil, 0) << "excitation_enable must be off after the fault";
+
+  // Recovery without a restart: the fault has cleared, the next serial gets a verdict.
+  std::this_thread::sleep_for(2500ms);
+  const auto again = http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-2"}}.dump(),
+                               "application/json");
+  ASSERT_TRUE(again && again->status == 202) << (again ? again->body : "no answer");
+  const nlohmann::json recovered = WaitForFinishedTest(http, "FAULT-2", 60s);
+  ASSERT_FALSE(recovered.is_null()) << station.output();
+  EXPECT_TRUE(recovered["outcome"] == "PASS" || recovered["outcome"] == "FAIL")
+      << recovered.dump() << "\n" << station.output();
+  EXPECT_FALSE(station.Wait(0ms).has_value()) << "the daemon must not need a restart";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EachFault, FixtureFault,
+    ::testing::Values(FaultCase{"stops_answering", "fixture"}, FaultCase{"clamp_drops", "clamp"},
+                      FaultCase{"pressure_low", "pressure"}, FaultCase{"door_opens", "door"},
+                      FaultCase{"estop", "stop"}, FaultCase{"heartbeat_freezes", "heartbeat"}),
+    [](const ::testing::TestParamInfo<FaultCase>& i) { return i.param.fault; });
+
+}  // namespace
+}  // namespace eol
