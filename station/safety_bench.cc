@@ -5,11 +5,41 @@
 #include <random>
 
 #include "drivers/daq/sim_daq.h"
+#include "drivers/fixture/modbus_fixture.h"
+#include "drivers/fixture/modbus_fixture_server.h"
 #include "drivers/fixture/sim_fixture.h"
 #include "station/sequencer.h"
 
 namespace eol::station {
 namespace {
+
+// The fixture under test: the in-process simulator, or the Modbus driver talking to the
+// emulator that serves the same bench.
+struct BenchFixture {
+  std::unique_ptr<drivers::ModbusFixtureServer> server;
+  std::unique_ptr<drivers::Fixture> fixture;
+};
+
+BenchFixture MakeFixture(const std::string& kind, const std::shared_ptr<drivers::SimBench>& bench) {
+  BenchFixture f;
+  if (kind == "sim") {
+    f.fixture = std::make_unique<drivers::SimFixture>(bench);
+    return f;
+  }
+  if (kind != "modbus") throw std::invalid_argument("safety-bench: fixture must be sim or modbus");
+  drivers::ModbusFixtureServerSettings ss;
+  ss.link.transport = drivers::ModbusLink::Transport::kTcp;
+  ss.link.host = "127.0.0.1";
+  ss.link.port = 0;
+  f.server = std::make_unique<drivers::ModbusFixtureServer>(bench, ss);
+  if (const drivers::Status s = f.server->Start(); !s.ok())
+    throw std::runtime_error("fixture emulator: " + s.message());
+  drivers::ModbusFixtureSettings cs;
+  cs.link = ss.link;
+  cs.link.port = f.server->port();
+  f.fixture = std::make_unique<drivers::ModbusFixture>(cs);
+  return f;
+}
 
 double Percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
@@ -41,7 +71,8 @@ std::vector<ReactionStats> RunSafetyBench(const SafetyBenchOptions& o) {
       bs.clamp_close_s = 0.02;
       bs.clamp_open_s = 0.02;
       auto bench = std::make_shared<drivers::SimBench>(bs);
-      drivers::SimFixture fixture(bench);
+      BenchFixture bench_fixture = MakeFixture(o.fixture, bench);
+      drivers::Fixture& fixture = *bench_fixture.fixture;
       drivers::SimDaqSettings ds;
       ds.time_scale = 1.0;  // real time: the fault lands mid-stream
       drivers::SimDaq daq(bench, ds);

@@ -17,6 +17,10 @@ struct SafetyBenchOptions {
   std::uint64_t seed = 1;
   double watchdog_period_ms = 5.0;
   std::string recipe_path;
+  // "sim": the in-process simulated fixture; "modbus": the same bench served by the fixture
+  // emulator (eol fixture-sim's server) on 127.0.0.1 and reached by the Modbus TCP driver, so
+  // the bus round trip is in the figure.
+  std::string fixture = "sim";
 };
 
 struct ReactionStats {

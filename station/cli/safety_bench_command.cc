@@ -26,6 +26,10 @@ void AddSafetyBenchCommand(CLI::App& app) {
   cmd->add_option("--watchdog-period-ms", o->watchdog_period_ms, "Interlock poll period")
       ->capture_default_str()->check(CLI::Range(1.0, 50.0));
   cmd->add_option("--recipe", o->recipe_path, "Recipe JSON")->capture_default_str();
+  cmd->add_option("--fixture", o->fixture,
+                  "sim: in-process simulated fixture; modbus: the Modbus TCP driver to the "
+                  "fixture emulator on 127.0.0.1 (the bus round trip included)")
+      ->capture_default_str()->check(CLI::IsMember({"sim", "modbus"}));
   cmd->add_flag("--json", *json, "Print the figures as JSON");
   cmd->callback([o, json] {
     RunGuarded("safety-bench", [&] {
@@ -35,8 +39,8 @@ void AddSafetyBenchCommand(CLI::App& app) {
         std::cout << ToJson(stats).dump(2) << std::endl;
         return 0;
       }
-      std::printf("watchdog period %.1f ms; reaction = relay open - fault visible\n",
-                  o->watchdog_period_ms);
+      std::printf("fixture %s, watchdog period %.1f ms; reaction = relay open - fault visible\n",
+                  o->fixture.c_str(), o->watchdog_period_ms);
       std::printf("%-12s %6s %6s %8s %8s %8s %8s\n", "fault", "tests", "ERROR", "min ms",
                   "median", "p95", "max");
       for (const auto& s : stats)
