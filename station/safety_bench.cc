@@ -93,6 +93,7 @@ std::vector<ReactionStats> RunSafetyBench(const SafetyBenchOptions& o) {
                                 *bench->last_excitation_off() - *bench->fault_visible_at())
                                 .count());
     }
+    st.measured = static_cast<int>(reactions.size());
     if (!reactions.empty()) {
       st.min_ms = *std::min_element(reactions.begin(), reactions.end());
       st.median_ms = Percentile(reactions, 0.5);
@@ -111,7 +112,7 @@ std::vector<ReactionStats> RunSafetyBench(const SafetyBenchOptions& o) {
 nlohmann::json ToJson(const std::vector<ReactionStats>& stats) {
   nlohmann::json j = nlohmann::json::array();
   for (const auto& s : stats)
-    j.push_back({{"fault", s.fault}, {"trials", s.trials}, {"errors", s.errors},
+    j.push_back({{"fault", s.fault}, {"trials", s.trials}, {"errors", s.errors}, {"measured", s.measured},
                  {"min_ms", s.min_ms}, {"median_ms", s.median_ms}, {"p95_ms", s.p95_ms},
                  {"max_ms", s.max_ms}});
   return j;

@@ -26,7 +26,8 @@ struct SafetyBenchOptions {
 struct ReactionStats {
   std::string fault;
   int trials = 0;
-  int errors = 0;  // tests that ended ERROR (should be all of them)
+  int errors = 0;    // tests that ended ERROR (should be all of them)
+  int measured = 0;  // tests where the fault showed and the relay opened after it
   double min_ms = 0, median_ms = 0, p95_ms = 0, max_ms = 0;
 };
 
