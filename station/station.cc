@@ -32,12 +32,14 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
   SequencerOptions opts;
   opts.station_id = config_.station_id;
   opts.safety = config_.safety;
+  opts.self_check = config_.self_check;
   if (drivers_.bench && drivers_.bench->settings().load_part_on_serial) {
     drivers::SimBench* bench = drivers_.bench.get();
     opts.on_serial = [bench](const std::string& serial) { bench->LoadPart(serial); };
   }
   sequencer_ = std::make_unique<Sequencer>(*drivers_.fixture, *drivers_.daq, *store_, recipe_,
                                            *board_, opts);
+  sequencer_->PublishLockout();  // a lockout survives a restart: it is read from the store
 }
 
 Station::~Station() {

@@ -616,7 +616,8 @@ TEST_F(StoreMigrationTest, VersionOneFileMigratesToTwoKeepingItsTests) {
   }
   auto store = Store::Open(path.string());
   RawDb raw(path);
-  EXPECT_EQ(raw.Column("PRAGMA user_version"), std::vector<std::string>{"2"});
+  EXPECT_EQ(raw.Column("PRAGMA user_version"),
+            std::vector<std::string>{std::to_string(Store::kSchemaVersion)});
   EXPECT_EQ(store->TestsOfSerial("OLD-1").size(), 1u);
   EXPECT_TRUE(store->AuditLog().empty());
 }
