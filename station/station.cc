@@ -167,9 +167,12 @@ void Station::Serve() {
       std::unique_lock<std::mutex> lock(queue_mu_);
       // Wakes at least every second to tell systemd's watchdog the loop is alive; a test that
       // hangs stops the pings and gets the daemon restarted.
+      int idle_s = 0;
       while (!queue_cv_.wait_for(lock, std::chrono::seconds(1),
-                                 [&] { return stop_ || !queue_.empty(); }))
+                                 [&] { return stop_ || !queue_.empty(); })) {
         NotifyWatchdog();
+        if (++idle_s % 60 == 0) sequencer_->PublishLockout();  // a check falls due with time
+      }
       NotifyWatchdog();
       if (stop_) return;
       serial = queue_.front();

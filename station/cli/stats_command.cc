@@ -37,10 +37,10 @@ void PrintText(const nlohmann::json& r) {
                 g["recipe_id"].get<std::string>().c_str(), g["recipe_version"].get<int>(),
                 g["recipe_hash"].get<std::string>().substr(0, 12).c_str(),
                 g["tests"].get<std::size_t>());
-    std::printf("  %-28s %6s %12s %10s %8s %8s  %s\n", "measurement", "n", "mean", "sd", "Cp",
+    std::printf("  %-34s %6s %12s %10s %8s %8s  %s\n", "measurement", "n", "mean", "sd", "Cp",
                 "Cpk", "drift");
     for (const auto& m : g["measurements"])
-      std::printf("  %-28s %6zu %12s %10s %8s %8s  %s\n", m["name"].get<std::string>().c_str(),
+      std::printf("  %-34s %6zu %12s %10s %8s %8s  %s\n", m["name"].get<std::string>().c_str(),
                   m["n"].get<std::size_t>(), Num(m["mean"], "%.6g").c_str(),
                   Num(m["sd"]).c_str(), Num(m["cp"], "%.3f").c_str(),
                   Num(m["cpk"], "%.3f").c_str(),

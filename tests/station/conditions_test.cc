@@ -101,8 +101,8 @@ TEST_F(ConditionsTest, InWindowPassesAndRecordsEveryCondition) {
 
 TEST_F(ConditionsTest, HotWindingIsAnErrorNotAPassAndNotAFail) {
   Build(Conditions());
-  // R = 0.579 ohm is inside the R limits (0.4..0.6): only the temperature says it is hot.
-  const db::TestRecord r = Test("COND-HOT", 60.0);
+  // R = 0.582 ohm is inside the R limits (0.4..0.6): only the temperature says it is hot.
+  const db::TestRecord r = Test("COND-HOT", 62.0);
   EXPECT_EQ(r.outcome, Outcome::kError) << Reasons(r);
   ASSERT_FALSE(r.reasons.empty());
   EXPECT_EQ(r.reasons.front().rfind("condition out of window: winding temperature 6", 0), 0u)

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <iostream>
 
 #include "db/store.h"
 #include "station/http_api.h"
@@ -247,11 +248,13 @@ TEST(StatsDrift, FixtureWearRaisesTheAlarmAndNoWearDoesNot) {
             std::string::npos)
       << worn["alarms"][0];
 
+  std::cout << "worn: " << worn["alarms"][0].get<std::string>() << "\n";
   const nlohmann::json fresh = DriftRun(dir, "fresh", 0.0);
   const nlohmann::json& f0_fresh = Measurement(fresh.at("recipes").at(0), "resonance_f_hz");
   EXPECT_FALSE(f0_fresh.at("drift").at("alarm").get<bool>()) << f0_fresh.dump();
   EXPECT_TRUE(f0_fresh.at("drift").at("usable").get<bool>());
   EXPECT_TRUE(fresh.at("alarms").empty()) << fresh.at("alarms").dump();
+  std::cout << "fresh: " << f0_fresh["drift"]["message"].get<std::string>() << "\n";
   // Wear also shows in the capability: the worn run's f0 spreads more than the fresh one's.
   EXPECT_GT(f0.at("sd").get<double>(), f0_fresh.at("sd").get<double>());
 }
