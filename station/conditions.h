@@ -3,8 +3,9 @@
 //   clamp_pressure_bar             read at clamp confirmation; its window is the recipe's
 //                                  fixture.clamp_pressure_bar (a safety interlock: the
 //                                  watchdog stops the test outside it). The minimum and
-//                                  maximum seen during excitation are recorded as
-//                                  clamp_pressure_min_bar / clamp_pressure_max_bar.
+//                                  maximum read from right before the relay closed through
+//                                  the excitation are recorded as clamp_pressure_min_bar /
+//                                  clamp_pressure_max_bar.
 //   winding_temperature_c          estimated from the fitted winding resistance with copper's
 //                                  temperature coefficient:
 //                                    R = R_ref (1 + alpha (T - T_ref)),  alpha = 0.00393 1/K

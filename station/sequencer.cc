@@ -310,10 +310,15 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
     result.emplace(daq_.Acquire(req, abort_));
     (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
     watchdog_fault = watchdog.fault();
+    // From the check right before the relay closed through the watchdog's reads (a very
+    // short acquisition may end before the watchdog's first read).
+    double p_min = in.clamp_pressure_bar, p_max = in.clamp_pressure_bar;
     if (const auto range = watchdog.pressure_range()) {
-      record.conditions["clamp_pressure_min_bar"] = range->first;
-      record.conditions["clamp_pressure_max_bar"] = range->second;
+      p_min = std::min(p_min, range->first);
+      p_max = std::max(p_max, range->second);
     }
+    record.conditions["clamp_pressure_min_bar"] = p_min;
+    record.conditions["clamp_pressure_max_bar"] = p_max;
   }
   record.calibration = {{"shunt_ohm", daq_.calibration().shunt_ohm},
                         {"divider_ratio", daq_.calibration().divider_ratio},
