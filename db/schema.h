@@ -88,4 +88,31 @@ CREATE TABLE recipe_audit (
 CREATE INDEX recipe_audit_at ON recipe_audit (at);
 )sql";
 
+// Version 2 -> 3: self-checks and the kind of each test.
+//
+// tests.kind: 'production' for a unit, 'self_check' for a master part tested to check the
+//   station itself; production statistics read only 'production' rows. Rows written before
+//   version 3 are production tests.
+// self_checks: one row per master test, written in the same transaction as its test: which
+//   master ('good' must PASS, 'limit' must FAIL on the resonance), whether the check passed,
+//   and why. The station's lockout is derived from this table (station/self_check.h), so it
+//   survives a restart.
+inline constexpr const char kSchemaV3[] = R"sql(
+ALTER TABLE tests ADD COLUMN kind TEXT NOT NULL DEFAULT 'production'
+  CHECK (kind IN ('production', 'self_check'));
+CREATE INDEX tests_kind_started ON tests(kind, started_at);
+
+CREATE TABLE self_checks (
+  id         INTEGER PRIMARY KEY,
+  test_id    INTEGER NOT NULL REFERENCES tests(id) ON DELETE CASCADE,
+  at         TEXT    NOT NULL,
+  station_id TEXT    NOT NULL,
+  master     TEXT    NOT NULL CHECK (master IN ('good', 'limit')),
+  serial     TEXT    NOT NULL,
+  passed     INTEGER NOT NULL CHECK (passed IN (0, 1)),
+  detail     TEXT    NOT NULL
+);
+CREATE INDEX self_checks_at ON self_checks(at);
+)sql";
+
 }  // namespace eol::db::schema

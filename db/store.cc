@@ -100,6 +100,9 @@ class Statement {
   std::optional<std::int64_t> OptInt(int c) const {
     return IsNull(c) ? std::nullopt : std::optional<std::int64_t>(Int(c));
   }
+  std::optional<double> OptReal(int c) const {
+    return IsNull(c) ? std::nullopt : std::optional<double>(sqlite3_column_double(stmt_, c));
+  }
   // NULL -> "".
   std::string Text(int c) const {
     const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(stmt_, c));
@@ -164,7 +167,12 @@ void MigrateTo2(sqlite3* db, const std::string& path) {
   Exec(db, path, schema::kSchemaV2, "migrate the schema to version 2");
 }
 
-constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {&MigrateTo1, &MigrateTo2};
+void MigrateTo3(sqlite3* db, const std::string& path) {
+  Exec(db, path, schema::kSchemaV3, "migrate the schema to version 3");
+}
+
+constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {&MigrateTo1, &MigrateTo2,
+                                                                      &MigrateTo3};
 
 std::int64_t PragmaInt(sqlite3* db, const std::string& path, const char* sql,
                        const std::string& op) {
@@ -267,9 +275,9 @@ void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
   if (record.started_at.empty()) throw StoreError(Message(path, op, "record.started_at is empty"));
   Statement s(db, path, R"sql(
     INSERT INTO tests (serial, station_id, recipe_id, recipe_version, recipe_hash,
-                       software_version, started_at, outcome, retest_of)
+                       software_version, started_at, outcome, retest_of, kind)
     VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, 'RUNNING',
-            (SELECT min(id) FROM tests WHERE serial = ?1))
+            (SELECT min(id) FROM tests WHERE serial = ?1), ?8)
     RETURNING id, retest_of)sql",
               op);
   s.BindText(1, record.serial);
@@ -279,6 +287,10 @@ void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
   s.BindText(5, record.recipe_hash);
   s.BindText(6, record.software_version);
   s.BindText(7, record.started_at);
+  if (record.kind != "production" && record.kind != "self_check")
+    throw StoreError(Message(path, op, "record.kind '" + record.kind +
+                                           "' is not production or self_check"));
+  s.BindText(8, record.kind);
   if (!s.Step()) throw StoreError(Message(path, op, "the insert returned no id"));
   const std::int64_t id = s.Int(0);
   const std::optional<std::int64_t> retest_of = s.OptInt(1);
@@ -333,6 +345,26 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
     m.Run();
   }
 
+  if (record.kind == "self_check") {
+    const nlohmann::json& c = record.self_check;
+    const std::string check_op = op + " (write the self-check)";
+    if (!c.is_object() || !c.contains("master") || !c["master"].is_string() ||
+        !c.contains("passed") || !c["passed"].is_boolean())
+      throw StoreError(Message(path, check_op, "record.self_check needs master and passed"));
+    Statement sc(db, path,
+                 "INSERT INTO self_checks (test_id, at, station_id, master, serial, passed, detail) "
+                 "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+                 check_op);
+    sc.BindInt(1, record.id);
+    sc.BindText(2, record.finished_at);
+    sc.BindText(3, record.station_id);
+    sc.BindText(4, c["master"].get<std::string>());
+    sc.BindText(5, record.serial);
+    sc.BindInt(6, c["passed"].get<bool>() ? 1 : 0);
+    sc.BindText(7, c.value("detail", ""));
+    sc.Run();
+  }
+
   const std::string curves_op = op + " (write curves)";
   Statement c(db, path,
               "INSERT INTO curves (test_id, name, raw_size, data) VALUES (?1, ?2, ?3, ?4)",
@@ -353,7 +385,7 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
 
 constexpr std::string_view kSelectTests =
     "SELECT id, serial, station_id, recipe_id, recipe_version, recipe_hash, software_version, "
-    "started_at, finished_at, outcome, retest_of, reasons, record FROM tests ";
+    "started_at, finished_at, outcome, retest_of, reasons, record, kind FROM tests ";
 
 TestRecord RowToRecord(const Statement& s, const std::string& path) {
   const std::int64_t id = s.Int(0);
@@ -380,6 +412,7 @@ TestRecord RowToRecord(const Statement& s, const std::string& path) {
   if (!parsed) throw StoreError(Message(path, op, "unknown outcome '" + outcome + "'"));
   r.outcome = *parsed;
   r.retest_of = s.OptInt(10);
+  r.kind = s.Text(13);
   r.curves.clear();
   return r;
 }
@@ -559,6 +592,98 @@ void Store::AppendAudit(const RecipeAudit& a) {
   s.BindText(8, a.new_hash);
   s.BindText(9, a.path);
   s.Step();
+}
+
+namespace {
+
+SelfCheckEntry RowToSelfCheck(const Statement& s) {
+  SelfCheckEntry e;
+  e.test_id = s.Int(0);
+  e.at = s.Text(1);
+  e.station_id = s.Text(2);
+  e.master = s.Text(3);
+  e.serial = s.Text(4);
+  e.passed = s.Int(5) != 0;
+  e.detail = s.Text(6);
+  return e;
+}
+
+constexpr std::string_view kSelectSelfChecks =
+    "SELECT test_id, at, station_id, master, serial, passed, detail FROM self_checks ";
+
+}  // namespace
+
+std::vector<SelfCheckEntry> Store::SelfChecks(int limit) {
+  Statement s(db_, path_, std::string(kSelectSelfChecks) + "ORDER BY id DESC LIMIT ?1",
+              "read the self-checks");
+  s.BindInt(1, std::clamp(limit, 1, kMaxQueryLimit));
+  std::vector<SelfCheckEntry> out;
+  while (s.Step()) out.push_back(RowToSelfCheck(s));
+  return out;
+}
+
+std::optional<SelfCheckEntry> Store::LatestSelfCheck(const std::string& master) {
+  Statement s(db_, path_, std::string(kSelectSelfChecks) + "WHERE master = ?1 ORDER BY id DESC LIMIT 1",
+              "read the latest self-check of the " + master + " master");
+  s.BindText(1, master);
+  if (!s.Step()) return std::nullopt;
+  return RowToSelfCheck(s);
+}
+
+int Store::CountTestsSince(const std::string& kind, const std::string& since) {
+  Statement s(db_, path_,
+              "SELECT count(*) FROM tests WHERE kind = ?1 AND started_at >= ?2 "
+              "AND outcome <> 'RUNNING'",
+              "count " + kind + " tests since " + since);
+  s.BindText(1, kind);
+  s.BindText(2, since);
+  if (!s.Step()) throw StoreError(Message(path_, "count tests", "no result"));
+  return static_cast<int>(s.Int(0));
+}
+
+std::vector<MeasurementRow> Store::MeasurementRows(const MeasurementQuery& q) {
+  // Only fixed clauses are appended; every value is a bound parameter.
+  std::string sql =
+      "SELECT t.id, t.serial, t.started_at, t.outcome, t.recipe_id, t.recipe_version, "
+      "t.recipe_hash, m.name, m.unit, m.value, m.lo, m.hi FROM measurements m "
+      "JOIN tests t ON t.id = m.test_id WHERE t.outcome IN ('PASS', 'FAIL', 'ERROR') "
+      "AND t.kind = ?1";
+  int n = 1;
+  const int from_i = q.from ? ++n : 0;
+  if (from_i) sql += " AND t.started_at >= ?" + std::to_string(from_i);
+  const int to_i = q.to ? ++n : 0;
+  if (to_i) sql += " AND t.started_at < ?" + std::to_string(to_i);
+  const int hash_i = q.recipe_hash ? ++n : 0;
+  if (hash_i) sql += " AND t.recipe_hash = ?" + std::to_string(hash_i);
+  const int serial_i = q.serial ? ++n : 0;
+  if (serial_i) sql += " AND t.serial = ?" + std::to_string(serial_i);
+  sql += " ORDER BY t.started_at, t.id, m.id LIMIT 1000000";
+  Statement s(db_, path_, sql, "read measurements for statistics");
+  s.BindText(1, q.kind);
+  if (from_i) s.BindText(from_i, *q.from);
+  if (to_i) s.BindText(to_i, *q.to);
+  if (hash_i) s.BindText(hash_i, *q.recipe_hash);
+  if (serial_i) s.BindText(serial_i, *q.serial);
+  std::vector<MeasurementRow> out;
+  while (s.Step()) {
+    MeasurementRow r;
+    r.test_id = s.Int(0);
+    r.serial = s.Text(1);
+    r.started_at = s.Text(2);
+    const std::optional<analysis::Outcome> o = analysis::ParseOutcome(s.Text(3));
+    if (!o) throw StoreError(Message(path_, "read measurements", "unknown outcome " + s.Text(3)));
+    r.outcome = *o;
+    r.recipe_id = s.Text(4);
+    r.recipe_version = static_cast<int>(s.Int(5));
+    r.recipe_hash = s.Text(6);
+    r.name = s.Text(7);
+    r.unit = s.Text(8);
+    r.value = s.OptReal(9);
+    r.lo = s.OptReal(10);
+    r.hi = s.OptReal(11);
+    out.push_back(std::move(r));
+  }
+  return out;
 }
 
 std::vector<RecipeAudit> Store::AuditLog(int limit) {

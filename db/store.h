@@ -54,9 +54,44 @@ struct RecipeAudit {
   std::string path;  // the file written
 };
 
+// One master test of a self-check (schema v3), as the store keeps it.
+struct SelfCheckEntry {
+  std::int64_t test_id = 0;
+  std::string at;  // ISO 8601 UTC, when the master's test finished
+  std::string station_id;
+  std::string master;  // "good" or "limit"
+  std::string serial;
+  bool passed = false;
+  std::string detail;
+};
+
+// Measurement rows of finished tests for statistics, oldest first.
+struct MeasurementQuery {
+  std::optional<std::string> from;  // ISO 8601, inclusive, on started_at
+  std::optional<std::string> to;    // exclusive
+  std::optional<std::string> recipe_hash;
+  std::optional<std::string> serial;
+  std::string kind = "production";  // "production" or "self_check"
+};
+
+struct MeasurementRow {
+  std::int64_t test_id = 0;
+  std::string serial;
+  std::string started_at;
+  analysis::Outcome outcome = analysis::Outcome::kError;
+  std::string recipe_id;
+  int recipe_version = 0;
+  std::string recipe_hash;
+  std::string name;
+  std::string unit;
+  std::optional<double> value;  // empty where the stored value was not finite
+  std::optional<double> lo;
+  std::optional<double> hi;
+};
+
 class Store {
  public:
-  static constexpr int kSchemaVersion = 2;
+  static constexpr int kSchemaVersion = 3;
 
   // kWriter: the station's one connection; recovers unfinished tests as ABORTED.
   // kReader: further connections (the HTTP API, queries, exports) that must never touch a
@@ -91,6 +126,16 @@ class Store {
 
   void AppendAudit(const RecipeAudit& entry);
   std::vector<RecipeAudit> AuditLog(int limit = 100);  // newest first
+
+  // Self-checks, newest first (written by FinishTest for records of kind "self_check").
+  std::vector<SelfCheckEntry> SelfChecks(int limit = 100);
+  // The newest check of one master ("good" or "limit"), if any.
+  std::optional<SelfCheckEntry> LatestSelfCheck(const std::string& master);
+  // Finished (or aborted) tests of `kind` that started at or after `since` (ISO 8601).
+  int CountTestsSince(const std::string& kind, const std::string& since);
+  // Every measurement row of finished PASS/FAIL/ERROR tests matching the query, in test order
+  // (started_at, id), at most 1,000,000 rows.
+  std::vector<MeasurementRow> MeasurementRows(const MeasurementQuery& query);
 
   // SQLite's own consistency check: "ok" or the first problem it finds.
   std::string IntegrityCheck();

@@ -105,7 +105,9 @@ void to_json(nlohmann::json& j, const TestRecord& r) {
        {"calibration", r.calibration},
        {"fit", r.fit},
        {"curves", r.curves},
-       {"trace", r.trace}};
+       {"trace", r.trace},
+       {"kind", r.kind},
+       {"self_check", r.self_check}};
 }
 
 void from_json(const nlohmann::json& j, TestRecord& r) {
@@ -135,6 +137,8 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   r.fit = j.value("fit", nlohmann::json::object());
   r.curves = j.value("curves", std::vector<Curve>{});
   r.trace = j.value("trace", std::vector<StateEntry>{});
+  r.kind = j.value("kind", "production");
+  r.self_check = j.value("self_check", nlohmann::json::object());
 }
 
 }  // namespace eol::db

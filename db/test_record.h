@@ -55,6 +55,13 @@ struct TestRecord {
   nlohmann::json fit = nlohmann::json::object();  // the fit summary
   std::vector<Curve> curves;
   std::vector<StateEntry> trace;
+
+  // What was tested (schema v3): "production" (a unit) or "self_check" (a master part that
+  // checks the station; never in production statistics).
+  std::string kind = "production";
+  // For a self-check: {"master": "good" | "limit", "passed": bool, "detail": "..."}; the store
+  // writes it to the self_checks table in the test's own transaction. Empty otherwise.
+  nlohmann::json self_check = nlohmann::json::object();
 };
 
 void to_json(nlohmann::json& j, const Curve& c);

@@ -39,6 +39,20 @@ SimBenchSettings ParseSimBenchSettings(const JsonObject& o) {
   s.clamp_pressure_bar = o.Number("clamp_pressure_bar", s.clamp_pressure_bar);
   s.heartbeat_period_s = o.Number("heartbeat_period_s", s.heartbeat_period_s);
   s.load_part_on_serial = o.Bool("load_part_on_serial", s.load_part_on_serial);
+  s.fixture_wear_per_test = o.Number("fixture_wear_per_test", s.fixture_wear_per_test);
+  o.Require(s.fixture_wear_per_test >= 0 && s.fixture_wear_per_test <= 0.01,
+            "fixture_wear_per_test", "must be in [0, 0.01] (share of the stiffness per part)");
+  if (o.Has("masters")) {
+    const nlohmann::json& list = o.Raw("masters");
+    if (!list.is_array()) throw ConfigError(o.PathOf("masters") + ": must be an array");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const JsonObject m(list[i], o.PathOf("masters") + "/" + std::to_string(i));
+      SimMaster master{m.RequiredString("serial"), m.Bool("defective", false)};
+      m.Require(!master.serial.empty(), "serial", "must not be empty");
+      m.RejectUnknown();
+      s.masters.push_back(master);
+    }
+  }
   o.Require(s.clamp_close_s > 0 && s.clamp_close_s < 10, "clamp_close_s", "must be in (0, 10) s");
   o.Require(s.clamp_open_s > 0 && s.clamp_open_s < 10, "clamp_open_s", "must be in (0, 10) s");
   o.Require(s.heartbeat_period_s > 0 && s.heartbeat_period_s <= 0.5, "heartbeat_period_s",

@@ -8,7 +8,9 @@
 //   "daq":     {"driver": "sim", "model": "steady_state" | "time_domain",
 //               "amplifier_output_ohm": 0, "time_scale": 0, "voltage_noise_v": 0.002, ...}
 //                                                   the simulated acquisition (sim_daq.h)
-//   "sim":     {"population": {...}, "clamp_close_s": 0.15, ...}   the simulated bench
+//   "sim":     {"population": {...}, "clamp_close_s": 0.15, ...,   the simulated bench
+//               "masters": [{"serial": "MASTER-G"}, {"serial": "MASTER-L", "defective": true}],
+//               "fixture_wear_per_test": 0.001}                    (sim_bench.h)
 //
 // A simulator is chosen exactly as real hardware is. A driver that was not compiled in, or
 // an unknown name, fails with a ConfigError naming the path and the known drivers.

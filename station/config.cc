@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "drivers/json_config.h"
+#include "station/serial_number.h"
 
 namespace eol::station {
 namespace {
@@ -62,6 +63,23 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       s->RejectUnknown();
     }
     c.serial_from_stdin = root.Bool("serial_from_stdin", false);
+    if (auto sc = root.OptionalObject("self_check")) {
+      SelfCheckConfig& k = c.self_check;
+      k.good_master = sc->RequiredString("good_master");
+      k.limit_master = sc->RequiredString("limit_master");
+      k.every_n_tests = sc->Integer("every_n_tests", k.every_n_tests);
+      k.every_hours = sc->Number("every_hours", k.every_hours);
+      std::string why;
+      sc->Require(ValidSerial(k.good_master, &why), "good_master", why);
+      sc->Require(ValidSerial(k.limit_master, &why), "limit_master", why);
+      sc->Require(k.limit_master != k.good_master, "limit_master",
+                  "must differ from good_master (two different parts)");
+      sc->Require(k.every_n_tests >= 0 && k.every_n_tests <= 100000, "every_n_tests",
+                  "must be in [0, 100000] (0: no count limit)");
+      sc->Require(k.every_hours >= 0 && k.every_hours <= 744, "every_hours",
+                  "must be in [0, 744] h (0: no time limit)");
+      sc->RejectUnknown();
+    }
     // The driver sections are validated by drivers::MakeDrivers; mark them known here.
     c.drivers["fixture"] = root.Raw("fixture");
     c.drivers["daq"] = root.Raw("daq");

@@ -13,7 +13,9 @@
 //   "daq": {"driver": "sim" | ...},
 //   "sim": {...},                                    the simulated bench, when a driver is sim
 //   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500},
-//   "serial_from_stdin": false                       a scanner typing serials into stdin
+//   "serial_from_stdin": false,                      a scanner typing serials into stdin
+//   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
+//                  "every_n_tests": 50, "every_hours": 8}       optional, station/self_check.h
 // }
 #pragma once
 
@@ -36,6 +38,15 @@ struct ApiToken {
   std::string token;
 };
 
+// Self-checks with master parts (station/self_check.h). Off when good_master is empty.
+struct SelfCheckConfig {
+  std::string good_master;    // serial of a known good unit: must PASS
+  std::string limit_master;   // serial of a deliberately soft-bonded rotor: must FAIL on the resonance
+  int every_n_tests = 50;     // production tests a passing check covers (0: no count limit)
+  double every_hours = 8.0;   // hours a passing check stays valid (0: no time limit)
+  bool enabled() const { return !good_master.empty(); }
+};
+
 struct StationConfig {
   std::string station_id = "eol-1";
   std::string recipe_path;
@@ -45,6 +56,7 @@ struct StationConfig {
   std::vector<ApiToken> tokens;
   SafetyOptions safety;
   bool serial_from_stdin = false;
+  SelfCheckConfig self_check;
   nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}
 };
 

@@ -8,6 +8,7 @@
 
 #include "db/store.h"
 #include "station/serial_number.h"
+#include "station/stats_report.h"
 
 namespace eol::station {
 namespace {
@@ -196,6 +197,31 @@ void HttpApi::Routes() {
     nlohmann::json list = nlohmann::json::array();
     for (const auto& t : tests) list.push_back(t);
     SendJson(res, 200, {{"tests", list}});
+  });
+
+  s.Get("/api/stats", [this](const httplib::Request& req, httplib::Response& res) {
+    StatsRequest q;
+    if (req.has_param("from")) q.from = req.get_param_value("from");
+    if (req.has_param("to")) q.to = req.get_param_value("to");
+    if (req.has_param("recipe_hash")) q.recipe_hash = req.get_param_value("recipe_hash");
+    if (req.has_param("gauge")) q.gauge_serial = req.get_param_value("gauge");
+    std::string why;
+    for (std::size_t i = 0; i < req.get_param_value_count("reference"); ++i)
+      if (!ParseReference(req.get_param_value("reference", i), q.reference, &why))
+        return SendError(res, 400, "bad_reference", why);
+    if (req.has_param("sigma_span")) {
+      const std::string v = req.get_param_value("sigma_span");
+      if (v != "4" && v != "6") return SendError(res, 400, "bad_sigma_span", "sigma_span must be 4 or 6");
+      q.gauge.sigma_span = std::stod(v);
+    }
+    if (const std::string bad = ValidateStatsRequest(q); !bad.empty())
+      return SendError(res, 400, "bad_request", bad);
+    nlohmann::json report;
+    {
+      std::lock_guard<std::mutex> lock(db_mu_);
+      report = StatsReport(*db_, q);
+    }
+    SendJson(res, 200, report);
   });
 
   s.Post("/api/tests", [this](const httplib::Request& req, httplib::Response& res) {

@@ -9,6 +9,8 @@
 //   PUT  /api/recipe            a new version of the recipe (engineer token; audited)
 //   GET  /api/recipe/audit      who changed the recipe, when, old and new hash
 //   GET  /api/recipe            the recipe in use with its hash (limits and masks)
+//   GET  /api/stats?from=&to=&recipe_hash=&gauge=&reference=NAME=VALUE&sigma_span=
+//                               capability, drift alarms, gauge study (station/stats_report.h)
 //   GET  /metrics               Prometheus text: tests by outcome, state, last resonance
 //   GET  /                      the operator page (station/web)
 //

@@ -138,6 +138,41 @@ void ParseMasks(const nlohmann::json& masks, const std::string& path, Recipe& r)
   }
 }
 
+analysis::Limit ParseWindow(const JsonObject& w) {
+  analysis::Limit l;
+  l.lo = w.OptionalNumber("lo");
+  l.hi = w.OptionalNumber("hi");
+  w.Require(!(l.lo && l.hi) || *l.hi > *l.lo, "hi", "must be greater than lo");
+  return l;
+}
+
+void ParseConditions(const JsonObject& c, Recipe& r) {
+  ConditionWindows& w = r.conditions;
+  w.enabled = true;
+  if (auto t = c.OptionalObject("winding_temperature_c")) {
+    w.r_ref_ohm = t->RequiredNumber("r_ref_ohm");
+    w.t_ref_c = t->Number("t_ref_c", w.t_ref_c);
+    t->Require(w.r_ref_ohm > 0, "r_ref_ohm", "must be positive");
+    t->Require(w.t_ref_c > -50 && w.t_ref_c < 200, "t_ref_c", "must be in (-50, 200) degC");
+    w.winding_temperature_c = ParseWindow(*t);
+    t->RejectUnknown();
+  }
+  if (auto v = c.OptionalObject("excitation_v_rms")) {
+    w.excitation_v_rms = ParseWindow(*v);
+    v->RejectUnknown();
+  }
+  if (auto a = c.OptionalObject("excitation_a_rms")) {
+    w.excitation_a_rms = ParseWindow(*a);
+    a->RejectUnknown();
+  }
+  const std::string policy = c.String("out_of_window", "error");
+  c.Require(policy == "error" || policy == "record", "out_of_window",
+            "must be \"error\" or \"record\" (R is not normalised to t_ref_c: the temperature "
+            "is estimated from R itself, see station/conditions.h)");
+  w.error_when_out = policy == "error";
+  c.RejectUnknown();
+}
+
 }  // namespace
 
 std::vector<analysis::MeasurementSpec> Recipe::Specs() const {
@@ -193,6 +228,7 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
     }
     ParseLimits(root.Raw("limits"), "/limits", r);
     if (root.Has("masks")) ParseMasks(root.Raw("masks"), "/masks", r);
+    if (auto c = root.OptionalObject("conditions")) ParseConditions(*c, r);
     root.RejectUnknown();
     r.source = j;
     r.hash = CanonicalHash(j);

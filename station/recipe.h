@@ -14,6 +14,9 @@
 //   "masks": [ {"name": "re_z_low_band", "quantity": "re_ohm" | "abs_ohm",
 //               "max_lines_outside": 0, "guard_sigma": 3,
 //               "points": [{"f_hz": 300, "hi": 0.75}, {"f_hz": 365, "hi": 0.75}]} ]  optional
+//   "conditions": {"winding_temperature_c": {"r_ref_ohm": 0.5, "t_ref_c": 20, "lo": 0, "hi": 45},
+//                  "excitation_v_rms": {"lo": 1.2, "hi": 1.45}, "excitation_a_rms": {...},
+//                  "out_of_window": "error" | "record"}       optional, station/conditions.h
 // }
 // Validated on load: every message names the JSON path and the rule broken, and a recipe
 // that fails validation is never used. The hash is the SHA-256 of the canonical JSON (keys
@@ -31,6 +34,7 @@
 #include "analysis/qc/measurement.h"
 #include "analysis/signal/multisine.h"
 #include "drivers/fixture/fixture.h"
+#include "station/conditions.h"
 
 namespace eol::station {
 
@@ -60,6 +64,7 @@ struct Recipe {
   analysis::ImpedanceAnalysisOptions analysis;
   std::vector<analysis::MeasurementSpec> limits;
   std::vector<analysis::CurveMask> masks;
+  ConditionWindows conditions;
 
   // Every declared measurement: the scalar limits, then one per mask.
   std::vector<analysis::MeasurementSpec> Specs() const;

@@ -2,12 +2,15 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <thread>
 
 #include "analysis/impedance_analysis.h"
+#include "analysis/qc/measurement_names.h"
 #include "db/clock.h"
+#include "station/self_check.h"
 #include "station/version.h"
 
 namespace eol::station {
@@ -131,6 +134,11 @@ class Sequencer::Watchdog {
     std::lock_guard<std::mutex> lock(mu_);
     return fault_;
   }
+  // Clamp pressure seen during excitation (bar): {min, max}; empty before the first read.
+  std::optional<std::pair<double, double>> pressure_range() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return pressure_;
+  }
 
  private:
   void Run() {
@@ -142,6 +150,13 @@ class Sequencer::Watchdog {
       if (!in.ok()) {
         why = "fixture not answering during excitation: " + in.status().message();
       } else {
+        {
+          std::lock_guard<std::mutex> lock(mu_);
+          const double p = in.value().clamp_pressure_bar;
+          pressure_ = pressure_ ? std::make_pair(std::min(pressure_->first, p),
+                                                 std::max(pressure_->second, p))
+                                : std::make_pair(p, p);
+        }
         why = InterlockFault(in.value(), *seq_.recipe_, true);
         if (why.empty() && !seq_.heartbeat_.Update(in.value().heartbeat, now))
           why = "fixture heartbeat frozen for " + Fixed(seq_.heartbeat_.stale_ms(now), 0) + " ms";
@@ -163,6 +178,7 @@ class Sequencer::Watchdog {
   std::atomic<bool> stop_{false};
   std::mutex mu_;
   std::optional<std::string> fault_;
+  std::optional<std::pair<double, double>> pressure_;
   std::thread thread_;  // last: starts after the members it uses exist
 };
 
@@ -294,6 +310,15 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
     result.emplace(daq_.Acquire(req, abort_));
     (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
     watchdog_fault = watchdog.fault();
+    // From the check right before the relay closed through the watchdog's reads (a very
+    // short acquisition may end before the watchdog's first read).
+    double p_min = in.clamp_pressure_bar, p_max = in.clamp_pressure_bar;
+    if (const auto range = watchdog.pressure_range()) {
+      p_min = std::min(p_min, range->first);
+      p_max = std::max(p_max, range->second);
+    }
+    record.conditions["clamp_pressure_min_bar"] = p_min;
+    record.conditions["clamp_pressure_max_bar"] = p_max;
   }
   record.calibration = {{"shunt_ohm", daq_.calibration().shunt_ohm},
                         {"divider_ratio", daq_.calibration().divider_ratio},
@@ -335,6 +360,20 @@ void Sequencer::AnalyseAndJudge(db::TestRecord& record, const analysis::Recordin
   if (v.outcome == analysis::Outcome::kFail)
     record.reasons.insert(record.reasons.end(), mask_details.begin(), mask_details.end());
   record.measurements = v.measurements;
+
+  std::optional<double> r_ohm;
+  if (const auto it = values.find(std::string(analysis::names::kWindingROhm)); it != values.end())
+    r_ohm = it->second.value;
+  const std::vector<std::string> off = EvaluateConditions(
+      recipe_->conditions, recording, recipe_->transient_periods, r_ohm, record.conditions);
+  if (!off.empty() && recipe_->conditions.error_when_out) {
+    // The limits assume the recipe's conditions: the station did not measure this motor.
+    record.outcome = analysis::Outcome::kError;
+    std::vector<std::string> reasons;
+    for (const std::string& line : off) reasons.push_back("condition out of window: " + line);
+    reasons.insert(reasons.end(), record.reasons.begin(), record.reasons.end());
+    record.reasons = std::move(reasons);
+  }
 }
 
 void Sequencer::Unclamp(db::TestRecord& record) {
@@ -407,9 +446,24 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
   record.started_at = db::UtcNowIso8601();
   record.outcome = analysis::Outcome::kError;
   Enter(record, SeqState::kWaitSerial, "serial " + serial + " received");
+  const std::optional<std::string> master = MasterRole(options_.self_check, serial);
+  if (master) record.kind = "self_check";
 
   try {
-    const int max_tests = recipe_->max_tests_per_serial;
+    if (options_.self_check.enabled() && !master) {
+      const LockoutState lock =
+          EvaluateLockout(options_.self_check, store_, std::chrono::system_clock::now());
+      if (lock.locked) {
+        // Refused before anything moves; not a test of the motor, so nothing is stored.
+        record.reasons = {"station locked out: " + lock.reason};
+        board_.SetLockout(lock.ToJson());
+        Enter(record, SeqState::kPublish, "ERROR");
+        board_.OnVerdict(record);
+        Enter(record, SeqState::kWaitSerial);
+        return record;
+      }
+    }
+    const int max_tests = master ? 0 : recipe_->max_tests_per_serial;  // masters: no limit
     if (max_tests > 0) {
       const std::size_t earlier = store_.TestsOfSerial(serial).size();
       if (earlier >= static_cast<std::size_t>(max_tests)) {
@@ -450,9 +504,27 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
     record.reasons.insert(record.reasons.begin(), std::string("internal error: ") + e.what());
     SafeState(record);
   }
+  if (master) {
+    record.self_check = JudgeMasterTest(*master, record);
+    record.reasons.push_back(std::string(record.self_check["passed"].get<bool>()
+                                             ? "self-check passed: "
+                                             : "self-check failed: ") +
+                             record.self_check["detail"].get<std::string>());
+  }
   StoreAndPublish(record);
+  if (options_.self_check.enabled()) PublishLockout();
   Enter(record, SeqState::kWaitSerial);
   return record;
+}
+
+void Sequencer::PublishLockout() {
+  if (!options_.self_check.enabled()) return;
+  try {
+    board_.SetLockout(
+        EvaluateLockout(options_.self_check, store_, std::chrono::system_clock::now()).ToJson());
+  } catch (const std::exception& e) {
+    board_.SetLockout({{"locked", true}, {"reason", std::string("self-check state unknown: ") + e.what()}});
+  }
 }
 
 }  // namespace eol::station

@@ -70,6 +70,8 @@ struct SequencerOptions {
   SafetyOptions safety;
   // Called with the serial before the interlock check (the simulated operator loads a part).
   std::function<void(const std::string& serial)> on_serial;
+  // Self-checks with master parts and the lockout (station/self_check.h); off by default.
+  SelfCheckConfig self_check;
 };
 
 class Sequencer {
@@ -88,6 +90,9 @@ class Sequencer {
   // Between tests only (the caller guarantees no RunTest is in progress).
   void SetRecipe(std::shared_ptr<const Recipe> recipe);
   const Recipe& recipe() const { return *recipe_; }
+  // Re-reads the self-check state from the store and shows it on the board (GET /api/status).
+  // Between tests only; a no-op when self-checks are off.
+  void PublishLockout();
 
  private:
   struct Fault;

@@ -32,12 +32,14 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
   SequencerOptions opts;
   opts.station_id = config_.station_id;
   opts.safety = config_.safety;
+  opts.self_check = config_.self_check;
   if (drivers_.bench && drivers_.bench->settings().load_part_on_serial) {
     drivers::SimBench* bench = drivers_.bench.get();
     opts.on_serial = [bench](const std::string& serial) { bench->LoadPart(serial); };
   }
   sequencer_ = std::make_unique<Sequencer>(*drivers_.fixture, *drivers_.daq, *store_, recipe_,
                                            *board_, opts);
+  sequencer_->PublishLockout();  // a lockout survives a restart: it is read from the store
 }
 
 Station::~Station() {
@@ -165,9 +167,12 @@ void Station::Serve() {
       std::unique_lock<std::mutex> lock(queue_mu_);
       // Wakes at least every second to tell systemd's watchdog the loop is alive; a test that
       // hangs stops the pings and gets the daemon restarted.
+      int idle_s = 0;
       while (!queue_cv_.wait_for(lock, std::chrono::seconds(1),
-                                 [&] { return stop_ || !queue_.empty(); }))
+                                 [&] { return stop_ || !queue_.empty(); })) {
         NotifyWatchdog();
+        if (++idle_s % 60 == 0) sequencer_->PublishLockout();  // a check falls due with time
+      }
       NotifyWatchdog();
       if (stop_) return;
       serial = queue_.front();

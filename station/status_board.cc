@@ -69,6 +69,13 @@ void StatusBoard::SetMessage(const std::string& message) {
   PushEventLocked({{"type", "message"}, {"message", message}});
 }
 
+void StatusBoard::SetLockout(const nlohmann::json& lockout) {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (lockout == lockout_) return;
+  lockout_ = lockout;
+  PushEventLocked({{"type", "lockout"}, {"lockout", lockout}});
+}
+
 nlohmann::json StatusBoard::Snapshot() const {
   std::lock_guard<std::mutex> lock(mu_);
   return {{"station_id", station_id_},
@@ -79,7 +86,8 @@ nlohmann::json StatusBoard::Snapshot() const {
           {"recipe", {{"id", recipe_id_}, {"hash", recipe_hash_}}},
           {"counts", {{"pass", pass_}, {"fail", fail_}, {"error", error_}, {"aborted", aborted_}}},
           {"last", last_},
-          {"recent", recent_}};
+          {"recent", recent_},
+          {"lockout", lockout_}};
 }
 
 std::vector<std::pair<std::uint64_t, nlohmann::json>> StatusBoard::EventsAfter(

@@ -30,10 +30,13 @@ class StatusBoard {
   void SetRecipe(const std::string& recipe_id, const std::string& recipe_hash);
   // Free text for the operator ("locked out: ...", "fixture not answering").
   void SetMessage(const std::string& message);
+  // The self-check lockout (station/self_check.h LockoutState::ToJson): {"locked", "reason",
+  // "good", "limit", "tests_since_check"}; null while self-checks are off.
+  void SetLockout(const nlohmann::json& lockout);
 
   // {"station_id", "state", "serial", "detail", "message", "recipe": {...}, "counts": {...},
   //  "last": {serial, outcome, reasons, measurements, finished_at, id} | null,
-  //  "recent": [...]}
+  //  "recent": [...], "lockout": {...} | null}
   nlohmann::json Snapshot() const;
 
   // Events (state changes and verdicts) with increasing sequence numbers. Blocks up to
@@ -55,6 +58,7 @@ class StatusBoard {
   std::string detail_;
   std::string message_;
   nlohmann::json last_;  // null until the first verdict
+  nlohmann::json lockout_;  // null while self-checks are off
   std::deque<nlohmann::json> recent_;
   std::uint64_t pass_ = 0, fail_ = 0, error_ = 0, aborted_ = 0;
   std::deque<std::pair<std::uint64_t, nlohmann::json>> events_;

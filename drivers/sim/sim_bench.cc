@@ -36,7 +36,24 @@ std::optional<SimFault> ParseSimFault(const std::string& s) {
 SimBench::SimBench(SimBenchSettings settings) : settings_(std::move(settings)) {}
 
 void SimBench::LoadPart(const std::string& serial) {
-  LoadUnit(analysis::DrawUnit(settings_.population, serial));
+  analysis::SimUnit unit;
+  const SimMaster* master = nullptr;
+  for (const SimMaster& m : settings_.masters)
+    if (m.serial == serial) master = &m;
+  if (master) {
+    analysis::MotorPopulation nominal = settings_.population;
+    for (double* spread : {&nominal.spread_inertia, &nominal.spread_k_rotor,
+                           &nominal.spread_k_fixture, &nominal.spread_q, &nominal.spread_r,
+                           &nominal.spread_l, &nominal.spread_transmission})
+      *spread = 0.0;
+    unit = analysis::DrawUnit(nominal, serial, master->defective);
+  } else {
+    unit = analysis::DrawUnit(settings_.population, serial);
+  }
+  std::lock_guard<std::mutex> lock(mu_);
+  const double wear = settings_.fixture_wear_per_test * static_cast<double>(parts_loaded_++);
+  unit.rotor.k_fixture_nm_per_rad *= std::max(0.05, 1.0 - wear);
+  part_ = unit;
 }
 
 void SimBench::LoadUnit(const analysis::SimUnit& unit) {

@@ -13,11 +13,19 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "analysis/sim/population.h"
 #include "drivers/fixture/fixture.h"
 
 namespace eol::drivers {
+
+// A reference part kept at the station for self-checks: the population's nominal unit (no
+// production spread), good or with the soft magnet bond (station/self_check.h).
+struct SimMaster {
+  std::string serial;
+  bool defective = false;
+};
 
 struct SimBenchSettings {
   analysis::MotorPopulation population;
@@ -26,6 +34,10 @@ struct SimBenchSettings {
   double clamp_pressure_bar = 5.5;      // steady pressure when closed
   double heartbeat_period_s = 0.2;
   bool load_part_on_serial = true;      // the simulated operator loads a part per serial
+  std::vector<SimMaster> masters;       // LoadPart of one of these serials loads that master
+  // Fixture wear: each part loaded softens the fixture spring by this share of its new
+  // stiffness (k_fixture x (1 - wear n) after n parts, at least 5 %), which lowers f0 slowly.
+  double fixture_wear_per_test = 0.0;
 };
 
 enum class SimFault {
@@ -47,8 +59,8 @@ class SimBench {
 
   const SimBenchSettings& settings() const { return settings_; }
 
-  // The simulated operator puts a part in (drawn from the population by serial) and takes it
-  // out. A new part resets nothing else.
+  // The simulated operator puts a part in (drawn from the population by serial, or the master
+  // of that serial) and takes it out. A new part resets nothing else but wears the fixture.
   void LoadPart(const std::string& serial);
   void LoadUnit(const analysis::SimUnit& unit);
   void RemovePart();
@@ -83,6 +95,7 @@ class SimBench {
   SimBenchSettings settings_;
   mutable std::mutex mu_;
   std::optional<analysis::SimUnit> part_;
+  std::uint64_t parts_loaded_ = 0;
   bool clamp_cmd_ = false;
   Clock::time_point clamp_cmd_at_{};
   bool excitation_ = false;

@@ -156,8 +156,16 @@ async function showTest(id) {
   }
 }
 
+// Self-check lockout: production tests are refused until a master check passes.
+function renderLockout(lockout) {
+  const el = $("lockout");
+  el.hidden = !(lockout && lockout.locked);
+  el.textContent = el.hidden ? "" : "LOCKED OUT: " + lockout.reason;
+}
+
 async function refreshStatus() {
   const s = await getJson("/api/status");
+  renderLockout(s.lockout);
   $("station").textContent = "EOL station " + s.station_id;
   $("message").textContent = s.message || "";
   renderHistory(s);
@@ -193,6 +201,7 @@ async function main() {
     showTest(e.record.id);
     refreshStatus().catch(() => {});
   });
+  events.addEventListener("lockout", ev => { renderLockout(JSON.parse(ev.data).lockout); });
   events.addEventListener("message", ev => { $("message").textContent = JSON.parse(ev.data).message; });
 }
 

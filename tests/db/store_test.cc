@@ -165,7 +165,7 @@ TEST_F(StoreTest, OpenCreatesTheSchemaWithWalAndVersion) {
   EXPECT_EQ(raw.Column("PRAGMA user_version"),
             std::vector<std::string>{std::to_string(Store::kSchemaVersion)});
   EXPECT_EQ(raw.Column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
-            (std::vector<std::string>{"curves", "measurements", "recipe_audit", "tests"}));
+            (std::vector<std::string>{"curves", "measurements", "recipe_audit", "self_checks", "tests"}));
   const auto indexes = raw.Column("SELECT name FROM sqlite_schema WHERE type = 'index'");
   for (const char* name : {"tests_serial_started", "tests_started", "measurements_name"})
     EXPECT_NE(std::find(indexes.begin(), indexes.end(), name), indexes.end()) << name;
@@ -616,7 +616,8 @@ TEST_F(StoreMigrationTest, VersionOneFileMigratesToTwoKeepingItsTests) {
   }
   auto store = Store::Open(path.string());
   RawDb raw(path);
-  EXPECT_EQ(raw.Column("PRAGMA user_version"), std::vector<std::string>{"2"});
+  EXPECT_EQ(raw.Column("PRAGMA user_version"),
+            std::vector<std::string>{std::to_string(Store::kSchemaVersion)});
   EXPECT_EQ(store->TestsOfSerial("OLD-1").size(), 1u);
   EXPECT_TRUE(store->AuditLog().empty());
 }

@@ -1,0 +1,56 @@
+// The statistics report behind `eol stats` and GET /api/stats: the store's measurement rows
+// grouped per recipe (hash) and measurement, fed to analysis/qc/statistics.h.
+//
+//   capability (n, mean, sd, min, max, Cp, Cpk) over the production tests that measured the
+//     unit (PASS and FAIL; ERROR tests said nothing about the motor), against the limits the
+//     units were judged with (stored with each measurement);
+//   drift over the passing production tests in test order (a rejected defect is not a
+//     trend), with the alarm and its message;
+//   a type-1 gauge study when a serial is given: its PASS/FAIL tests (production or
+//     self-check) under the recipe of its newest test.
+// Self-check (master) tests never enter the production figures.
+//
+// {"window": {"from", "to", "recipe_hash"},
+//  "recipes": [{"recipe_id", "recipe_version", "recipe_hash", "tests", "outcomes": {...},
+//               "measurements": [{"name", "unit", "lo", "hi", "n", "mean", "sd", "min", "max",
+//                                 "cp", "cpk", "message", "drift": {...}}]}],
+//  "alarms": ["<recipe id> v<version>: drift alarm: ..."],
+//  "gauge": null | {"serial", "recipe_hash", "tests", "tolerance_share", "sigma_span",
+//                   "measurements": [{"name", "unit", "lo", "hi", "n", "mean", "sd",
+//                                     "tolerance", "cg", "cgk", "reference", "bias",
+//                                     "repeatable", "capable", "usable", "message"}]}}
+// Numbers that do not exist (Cp with a one-sided limit, Cgk without a reference) are null.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/qc/statistics.h"
+#include "db/store.h"
+
+namespace eol::station {
+
+struct StatsRequest {
+  std::optional<std::string> from;  // ISO 8601 on started_at, inclusive
+  std::optional<std::string> to;    // exclusive
+  std::optional<std::string> recipe_hash;
+  std::optional<std::string> gauge_serial;
+  std::map<std::string, double> reference;  // gauge reference value per measurement name
+  analysis::DriftOptions drift;
+  analysis::GaugeOptions gauge;
+};
+
+// Empty when valid; otherwise the reason naming the field.
+std::string ValidateStatsRequest(const StatsRequest& request);
+
+// Reads the store (throws db::StoreError).
+nlohmann::json StatsReport(db::Store& store, const StatsRequest& request);
+
+// "resonance_f_hz=390.2" -> {name, value}; false with the reason otherwise.
+bool ParseReference(const std::string& text, std::map<std::string, double>& into,
+                    std::string* why);
+
+}  // namespace eol::station
