@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   eol::station::cli::AddQueryCommand(app);
   eol::station::cli::AddExportCommand(app);
   eol::station::cli::AddSafetyBenchCommand(app);
+  eol::station::cli::AddCalibrateCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

@@ -8,6 +8,7 @@
 
 #include "analysis/impedance_analysis.h"
 #include "db/clock.h"
+#include "drivers/daq/calibration_file.h"
 #include "station/version.h"
 
 namespace eol::station {
@@ -295,11 +296,8 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
     (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
     watchdog_fault = watchdog.fault();
   }
-  record.calibration = {{"shunt_ohm", daq_.calibration().shunt_ohm},
-                        {"divider_ratio", daq_.calibration().divider_ratio},
-                        {"channel_delay_s", daq_.calibration().channel_delay_s},
-                        {"method", daq_.calibration().method},
-                        {"daq", daq_.name()}};
+  record.calibration = drivers::CalibrationToJson(daq_.calibration());
+  record.calibration["daq"] = daq_.name();
   if (watchdog_fault) throw Fault{analysis::Outcome::kError, *watchdog_fault};
   ThrowIfAborted();
   if (!result->ok())

@@ -18,5 +18,6 @@ void AddGapBenchCommand(CLI::App& app);
 void AddQueryCommand(CLI::App& app);
 void AddExportCommand(CLI::App& app);
 void AddSafetyBenchCommand(CLI::App& app);
+void AddCalibrateCommand(CLI::App& app);
 
 }  // namespace eol::station::cli
