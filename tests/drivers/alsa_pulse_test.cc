@@ -83,8 +83,8 @@ AlsaDaqSettings PulseSettings() {
   s.playback_device = "pulse:eol_null";
   s.capture_device = "pulse:eol_null.monitor";
   s.format = AlsaSampleFormat::kFloat;
-  s.period_frames = 1024;
-  s.buffer_periods = 4;
+  s.period_frames = 2048;  // 341 ms of buffer: no xrun from a loaded machine (ctest -j)
+  s.buffer_periods = 8;
   s.output_v_per_fs = 1.0;
   s.voltage_v_per_fs = 2.0;  // 1 V at the input reads 2 V
   s.current_v_per_fs = 0.5;  // 1 V across the shunt ...
@@ -185,8 +185,8 @@ TEST(AlsaPulse, StalledReaderIsReportedAsXrun) {
   PulseServer server;
   if (!server.ready()) GTEST_SKIP() << server.why_not();
   AlsaDaqSettings s = PulseSettings();
-  s.stall_after_frames = 9600;  // 0.2 s in, the reader sleeps for 1 s (buffer: 85 ms)
-  s.stall_s = 1.0;
+  s.stall_after_frames = 9600;  // 0.2 s in, the reader sleeps for 2 s (buffer: 341 ms)
+  s.stall_s = 2.0;
   AlsaDaq daq(s);
   ASSERT_TRUE(daq.Connect().ok());
   const analysis::Excitation ex = Multisine();
@@ -196,14 +196,14 @@ TEST(AlsaPulse, StalledReaderIsReportedAsXrun) {
   req.excitation_v = ex.Repeat(10);
   const std::atomic<bool> abort{false};
   const auto result = daq.Acquire(req, abort);
-  ASSERT_FALSE(result.ok()) << "a 1 s stall against an 85 ms buffer must not give a result";
+  ASSERT_FALSE(result.ok()) << "a 2 s stall against a 341 ms buffer must not give a result";
   const std::string& m = result.status().message();
   EXPECT_NE(m.find("xrun"), std::string::npos) << m;
   EXPECT_NE(m.find("'pulse:eol_null"), std::string::npos) << m;  // names the device
   EXPECT_NE(m.find("at frame "), std::string::npos) << m;
   EXPECT_NE(m.find("of 48000 frames"), std::string::npos) << m;
   std::printf("%s\n", m.c_str());
-  // The driver is in the error state; a new Connect recovers it and the next run is clean.
+  // The driver is in the error state until connected again.
   EXPECT_EQ(daq.lifecycle(), Lifecycle::kError);
 }
 
