@@ -15,18 +15,6 @@
 
 namespace eol::drivers {
 
-const char* ToString(AlsaSampleFormat f) {
-  switch (f) {
-    case AlsaSampleFormat::kS16:
-      return "S16_LE";
-    case AlsaSampleFormat::kS32:
-      return "S32_LE";
-    case AlsaSampleFormat::kFloat:
-      return "FLOAT_LE";
-  }
-  return "?";
-}
-
 namespace {
 
 constexpr unsigned kChannels = 2;
