@@ -106,8 +106,7 @@ ReferenceCalibrationSummary EstimateReferenceCalibration(
   s.usable = true;
   s.message = "gain " + std::to_string(s.gain) + " +- " + std::to_string(s.gain_sigma) +
               ", current channel delay " + std::to_string(s.delay_s * 1e6) + " +- " +
-              std::to_string(s.delay_sigma_s * 1e6) + " us over " + std::to_string(n) +
-              " lines";
+              std::to_string(s.delay_sigma_s * 1e6) + " us over " + std::to_string(n) + " lines";
   return s;
 }
 

@@ -54,8 +54,8 @@ class FrameBuffer {
         break;
       }
       case AlsaSampleFormat::kS32: {
-        const auto v = static_cast<std::int32_t>(
-            std::llround(std::clamp(x, -1.0, 1.0) * 2147483647.0));
+        const auto v =
+            static_cast<std::int32_t>(std::llround(std::clamp(x, -1.0, 1.0) * 2147483647.0));
         std::memcpy(&bytes_[i * 4], &v, 4);
         break;
       }
@@ -214,9 +214,10 @@ analysis::Recording AlsaDaq::DoAcquire(const AcquisitionRequest& req,
   const StreamGeometry cg = Configure(capture_, "capture", cdev, settings_, rate_hz);
   const bool linked = snd_pcm_link(capture_, playback_) == 0;
   if (!linked)
-    spdlog::warn("daq alsa: capture '{}' and playback '{}' cannot be linked; starting them "
-                 "one after the other",
-                 cdev, pdev);
+    spdlog::warn(
+        "daq alsa: capture '{}' and playback '{}' cannot be linked; starting them "
+        "one after the other",
+        cdev, pdev);
 
   FrameBuffer out(settings_.format, pg.buffer);
   FrameBuffer in(settings_.format, cg.period);
@@ -276,8 +277,8 @@ analysis::Recording AlsaDaq::DoAcquire(const AcquisitionRequest& req,
       }
       const snd_pcm_sframes_t avail = snd_pcm_avail_update(capture_);
       if (avail == -EPIPE || avail == -ESTRPIPE)
-        Xrun(avail == -EPIPE ? "overrun" : "suspend", "capture", cdev, captured, total,
-             "recorded", static_cast<int>(avail));
+        Xrun(avail == -EPIPE ? "overrun" : "suspend", "capture", cdev, captured, total, "recorded",
+             static_cast<int>(avail));
       if (avail > static_cast<snd_pcm_sframes_t>(cg.buffer))
         Xrun("overrun", "capture", cdev, captured, total, "recorded", -EPIPE);
       const std::size_t want = std::min<std::size_t>(cg.period, total - captured);
@@ -296,8 +297,8 @@ analysis::Recording AlsaDaq::DoAcquire(const AcquisitionRequest& req,
 
       const snd_pcm_sframes_t space = snd_pcm_avail_update(playback_);
       if (space == -EPIPE || space == -ESTRPIPE)
-        Xrun(space == -EPIPE ? "underrun" : "suspend", "playback", pdev, played, total,
-             "played", static_cast<int>(space));
+        Xrun(space == -EPIPE ? "underrun" : "suspend", "playback", pdev, played, total, "played",
+             static_cast<int>(space));
       if (space < 0) Fail("avail", "playback", pdev, static_cast<int>(space));
       if (space > 0) fill(std::min<std::size_t>(static_cast<std::size_t>(space), pg.buffer));
     }

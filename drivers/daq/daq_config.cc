@@ -21,8 +21,8 @@ const char* ToString(AlsaSampleFormat f) {
 
 namespace {
 
-std::size_t Count(const JsonObject& o, const std::string& key, std::size_t fallback,
-                  std::size_t lo, std::size_t hi) {
+std::size_t Count(const JsonObject& o, const std::string& key, std::size_t fallback, std::size_t lo,
+                  std::size_t hi) {
   const int v = o.Integer(key, static_cast<int>(fallback));
   o.Require(v >= static_cast<int>(lo) && v <= static_cast<int>(hi), key,
             "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
@@ -69,8 +69,8 @@ AlsaDaqSettings ParseAlsaDaqSettings(const JsonObject& o) {
 
 ReplayDaqSettings ParseReplayDaqSettings(const JsonObject& o) {
   ReplayDaqSettings s;
-  const int sources = (o.Has("files") ? 1 : 0) + (o.Has("directory") ? 1 : 0) +
-                      (o.Has("file") ? 1 : 0);
+  const int sources =
+      (o.Has("files") ? 1 : 0) + (o.Has("directory") ? 1 : 0) + (o.Has("file") ? 1 : 0);
   if (sources != 1)
     throw ConfigError(o.path() + ": give exactly one of \"files\", \"directory\" or \"file\"");
   if (o.Has("files")) {

@@ -48,8 +48,7 @@ analysis::Recording SimDaq::DoAcquire(const AcquisitionRequest& req,
   // The motor in the bench circuit (open circuit when no part): one steady-state period, or
   // the time-domain simulator run chunk by chunk below.
   const bool reference = settings_.load == SimLoad::kReferenceResistor;
-  const std::optional<analysis::SimUnit> part =
-      reference ? std::nullopt : bench_->part();
+  const std::optional<analysis::SimUnit> part = reference ? std::nullopt : bench_->part();
   const analysis::BenchCircuit circuit{settings_.amplifier_output_ohm,
                                        settings_.calibration.shunt_ohm};
   analysis::ChannelSamples steady;

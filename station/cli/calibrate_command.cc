@@ -32,7 +32,8 @@ struct CalibrateArgs {
 };
 
 // Connects, closes the excitation relay while the interlocks hold, acquires, opens it again.
-analysis::Recording AcquireReference(drivers::DriverSet& d, const drivers::AcquisitionRequest& req) {
+analysis::Recording AcquireReference(drivers::DriverSet& d,
+                                     const drivers::AcquisitionRequest& req) {
   if (drivers::Status s = d.fixture->Connect(); !s.ok()) throw std::runtime_error(s.message());
   if (drivers::Status s = d.fixture->Activate(); !s.ok()) throw std::runtime_error(s.message());
   if (drivers::Status s = d.daq->Connect(); !s.ok()) throw std::runtime_error(s.message());

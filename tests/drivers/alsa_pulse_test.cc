@@ -87,8 +87,8 @@ AlsaDaqSettings PulseSettings() {
   s.period_frames = 2048;  // 341 ms of buffer: no xrun from a loaded machine (ctest -j)
   s.buffer_periods = 8;
   s.output_v_per_fs = 1.0;
-  s.voltage_v_per_fs = 2.0;  // 1 V at the input reads 2 V
-  s.current_v_per_fs = 0.5;  // 1 V across the shunt ...
+  s.voltage_v_per_fs = 2.0;        // 1 V at the input reads 2 V
+  s.current_v_per_fs = 0.5;        // 1 V across the shunt ...
   s.calibration.shunt_ohm = 0.25;  // ... is 0.5 V / 0.25 ohm = 2 A
   return s;
 }
@@ -163,8 +163,7 @@ TEST(AlsaPulse, PlayedMultisineComesBackOnBothChannels) {
   const std::size_t start = silent_periods * ex.period_samples;
   const Match u = FindPlayed(req.excitation_v, start, rec.voltage_v, compare);
   const Match i = FindPlayed(req.excitation_v, start, rec.current_a, compare);
-  const double delay_ms =
-      1e3 * (static_cast<double>(u.lag) - static_cast<double>(start)) / kRateHz;
+  const double delay_ms = 1e3 * (static_cast<double>(u.lag) - static_cast<double>(start)) / kRateHz;
   std::printf("pulse round trip: delay %.2f ms, correlation u %.6f i %.6f, gain u %.4f i %.4f\n",
               delay_ms, u.correlation, i.correlation, u.gain, i.gain);
   ASSERT_GT(u.correlation, 0.0) << "the played signal never came back";
@@ -173,7 +172,8 @@ TEST(AlsaPulse, PlayedMultisineComesBackOnBothChannels) {
   // signal earlier than its place in the playback stream, by up to the buffer.)
   ASSERT_GT(u.lag, 10u);
   double before = 0.0;
-  for (std::size_t k = 0; k + 10 < u.lag; ++k) before = std::max(before, std::abs(rec.voltage_v[k]));
+  for (std::size_t k = 0; k + 10 < u.lag; ++k)
+    before = std::max(before, std::abs(rec.voltage_v[k]));
   EXPECT_LT(before, 1e-3) << "signal before the multisine's onset";
   EXPECT_GT(u.correlation, 0.999);
   EXPECT_GT(i.correlation, 0.999);

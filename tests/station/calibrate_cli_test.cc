@@ -2,8 +2,8 @@
 // the fixture and injected channel errors (gain 1.03 on the voltage channel, the current
 // channel 20 us late): the written calibration recovers both within three of its sigmas and
 // corrects the shunt; a wrong --reference-ohm writes nothing and says why. The station config
-// then names the file (relative to the config) and the DAQ reports the measured calibration,
-// which is what every test record stores.
+// then names the file (relative to the config): the DAQ reports the measured calibration and
+// a test the station runs stores it (method, date, R_ref) in its record.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -12,6 +12,7 @@
 #include "drivers/daq/calibration_file.h"
 #include "drivers/factory.h"
 #include "station/config.h"
+#include "station/station.h"
 
 namespace eol {
 namespace {
@@ -77,8 +78,7 @@ TEST(CalibrateCli, RecoversInjectedGainAndDelayWithinThreeSigma) {
   EXPECT_EQ(j["method"], "reference_resistor");
   EXPECT_EQ(j["reference_ohm"], 2.0);
   const std::string date = j["date"];  // UTC ISO 8601: 2026-11-22T07:30:00.123Z
-  EXPECT_TRUE(date.size() >= 20 && date[4] == '-' && date[10] == 'T' && date.back() == 'Z')
-      << date;
+  EXPECT_TRUE(date.size() >= 20 && date[4] == '-' && date[10] == 'T' && date.back() == 'Z') << date;
 
   // The station config names the file, relative to itself: the DAQ reports it.
   nlohmann::json daq = {{"driver", "sim"}, {"calibration_file", "calibration.json"}};
@@ -90,10 +90,15 @@ TEST(CalibrateCli, RecoversInjectedGainAndDelayWithinThreeSigma) {
   EXPECT_EQ(c.date, j["date"].get<std::string>());
   EXPECT_DOUBLE_EQ(c.reference_ohm, 2.0);
   EXPECT_DOUBLE_EQ(c.shunt_ohm, j["shunt_ohm"].get<double>());
-  const nlohmann::json stored = drivers::CalibrationToJson(c);  // what the sequencer stores
-  EXPECT_EQ(stored["method"], "reference_resistor");
-  EXPECT_EQ(stored["reference_ohm"], 2.0);
-  EXPECT_EQ(stored["date"], j["date"]);
+
+  // A test run by the station stores it in the record.
+  station::Station st(config);
+  const db::TestRecord record = st.RunTest("SN-CAL-1");
+  EXPECT_EQ(record.calibration["method"], "reference_resistor") << record.calibration.dump();
+  EXPECT_EQ(record.calibration["reference_ohm"], 2.0);
+  EXPECT_EQ(record.calibration["date"], j["date"]);
+  EXPECT_EQ(record.calibration["shunt_ohm"], j["shunt_ohm"]);
+  EXPECT_EQ(record.calibration["daq"], "sim");
 }
 
 TEST(CalibrateCli, WrongReferenceWritesNothing) {

@@ -45,7 +45,8 @@ struct Fixture {
     return std::move(set.daq);
   }
   double F0(const analysis::Recording& rec) {
-    const analysis::ImpedanceAnalysis a = analysis::AnalyzeRecording(rec, ex.lines, recipe.analysis);
+    const analysis::ImpedanceAnalysis a =
+        analysis::AnalyzeRecording(rec, ex.lines, recipe.analysis);
     EXPECT_TRUE(a.usable) << a.message;
     const analysis::FittedParameter* f0 = a.fit.Find("f0_hz");
     return f0 ? f0->value : std::nan("");
@@ -76,8 +77,7 @@ TEST(ReplayDaq, SimulatedRecordingRoundTripsToTheSameF0) {
   EXPECT_NEAR(fx.F0(b.value()), f0_direct, 1.0);
   auto c = daq->Acquire(fx.req, abort);
   ASSERT_FALSE(c.ok());
-  EXPECT_NE(c.status().message().find("no more recordings: all 2 were replayed"),
-            std::string::npos)
+  EXPECT_NE(c.status().message().find("no more recordings: all 2 were replayed"), std::string::npos)
       << c.status().message();
 
   // WAV (32-bit float, gains 10 V and 2 A per full scale) through a directory listing.
@@ -104,8 +104,7 @@ TEST(ReplayDaq, RepeatsOneFileAndRefusesMisfits) {
   longer.excitation_v = fx.ex.Repeat(fx.recipe.transient_periods + fx.recipe.periods + 1);
   auto r = daq->Acquire(longer, abort);
   ASSERT_FALSE(r.ok());
-  EXPECT_NE(r.status().message().find("recording " + (fx.dir / "a.csv") + ": "),
-            std::string::npos)
+  EXPECT_NE(r.status().message().find("recording " + (fx.dir / "a.csv") + ": "), std::string::npos)
       << r.status().message();
   EXPECT_NE(r.status().message().find("samples, the excitation has"), std::string::npos);
 
