@@ -1,5 +1,8 @@
 #include "drivers/factory.h"
 
+#include "drivers/daq/calibration_file.h"
+#include "drivers/daq/daq_config.h"
+
 #include "drivers/fixture/modbus_fixture.h"
 #include "drivers/fixture/sim_fixture.h"
 
@@ -82,6 +85,7 @@ SimDaqSettings ParseSimDaqSettings(const JsonObject& o) {
   const std::string relay = o.String("relay", "bench");
   o.Require(relay == "bench" || relay == "external", "relay", "must be \"bench\" or \"external\"");
   s.relay_external = relay == "external";
+  ParseSimCalibrationLoad(o, s);
   o.Require(s.time_scale >= 0.0, "time_scale", "must not be negative");
   o.Require(s.voltage_noise_v >= 0.0, "voltage_noise_v", "must not be negative");
   o.Require(s.current_noise_a >= 0.0, "current_noise_a", "must not be negative");
@@ -91,7 +95,8 @@ SimDaqSettings ParseSimDaqSettings(const JsonObject& o) {
   return s;
 }
 
-DriverSet MakeDrivers(const nlohmann::json& station_config, std::shared_ptr<SimBench> bench) {
+DriverSet MakeDrivers(const nlohmann::json& station_config, std::shared_ptr<SimBench> bench,
+                      RecordingFileReader read_recording) {
   const JsonObject root(station_config, "");
   const JsonObject fixture = root.Object("fixture");
   const JsonObject daq = root.Object("daq");
@@ -123,9 +128,19 @@ DriverSet MakeDrivers(const nlohmann::json& station_config, std::shared_ptr<SimB
 
   if (daq_driver == "sim") {
     set.daq = std::make_unique<SimDaq>(set.bench, ParseSimDaqSettings(daq));
+  } else if (daq_driver == "alsa") {
+    const AlsaDaqSettings alsa = ParseAlsaDaqSettings(daq);
+#if EOL_WITH_ALSA
+    set.daq = std::make_unique<AlsaDaq>(alsa);
+#else
+    throw ConfigError(daq.PathOf("driver") +
+                      ": the alsa driver was not compiled in (configure with -DEOL_WITH_ALSA=ON)");
+#endif
+  } else if (daq_driver == "replay") {
+    set.daq = std::make_unique<ReplayDaq>(ParseReplayDaqSettings(daq), std::move(read_recording));
   } else {
     throw ConfigError(daq.PathOf("driver") + ": unknown daq driver '" + daq_driver +
-                      "' (known: sim)");
+                      "' (known: sim, alsa, replay)");
   }
   return set;
 }

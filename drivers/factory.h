@@ -8,6 +8,11 @@
 //   "daq":     {"driver": "sim", "model": "steady_state" | "time_domain",
 //               "amplifier_output_ohm": 0, "time_scale": 0, "voltage_noise_v": 0.002, ...}
 //                                                   the simulated acquisition (sim_daq.h)
+//   "daq":     {"driver": "alsa", "playback": "default", "capture": "default", ...}
+//                                                   a sound interface (alsa_daq.h)
+//   "daq":     {"driver": "replay", "files": [...] | "directory": "..." | "file": "..."}
+//                                                   recordings from files (replay_daq.h)
+//              keys of these and the calibration: daq/daq_config.h
 //   "sim":     {"population": {...}, "clamp_close_s": 0.15, ...,   the simulated bench
 //               "masters": [{"serial": "MASTER-G"}, {"serial": "MASTER-L", "defective": true}],
 //               "fixture_wear_per_test": 0.001}                    (sim_bench.h)
@@ -21,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drivers/daq/daq.h"
+#include "drivers/daq/replay_daq.h"
 #include "drivers/daq/sim_daq.h"
 #include "drivers/fixture/fixture.h"
 #include "drivers/json_config.h"
@@ -37,8 +43,10 @@ struct DriverSet {
 // `station_config` is the whole station config; its "fixture", "daq" and optional "sim"
 // objects are read. Throws ConfigError. A given `bench` is used by the sim drivers instead of
 // a new one: the demo shares one bench between the sim DAQ and the Modbus fixture emulator.
+// `read_recording` reads the replay driver's files (the station passes its file readers).
 DriverSet MakeDrivers(const nlohmann::json& station_config,
-                      std::shared_ptr<SimBench> bench = nullptr);
+                      std::shared_ptr<SimBench> bench = nullptr,
+                      RecordingFileReader read_recording = nullptr);
 
 SimBenchSettings ParseSimBenchSettings(const JsonObject& sim);
 analysis::MotorPopulation ParsePopulation(const JsonObject& population);

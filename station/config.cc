@@ -83,6 +83,15 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
     // The driver sections are validated by drivers::MakeDrivers; mark them known here.
     c.drivers["fixture"] = root.Raw("fixture");
     c.drivers["daq"] = root.Raw("daq");
+    // The daq's files (calibration, replayed recordings) are relative to this file too.
+    if (nlohmann::json& daq = c.drivers["daq"]; daq.is_object()) {
+      for (const char* key : {"calibration_file", "directory", "file"})
+        if (daq.contains(key) && daq[key].is_string())
+          daq[key] = Resolve(base_dir, daq[key].get<std::string>());
+      if (daq.contains("files") && daq["files"].is_array())
+        for (auto& f : daq["files"])
+          if (f.is_string()) f = Resolve(base_dir, f.get<std::string>());
+    }
     if (root.Has("sim")) c.drivers["sim"] = root.Raw("sim");
     root.RejectUnknown();
     return c;

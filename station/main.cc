@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   eol::station::cli::AddExportCommand(app);
   eol::station::cli::AddSafetyBenchCommand(app);
   eol::station::cli::AddStatsCommand(app);
+  eol::station::cli::AddCalibrateCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

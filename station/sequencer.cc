@@ -10,6 +10,7 @@
 #include "analysis/impedance_analysis.h"
 #include "analysis/qc/measurement_names.h"
 #include "db/clock.h"
+#include "drivers/daq/calibration_file.h"
 #include "station/self_check.h"
 #include "station/version.h"
 
@@ -320,11 +321,8 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
     record.conditions["clamp_pressure_min_bar"] = p_min;
     record.conditions["clamp_pressure_max_bar"] = p_max;
   }
-  record.calibration = {{"shunt_ohm", daq_.calibration().shunt_ohm},
-                        {"divider_ratio", daq_.calibration().divider_ratio},
-                        {"channel_delay_s", daq_.calibration().channel_delay_s},
-                        {"method", daq_.calibration().method},
-                        {"daq", daq_.name()}};
+  record.calibration = drivers::CalibrationToJson(daq_.calibration());
+  record.calibration["daq"] = daq_.name();
   if (watchdog_fault) throw Fault{analysis::Outcome::kError, *watchdog_fault};
   ThrowIfAborted();
   if (!result->ok())

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "db/clock.h"
+#include "station/files/recording_files.h"
 #include "station/systemd_notify.h"
 
 namespace eol::station {
@@ -19,7 +20,7 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
   if (store_->aborted_on_open() > 0)
     spdlog::warn("store {}: {} test(s) interrupted by a previous stop recorded as ABORTED",
                  config_.db_path, store_->aborted_on_open());
-  drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench));
+  drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench), files::ReadRecordingFile);
   board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_->id, recipe_->hash);
   if (const drivers::Status s = drivers_.fixture->Connect(); !s.ok()) {
     spdlog::error("{} (will retry at the next test)", s.message());

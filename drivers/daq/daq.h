@@ -20,6 +20,10 @@ struct Calibration {
   double divider_ratio = 1.0;     // voltage channel: phase volts per channel volt
   double channel_delay_s = 0.0;   // current channel lags voltage channel by this much
   std::string method = "nominal";  // "nominal", or how it was measured (reference resistor)
+  // Set by a measured calibration (method "reference_resistor", calibration_file.h): when it
+  // was measured (ISO 8601 UTC) and the reference resistor it was measured with.
+  std::string date;
+  double reference_ohm = 0.0;
 };
 
 struct AcquisitionRequest {

@@ -2,10 +2,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <complex>
+#include <optional>
 #include <random>
 #include <thread>
 
 #include "analysis/sim/bench_circuit.h"
+#include "analysis/signal/reference_calibration.h"
 #include "analysis/sim/time_domain.h"
 
 namespace eol::drivers {
@@ -16,6 +20,16 @@ const char* ToString(SimMotorModel m) {
       return "steady_state";
     case SimMotorModel::kTimeDomain:
       return "time_domain";
+  }
+  return "?";
+}
+
+const char* ToString(SimLoad l) {
+  switch (l) {
+    case SimLoad::kFixturePart:
+      return "fixture_part";
+    case SimLoad::kReferenceResistor:
+      return "reference_resistor";
   }
   return "?";
 }
@@ -33,12 +47,19 @@ analysis::Recording SimDaq::DoAcquire(const AcquisitionRequest& req,
 
   // The motor in the bench circuit (open circuit when no part): one steady-state period, or
   // the time-domain simulator run chunk by chunk below.
-  const auto part = bench_->part();
+  const bool reference = settings_.load == SimLoad::kReferenceResistor;
+  const std::optional<analysis::SimUnit> part = reference ? std::nullopt : bench_->part();
   const analysis::BenchCircuit circuit{settings_.amplifier_output_ohm,
                                        settings_.calibration.shunt_ohm};
   analysis::ChannelSamples steady;
   std::unique_ptr<analysis::TimeDomainSimulator> sim;
-  if (part && settings_.model == SimMotorModel::kSteadyState) {
+  if (reference) {
+    const double r_ohm = settings_.reference_ohm;
+    const std::vector<double> u_period(req.excitation_v.begin(),
+                                       req.excitation_v.begin() + static_cast<long>(period));
+    steady = analysis::SteadyStatePeriod([r_ohm](double) { return std::complex<double>(r_ohm); },
+                                         circuit, u_period, req.sample_rate_hz);
+  } else if (part && settings_.model == SimMotorModel::kSteadyState) {
     const analysis::MotionalImpedance z = part->Electrical();
     const std::vector<double> u_period(req.excitation_v.begin(),
                                        req.excitation_v.begin() + static_cast<long>(period));
@@ -52,6 +73,7 @@ analysis::Recording SimDaq::DoAcquire(const AcquisitionRequest& req,
     options.circuit = circuit;
     sim = std::make_unique<analysis::TimeDomainSimulator>(motor, options);
   }
+  analysis::DelayPeriodic(steady.current_a, settings_.injected_channel_delay_s, req.sample_rate_hz);
   std::vector<double> u_motor, i_motor;
 
   std::mt19937_64 rng(settings_.seed + 1000003ULL * ++acquisitions_);
@@ -77,7 +99,7 @@ analysis::Recording SimDaq::DoAcquire(const AcquisitionRequest& req,
     const std::size_t last = std::min(total, first + chunk);
     u_motor.assign(last - first, 0.0);
     i_motor.assign(last - first, 0.0);
-    if (connected && !part) {  // open circuit: the amplifier's voltage, no current
+    if (connected && !part && !reference) {  // open circuit: the amplifier's voltage, no current
       std::copy(req.excitation_v.begin() + static_cast<long>(first),
                 req.excitation_v.begin() + static_cast<long>(last), u_motor.begin());
     } else if (connected && sim) {
@@ -91,7 +113,7 @@ analysis::Recording SimDaq::DoAcquire(const AcquisitionRequest& req,
       sim->Reset();  // relay open: the motor rests until it closes again
     }
     for (std::size_t t = first; t < last; ++t) {
-      const double u = u_motor[t - first];
+      const double u = settings_.injected_gain * u_motor[t - first];
       const double i = i_motor[t - first];
       rec.voltage_v[t] =
           std::clamp(u + vn(rng), -settings_.voltage_full_scale_v, settings_.voltage_full_scale_v);

@@ -14,6 +14,13 @@
 // the time-domain motor restarts from rest when it closes, so a sequencer that forgets to enable
 // the relay, or a watchdog that cuts it, is visible in the data. Pacing: time_scale 1 plays
 // in real time, 0 as fast as the machine computes.
+//
+// Load "reference_resistor" (calibration, analysis/signal/reference_calibration.h): a resistor
+// of reference_ohm sits in the fixture instead of the part (its steady state, whatever the
+// model). The acquisition's own errors can be injected, so that a calibration has something to
+// find: the voltage channel reads injected_gain * u and the current channel reads
+// i(t - injected_channel_delay_s) (a periodic fractional delay of the steady-state period;
+// the time_domain model takes no delay).
 #pragma once
 
 #include <cstdint>
@@ -26,6 +33,8 @@ namespace eol::drivers {
 
 enum class SimMotorModel { kSteadyState, kTimeDomain };
 const char* ToString(SimMotorModel m);
+enum class SimLoad { kFixturePart, kReferenceResistor };
+const char* ToString(SimLoad l);
 
 struct SimDaqSettings {
   SimMotorModel model = SimMotorModel::kSteadyState;
@@ -42,6 +51,10 @@ struct SimDaqSettings {
   bool relay_external = false;
   std::uint64_t seed = 7;
   Calibration calibration;
+  SimLoad load = SimLoad::kFixturePart;
+  double reference_ohm = 1.0;             // the resistor of SimLoad::kReferenceResistor
+  double injected_gain = 1.0;             // voltage channel reads injected_gain * u
+  double injected_channel_delay_s = 0.0;  // current channel reads i(t - delay)
 };
 
 class SimDaq final : public Daq {

@@ -19,5 +19,6 @@ void AddQueryCommand(CLI::App& app);
 void AddExportCommand(CLI::App& app);
 void AddSafetyBenchCommand(CLI::App& app);
 void AddStatsCommand(CLI::App& app);
+void AddCalibrateCommand(CLI::App& app);
 
 }  // namespace eol::station::cli

@@ -2,6 +2,7 @@
 
 #include <sndfile.h>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <locale>
@@ -115,6 +116,14 @@ void WriteWavRecording(const std::string& path, const analysis::Recording& rec,
   const auto n = static_cast<sf_count_t>(rec.voltage_v.size());
   if (sf_writef_double(f.get(), frames.data(), n) != n)
     throw FileError(path, 0, 0, std::string("write failed: ") + sf_strerror(f.get()));
+}
+
+analysis::Recording ReadRecordingFile(const std::string& path, double voltage_gain_v,
+                                      double current_gain_a) {
+  std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".wav") return ReadWavRecording(path, voltage_gain_v, current_gain_a);
+  return ReadRecordingCsv(path);
 }
 
 }  // namespace eol::station::files

@@ -31,4 +31,9 @@ analysis::Recording ReadWavRecording(const std::string& path, double voltage_gai
 void WriteWavRecording(const std::string& path, const analysis::Recording& recording,
                        double voltage_gain_v, double current_gain_a);
 
+// By extension: *.wav (any case) with the gains, anything else as a recording CSV (the gains
+// unused). The replay acquisition driver reads its files through this.
+analysis::Recording ReadRecordingFile(const std::string& path, double voltage_gain_v,
+                                      double current_gain_a);
+
 }  // namespace eol::station::files

@@ -1,0 +1,66 @@
+#include "drivers/daq/replay_daq.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+
+namespace eol::drivers {
+
+ReplayDaq::ReplayDaq(ReplayDaqSettings settings, RecordingFileReader reader)
+    : Daq("replay"), settings_(std::move(settings)), reader_(std::move(reader)) {}
+
+void ReplayDaq::DoConnect() {
+  namespace fs = std::filesystem;
+  if (!reader_) throw DeviceError("no recording file reader was given to the replay driver");
+  files_ = settings_.files;
+  if (!settings_.directory.empty()) {
+    std::error_code ec;
+    if (!fs::is_directory(settings_.directory, ec))
+      throw DeviceError("directory " + settings_.directory + ": not a readable directory");
+    files_.clear();
+    for (const auto& entry : fs::directory_iterator(settings_.directory, ec)) {
+      const std::string ext = entry.path().extension().string();
+      if (entry.is_regular_file() && (ext == ".csv" || ext == ".wav"))
+        files_.push_back(entry.path().string());
+    }
+    if (ec) throw DeviceError("directory " + settings_.directory + ": " + ec.message());
+    std::sort(files_.begin(), files_.end());
+    if (files_.empty())
+      throw DeviceError("directory " + settings_.directory + ": no *.csv or *.wav recordings");
+  }
+  if (files_.empty()) throw DeviceError("no recording files configured");
+  for (const std::string& f : files_) {
+    std::error_code ec;
+    if (!fs::is_regular_file(f, ec)) throw DeviceError("recording " + f + ": no such file");
+  }
+  next_ = 0;
+}
+
+analysis::Recording ReplayDaq::DoAcquire(const AcquisitionRequest& req,
+                                         const std::atomic<bool>& abort) {
+  if (abort.load()) throw AcquisitionAborted();
+  if (!settings_.repeat && next_ >= files_.size())
+    throw DeviceError("no more recordings: all " + std::to_string(files_.size()) +
+                      " were replayed");
+  const std::string& path = settings_.repeat ? files_.front() : files_[next_];
+  analysis::Recording rec;
+  try {
+    rec = reader_(path, settings_.voltage_v_per_fs, settings_.current_a_per_fs);
+  } catch (const std::exception& e) {
+    throw DeviceError(std::string("recording ") + e.what());
+  }
+  if (!settings_.repeat) ++next_;
+  if (!(std::abs(rec.sample_rate_hz - req.sample_rate_hz) <= 1e-6 * req.sample_rate_hz))
+    throw DeviceError("recording " + path + ": sample rate " + std::to_string(rec.sample_rate_hz) +
+                      " Hz, the excitation needs " + std::to_string(req.sample_rate_hz) + " Hz");
+  if (rec.voltage_v.size() != req.excitation_v.size() ||
+      rec.current_a.size() != req.excitation_v.size())
+    throw DeviceError("recording " + path + ": " + std::to_string(rec.voltage_v.size()) +
+                      " samples, the excitation has " + std::to_string(req.excitation_v.size()));
+  rec.sample_rate_hz = req.sample_rate_hz;
+  rec.period_samples = req.period_samples;
+  return rec;
+}
+
+}  // namespace eol::drivers
