@@ -18,5 +18,8 @@ void AddGapBenchCommand(CLI::App& app);
 void AddQueryCommand(CLI::App& app);
 void AddExportCommand(CLI::App& app);
 void AddSafetyBenchCommand(CLI::App& app);
+void AddTeachCommand(CLI::App& app);
+void AddDetectabilityCommand(CLI::App& app);
+void AddProductionBenchCommand(CLI::App& app);
 
 }  // namespace eol::station::cli
