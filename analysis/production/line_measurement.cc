@@ -1,7 +1,7 @@
 #include "analysis/production/line_measurement.h"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "analysis/signal/fft.h"

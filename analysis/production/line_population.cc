@@ -65,16 +65,17 @@ bool LineSpread::IsValid(std::string* why) const {
     if (why) *why = m;
     return false;
   };
-  for (double s : {magnet_inertia, bond_stiffness, bond_damping, bridge_stiffness, hub_inertia,
-                   shaft_stiffness, fixture_damping, fixture_wear, spread_r, spread_l,
-                   spread_transmission})
+  for (double s :
+       {magnet_inertia, bond_stiffness, bond_damping, bridge_stiffness, hub_inertia,
+        shaft_stiffness, fixture_damping, fixture_wear, spread_r, spread_l, spread_transmission})
     if (!(s >= 0.0 && s < 0.3)) return fail("every relative spread must be in [0, 0.3)");
   if (!(clamp_pressure_lo_bar > 0.0 && clamp_pressure_hi_bar > clamp_pressure_lo_bar))
     return fail("clamp pressure window must be positive and increasing");
   if (!(clamp_pressure_sd_bar >= 0.0)) return fail("clamp_pressure_sd_bar must not be negative");
   if (!(r_ohm > 0.0 && l_h > 0.0 && transmission_nm_per_a > 0.0))
     return fail("r_ohm, l_h and transmission_nm_per_a must be positive");
-  if (!(temperature_hi_c >= temperature_lo_c)) return fail("temperature_hi_c below temperature_lo_c");
+  if (!(temperature_hi_c >= temperature_lo_c))
+    return fail("temperature_hi_c below temperature_lo_c");
   if (!(weak_fraction_lo > 0.0 && weak_fraction_hi >= weak_fraction_lo && weak_fraction_hi <= 1.0))
     return fail("weak bond fractions must satisfy 0 < lo <= hi <= 1");
   return true;
@@ -130,9 +131,8 @@ LineUnit DrawLineUnit(const RotorChainParams& p, const LineSpread& s, DefectClas
   std::vector<bool> soft(static_cast<std::size_t>(n), false);
   for (int i = 0; i < SoftCount(defect, n); ++i)
     soft[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])] = true;
-  const double weak = defect == DefectClass::kWeakBonds
-                          ? r.Uniform(s.weak_fraction_lo, s.weak_fraction_hi)
-                          : 1.0;
+  const double weak =
+      defect == DefectClass::kWeakBonds ? r.Uniform(s.weak_fraction_lo, s.weak_fraction_hi) : 1.0;
 
   TorsionalChain& chain = unit.motor.chain;
   std::vector<int> magnet, pole;

@@ -86,8 +86,8 @@ struct LineUnit {
 LineUnit DrawLineUnit(const RotorChainParams& nominal, const LineSpread& spread,
                       const DefectRates& rates, std::uint64_t seed, std::uint64_t index);
 // The same with the class forced.
-LineUnit DrawLineUnit(const RotorChainParams& nominal, const LineSpread& spread,
-                      DefectClass defect, std::uint64_t seed, std::uint64_t index);
+LineUnit DrawLineUnit(const RotorChainParams& nominal, const LineSpread& spread, DefectClass defect,
+                      std::uint64_t seed, std::uint64_t index);
 
 // Nominal rotor (no spread) with a defect: soft magnets 0..n-1 (n from the class), or every
 // bond at bond_fraction of the good one for kWeakBonds. Fixture as given in `nominal`.

@@ -34,8 +34,8 @@ struct Measured {
 Measured MeasureUnit(const ProductionBenchOptions& o, const LineMeasurementSetup& setup,
                      const LineUnit& unit, std::uint64_t index) {
   Measured m;
-  m.frf = MeasureLineUnit(setup, ModalImpedance(unit.motor, setup.freq_hz),
-                          NoiseSeed(o.seed, index));
+  m.frf =
+      MeasureLineUnit(setup, ModalImpedance(unit.motor, setup.freq_hz), NoiseSeed(o.seed, index));
   m.analysis = AnalyzeImpedance(m.frf, o.fit);
   return m;
 }
@@ -152,8 +152,7 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
   for (std::size_t i = 0; i < golden.size(); ++i)
     if (golden_ok[i]) usable_golden.push_back(std::move(golden[i]));
   s.teach = TeachLimits(o.declared, usable_golden, o.teach);
-  s.golden_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.golden_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!s.teach.usable) {
     s.message = "teaching failed: " + s.teach.message;
     return s;

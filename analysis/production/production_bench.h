@@ -37,9 +37,9 @@ struct ProductionBenchOptions {
   std::size_t periods = 4;
   double voltage_noise_v = 2.0e-3;  // the simulated DAQ's, rms per sample
   double current_noise_a = 1.0e-3;
-  ResonanceFitOptions fit;                    // the recipe's analysis options
-  std::vector<MeasurementSpec> declared;      // the recipe's scalar limits
-  std::vector<CurveMask> recipe_masks;        // the recipe's masks (the "recipe" rule)
+  ResonanceFitOptions fit;                // the recipe's analysis options
+  std::vector<MeasurementSpec> declared;  // the recipe's scalar limits
+  std::vector<CurveMask> recipe_masks;    // the recipe's masks (the "recipe" rule)
   TeachOptions teach;
   RotorChainParams rotor;  // nominal geometry, default fixture
   LineSpread spread;

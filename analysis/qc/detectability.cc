@@ -76,16 +76,17 @@ std::vector<MeasurementSeparation> Separate(const DetectabilityOptions& o, const
       m.good = g.value;
       m.defect = d->second.value;
       m.sigma = g.sigma / std::sqrt(p_scale);
-      m.spread = given->second * (name == std::string(names::kResonanceFHz) ? spread_scale_f0 : 1.0);
+      m.spread =
+          given->second * (name == std::string(names::kResonanceFHz) ? spread_scale_f0 : 1.0);
     }
     const double total = std::hypot(m.spread, m.sigma);
     m.separation = total > 0.0 ? std::abs(m.defect - m.good) / total : 0.0;
     m.limit_is_lo = m.defect < m.good;
     m.recommended_limit = m.good + (m.limit_is_lo ? -1.0 : 1.0) * o.required_sigmas * total;
-    m.miss_probability = total > 0.0 ? (m.limit_is_lo
-                                            ? 1.0 - NormalCdf((m.recommended_limit - m.defect) / total)
-                                            : NormalCdf((m.recommended_limit - m.defect) / total))
-                                     : 0.0;
+    m.miss_probability =
+        total > 0.0 ? (m.limit_is_lo ? 1.0 - NormalCdf((m.recommended_limit - m.defect) / total)
+                                     : NormalCdf((m.recommended_limit - m.defect) / total))
+                    : 0.0;
     out.push_back(m);
   }
   return out;
@@ -112,7 +113,8 @@ bool DetectabilityOptions::IsValid(std::string* why) const {
     return fail("r_ohm, l_h and transmission_nm_per_a must be positive");
   if (!excitation.IsValid(&w)) return fail("excitation: " + w);
   if (periods < 1) return fail("periods must be at least 1");
-  if (!(voltage_noise_v > 0.0 && current_noise_a > 0.0)) return fail("channel noise must be positive");
+  if (!(voltage_noise_v > 0.0 && current_noise_a > 0.0))
+    return fail("channel noise must be positive");
   if (!fit.IsValid(&w)) return fail("fit: " + w);
   for (const auto& [name, s] : unit_spread)
     if (!(s >= 0.0 && std::isfinite(s))) return fail("unit spread of " + name + " must be >= 0");
@@ -129,8 +131,8 @@ DetectabilitySummary PredictDetectability(const DetectabilityOptions& o) {
     s.message = "detectability options: " + why;
     return s;
   }
-  const Context ctx{o, MakeLineMeasurement(o.excitation, o.periods, o.voltage_noise_v,
-                                           o.current_noise_a)};
+  const Context ctx{
+      o, MakeLineMeasurement(o.excitation, o.periods, o.voltage_noise_v, o.current_noise_a)};
   s.k_fixture_nm_per_rad = o.rotor.fixture->stiffness_nm_per_rad;
   const Expected good = ctx.Evaluate(o.rotor);
   if (!good.analysis.usable) {
@@ -148,8 +150,8 @@ DetectabilitySummary PredictDetectability(const DetectabilityOptions& o) {
       {"half_soft", NominalWithDefect(o.rotor, DefectClass::kHalfSoft, 1.0)},
       {"all_soft", NominalWithDefect(o.rotor, DefectClass::kAllSoft, 1.0)}};
   for (double f : o.bond_fractions)
-    defects.push_back({"weak_bonds:" + Fmt("%.2g", f),
-                       NominalWithDefect(o.rotor, DefectClass::kWeakBonds, f)});
+    defects.push_back(
+        {"weak_bonds:" + Fmt("%.2g", f), NominalWithDefect(o.rotor, DefectClass::kWeakBonds, f)});
 
   const std::vector<double> clamp_scales = {1.25, 1.5, 2, 3, 5, 10, 20, 50, 100, INFINITY};
   std::vector<Expected> good_clamped;
@@ -168,8 +170,9 @@ DetectabilitySummary PredictDetectability(const DetectabilityOptions& o) {
     if (!p.fit_usable) {
       p.separable = true;
       p.best = "fit";
-      p.remedies.push_back("the station's fit finds no resonance for this class: it ends ERROR "
-                           "(never PASS) and is retested; no limit needed");
+      p.remedies.push_back(
+          "the station's fit finds no resonance for this class: it ends ERROR "
+          "(never PASS) and is retested; no limit needed");
       s.classes.push_back(p);
       continue;
     }
@@ -227,18 +230,19 @@ DetectabilitySummary PredictDetectability(const DetectabilityOptions& o) {
       }
       if (p_scale > 0.0) {
         const double periods = std::ceil(p_scale * static_cast<double>(o.periods));
+        p.remedies.push_back(std::string(periods > 100.0 ? "impractical: " : "") +
+                             "longer measurement: " + Fmt("%.0f", periods) +
+                             " averaged periods (now " + std::to_string(o.periods) + "; " +
+                             Fmt("%.1f", (periods + static_cast<double>(o.transient_periods)) /
+                                             o.excitation.line_spacing_hz) +
+                             " s of excitation) separate it by " + Fmt("%.1f", via->separation) +
+                             " sigma in " + via->name);
         p.remedies.push_back(
-            "longer measurement: " + Fmt("%.0f", periods) + " averaged periods (now " +
-            std::to_string(o.periods) + "; " +
-            Fmt("%.1f", (periods + static_cast<double>(o.transient_periods)) /
-                            o.excitation.line_spacing_hz) +
-            " s of excitation) separate it by " + Fmt("%.1f", via->separation) + " sigma in " +
-            via->name);
-        p.remedies.push_back("another phase pair: one whose coupling T at the clamped rotor "
-                             "position is " +
-                             Fmt("%.2g", std::sqrt(p_scale)) +
-                             " x the present one does the same (Rp ~ T^2: the noise-limited "
-                             "separation grows like the periods)");
+            "another phase pair: one whose coupling T at the clamped rotor "
+            "position is " +
+            Fmt("%.2g", std::sqrt(p_scale)) +
+            " x the present one does the same (Rp ~ T^2: the noise-limited "
+            "separation grows like the periods)");
       } else {
         p.remedies.push_back(
             "longer measurement or another phase pair cannot separate it: the good units' own "

@@ -210,9 +210,9 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
     for (const Run& r : runs) total += r.b - r.a;
     for (Run& r : runs)
       r.segments = std::clamp<std::size_t>(
-          static_cast<std::size_t>(std::lround(static_cast<double>(o.mask_segments) *
-                                               static_cast<double>(r.b - r.a) /
-                                               static_cast<double>(total))),
+          static_cast<std::size_t>(
+              std::lround(static_cast<double>(o.mask_segments) * static_cast<double>(r.b - r.a) /
+                          static_cast<double>(total))),
           1, (r.b - r.a) / 2);
     if (runs.empty()) {
       with_mask = false;
@@ -285,15 +285,14 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
   }
 
   s.usable = true;
-  s.message = std::string("method ") + o.method + ", " + std::to_string(s.units_used) + " of " +
-              std::to_string(s.units_given) + " golden units used (" +
-              std::to_string(s.rejected.size()) + " rejected as outliers), coverage " +
-              Num(o.coverage) + " of good units over " + std::to_string(s.bounds) +
-              " bounds (" + Num(s.p_bound) + " each) at confidence " + Num(o.confidence) +
-              ": k = " + Num(s.k_factor) + "; " + std::to_string(s.units_needed) +
-              " units needed for limits within " + Num(100 * o.width_margin) +
-              " % of a known spread (" + std::to_string(s.units_needed_distribution_free) +
-              " distribution-free)" + mask_note;
+  s.message =
+      std::string("method ") + o.method + ", " + std::to_string(s.units_used) + " of " +
+      std::to_string(s.units_given) + " golden units used (" + std::to_string(s.rejected.size()) +
+      " rejected as outliers), coverage " + Num(o.coverage) + " of good units over " +
+      std::to_string(s.bounds) + " bounds (" + Num(s.p_bound) + " each) at confidence " +
+      Num(o.confidence) + ": k = " + Num(s.k_factor) + "; " + std::to_string(s.units_needed) +
+      " units needed for limits within " + Num(100 * o.width_margin) + " % of a known spread (" +
+      std::to_string(s.units_needed_distribution_free) + " distribution-free)" + mask_note;
   if (s.units_used < s.units_needed)
     s.message += "; WARNING: fewer golden units than needed, the limits are wide";
   return s;

@@ -75,17 +75,17 @@ struct TaughtStatistic {
 
 struct TeachSummary {
   bool usable = false;
-  std::string message;  // what was used, or why nothing may be used
+  std::string message;                  // what was used, or why nothing may be used
   std::vector<MeasurementSpec> limits;  // the declared limits with learned bounds
   std::vector<CurveMask> masks;         // learned masks (empty without curves)
   std::vector<TaughtStatistic> statistics;
   std::vector<std::string> rejected;  // "label: name robust z = ..."
   int units_given = 0;
   int units_used = 0;
-  int bounds = 0;          // B
-  double p_bound = 0.0;    // coverage per statistic
-  double k_factor = 0.0;   // the tolerance factor applied
-  int units_needed = 0;    // for the stated confidence (see above)
+  int bounds = 0;         // B
+  double p_bound = 0.0;   // coverage per statistic
+  double k_factor = 0.0;  // the tolerance factor applied
+  int units_needed = 0;   // for the stated confidence (see above)
   int units_needed_distribution_free = 0;
 };
 

@@ -88,8 +88,7 @@ class ToleranceIntegral {
 };
 
 void CheckProbability(double v, const char* name) {
-  if (!(v > 0.0 && v < 1.0))
-    throw std::invalid_argument(std::string(name) + " must be in (0, 1)");
+  if (!(v > 0.0 && v < 1.0)) throw std::invalid_argument(std::string(name) + " must be in (0, 1)");
 }
 
 }  // namespace

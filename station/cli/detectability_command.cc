@@ -44,8 +44,9 @@ double KFixtureFromGap(const std::string& path) {
   }
   const json* p = j.contains("params") ? &j.at("params") : nullptr;
   if (!p || !p->contains("k_fixture_nm_per_rad") || !p->at("k_fixture_nm_per_rad").is_number())
-    throw std::runtime_error(path + ": /params/k_fixture_nm_per_rad is missing: the gap diagnosis "
-                                    "did not name fixture_compliance (effect: " +
+    throw std::runtime_error(path +
+                             ": /params/k_fixture_nm_per_rad is missing: the gap diagnosis "
+                             "did not name fixture_compliance (effect: " +
                              j.value("effect", std::string("?")) + "); give --k-fixture");
   const double k = p->at("k_fixture_nm_per_rad").get<double>();
   if (!(k > 0.0 && std::isfinite(k)))
@@ -115,24 +116,39 @@ int RunDetect(const DetectArgs& a) {
     for (const auto& c : s.classes) {
       json ms = json::array();
       for (const auto& m : c.measurements)
-        ms.push_back({{"name", m.name}, {"good", m.good}, {"defect", m.defect},
-                      {"sigma", m.sigma}, {"spread", m.spread}, {"separation", m.separation},
+        ms.push_back({{"name", m.name},
+                      {"good", m.good},
+                      {"defect", m.defect},
+                      {"sigma", m.sigma},
+                      {"spread", m.spread},
+                      {"separation", m.separation},
                       {"recommended_limit", m.recommended_limit},
                       {"limit_side", m.limit_is_lo ? "lo" : "hi"},
                       {"miss_probability", m.miss_probability}});
-      classes.push_back({{"defect", c.defect}, {"fit_usable", c.fit_usable},
-                         {"f0_hz", c.f0_hz}, {"q", c.q}, {"rp_ohm", c.rp_ohm},
+      classes.push_back({{"defect", c.defect},
+                         {"fit_usable", c.fit_usable},
+                         {"f0_hz", c.f0_hz},
+                         {"q", c.q},
+                         {"rp_ohm", c.rp_ohm},
                          {"chi2_per_dof", c.chi2_per_dof},
                          {"curve_separation", c.curve_separation},
-                         {"best", c.best}, {"best_separation", c.best_separation},
-                         {"separable", c.separable}, {"remedies", c.remedies},
+                         {"best", c.best},
+                         {"best_separation", c.best_separation},
+                         {"separable", c.separable},
+                         {"remedies", c.remedies},
                          {"measurements", ms}});
     }
-    std::cout << json{{"usable", true}, {"k_fixture_nm_per_rad", s.k_fixture_nm_per_rad},
-                      {"k_fixture_source", source}, {"spread_source", spread_source},
-                      {"required_sigmas", a.required_sigmas}, {"f0_good_hz", s.f0_good_hz},
-                      {"q_good", s.q_good}, {"chi2_good", s.chi2_good}, {"dof", s.dof},
-                      {"classes", classes}, {"message", s.message}}
+    std::cout << json{{"usable", true},
+                      {"k_fixture_nm_per_rad", s.k_fixture_nm_per_rad},
+                      {"k_fixture_source", source},
+                      {"spread_source", spread_source},
+                      {"required_sigmas", a.required_sigmas},
+                      {"f0_good_hz", s.f0_good_hz},
+                      {"q_good", s.q_good},
+                      {"chi2_good", s.chi2_good},
+                      {"dof", s.dof},
+                      {"classes", classes},
+                      {"message", s.message}}
                      .dump()
               << std::endl;
     return 0;
@@ -147,9 +163,8 @@ int RunDetect(const DetectArgs& a) {
       if (m.name == c.best)
         rec = std::string(m.limit_is_lo ? "lo " : "hi ") + G(m.recommended_limit) + " (" +
               G(100.0 * m.miss_probability) + " % pass)";
-    std::printf("%-18s %8.2f %6.1f %8.3f %9.1f  %-16s %6.1f  %s\n", c.defect.c_str(), c.f0_hz,
-                c.q, c.chi2_per_dof, c.curve_separation, c.best.c_str(), c.best_separation,
-                rec.c_str());
+    std::printf("%-18s %8.2f %6.1f %8.3f %9.1f  %-16s %6.1f  %s\n", c.defect.c_str(), c.f0_hz, c.q,
+                c.chi2_per_dof, c.curve_separation, c.best.c_str(), c.best_separation, rec.c_str());
   }
   for (const auto& c : s.classes) {
     if (c.separable) continue;

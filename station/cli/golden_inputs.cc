@@ -25,7 +25,8 @@ analysis::GoldenUnit FromMeasured(const std::string& path, const Recipe& recipe)
   analysis::ImpedanceAnalysis a;
   if (in.kind == files::MeasuredKind::kFrf) {
     if (in.frf.quantity != analysis::Quantity::kImpedanceOhm)
-      throw std::runtime_error(path + ": a golden unit must be an impedance FRF (f_hz,re_ohm,im_ohm)");
+      throw std::runtime_error(path +
+                               ": a golden unit must be an impedance FRF (f_hz,re_ohm,im_ohm)");
     a = analysis::AnalyzeImpedance(in.frf, recipe.analysis.fit);
   } else {
     const analysis::MultisineOptions& e = recipe.excitation;
@@ -47,8 +48,11 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
   if (!j.value("usable", false))
     throw std::runtime_error(path + ": the analysis is not usable (\"usable\": false)");
   static const std::map<std::string, std::string_view> kParams = {
-      {"f0_hz", names::kResonanceFHz}, {"Q", names::kResonanceQ},     {"R_ohm", names::kWindingROhm},
-      {"L_h", names::kWindingLH},      {"Rp_ohm", names::kMotionalRpOhm}};
+      {"f0_hz", names::kResonanceFHz},
+      {"Q", names::kResonanceQ},
+      {"R_ohm", names::kWindingROhm},
+      {"L_h", names::kWindingLH},
+      {"Rp_ohm", names::kMotionalRpOhm}};
   analysis::GoldenUnit u;
   u.label = path;
   for (const auto& [param, name] : kParams) {
@@ -67,7 +71,8 @@ analysis::GoldenUnit FromRecord(const db::TestRecord& r, const std::string& labe
   for (const db::Curve& c : r.curves) {
     if (c.name != "impedance") continue;
     u.curve.freq_hz = c.freq_hz;
-    for (std::size_t k = 0; k < c.re.size() && k < c.im.size(); ++k) u.curve.value.emplace_back(c.re[k], c.im[k]);
+    for (std::size_t k = 0; k < c.re.size() && k < c.im.size(); ++k)
+      u.curve.value.emplace_back(c.re[k], c.im[k]);
     u.curve.sigma = c.sigma;
     u.curve.method = "record";
   }

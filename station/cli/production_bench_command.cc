@@ -94,8 +94,8 @@ int RunBench(BenchArgs a) {
     std::cout << SummaryJson(s, a).dump() << std::endl;
     return 0;
   }
-  std::cout << "production bench: " << s.units << " units, seed " << o.seed << ", recipe "
-            << r.id << " v" << r.version << "\n"
+  std::cout << "production bench: " << s.units << " units, seed " << o.seed << ", recipe " << r.id
+            << " v" << r.version << "\n"
             << "teach: " << s.teach.message << "\n";
   for (const auto& l : s.teach.limits)
     std::cout << "  " << l.name << ": [" << (l.limit.lo ? json(*l.limit.lo).dump() : "-") << ", "
@@ -113,8 +113,8 @@ int RunBench(BenchArgs a) {
     std::printf("%-18s %6d | %-22s | %-22s | %-22s\n", analysis::ToString(c), t.units, tb, hb, nb);
   }
   for (analysis::BenchRule rule : analysis::kBenchRules) {
-    std::cout << analysis::ToString(rule)
-              << ": false rejects " << Percent(s.FalseRejectRate(rule)) << ", escapes";
+    std::cout << analysis::ToString(rule) << ": false rejects " << Percent(s.FalseRejectRate(rule))
+              << ", escapes";
     for (analysis::DefectClass c : analysis::kAllDefectClasses)
       if (c != analysis::DefectClass::kGood)
         std::cout << " " << analysis::ToString(c) << " " << Percent(s.EscapeRate(rule, c));

@@ -70,8 +70,9 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
 
 void WriteNew(const std::string& path, const json& j, bool force) {
   if (std::filesystem::exists(path) && !force)
-    throw std::runtime_error(path + " exists: refusing to overwrite it (choose another --out, or "
-                                    "--force)");
+    throw std::runtime_error(path +
+                             " exists: refusing to overwrite it (choose another --out, or "
+                             "--force)");
   const std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
@@ -88,8 +89,9 @@ int RunTeach(const TeachArgs& a) {
   if (!a.options.IsValid(&why)) throw std::runtime_error("options: " + why);
   const Recipe recipe = LoadRecipe(a.recipe);
   if (std::filesystem::exists(a.out) && !a.force)
-    throw std::runtime_error(a.out + " exists: refusing to overwrite it (choose another --out, or "
-                                     "--force)");
+    throw std::runtime_error(a.out +
+                             " exists: refusing to overwrite it (choose another --out, or "
+                             "--force)");
   std::vector<std::string> skipped;
   const std::vector<analysis::GoldenUnit> golden = ReadGoldenUnits(a.golden, recipe, &skipped);
   const analysis::TeachSummary s = analysis::TeachLimits(recipe.limits, golden, a.options);
@@ -115,10 +117,13 @@ int RunTeach(const TeachArgs& a) {
     json masks = json::array();
     for (const auto& m : s.masks) masks.push_back(MaskJson(m));
     std::cout << json{{"usable", true},
-                      {"recipe", {{"path", a.out}, {"id", next.id}, {"version", next.version},
-                                  {"hash", next.hash}}},
-                      {"previous", {{"path", a.recipe}, {"version", recipe.version},
-                                    {"hash", recipe.hash}}},
+                      {"recipe",
+                       {{"path", a.out},
+                        {"id", next.id},
+                        {"version", next.version},
+                        {"hash", next.hash}}},
+                      {"previous",
+                       {{"path", a.recipe}, {"version", recipe.version}, {"hash", recipe.hash}}},
                       {"method", a.options.method},
                       {"confidence", a.options.confidence},
                       {"coverage", a.options.coverage},
@@ -144,7 +149,9 @@ int RunTeach(const TeachArgs& a) {
   for (std::size_t i = 0; i < s.limits.size(); ++i) {
     const auto& old = recipe.limits[i].limit;
     const auto& now = s.limits[i].limit;
-    auto bound = [](const std::optional<double>& v) { return v ? json(*v).dump() : std::string("-"); };
+    auto bound = [](const std::optional<double>& v) {
+      return v ? json(*v).dump() : std::string("-");
+    };
     std::cout << "  " << s.limits[i].name << ": [" << bound(old.lo) << ", " << bound(old.hi)
               << "] -> [" << bound(now.lo) << ", " << bound(now.hi) << "], marginal "
               << now.marginal << " (centre " << s.statistics[i].centre << ", scale "
@@ -180,8 +187,7 @@ void AddTeachCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--golden", args->golden, "Files of good units")->required()->expected(1, -1);
   cmd->add_option("--out", args->out, "The new recipe file")->required();
-  cmd->add_option("--confidence", args->options.confidence,
-                  "Confidence of the tolerance intervals")
+  cmd->add_option("--confidence", args->options.confidence, "Confidence of the tolerance intervals")
       ->capture_default_str();
   cmd->add_option("--coverage", args->options.coverage,
                   "Share of good units that pass every taught bound together")

@@ -1,9 +1,9 @@
 // Defect detectability (analysis/qc/detectability.h): in the default fixture every magnet
 // poorly cemented is separable; a class the fixture hides is flagged with remedies carrying
 // numbers, and the same class is not flagged when the clamp is stiff enough.
-#include <gtest/gtest.h>
-
 #include "analysis/qc/detectability.h"
+
+#include <gtest/gtest.h>
 
 namespace eol::analysis {
 namespace {
@@ -63,8 +63,7 @@ TEST(Detectability, SoftFixtureHidesAClassAndSaysWhatFixesIt) {
     hopeless = hopeless || r.find("cannot separate it") != std::string::npos;
   EXPECT_TRUE(hopeless);
   // The recommended limit sits on the defect's side of the good value.
-  for (const auto& m : weak.measurements)
-    EXPECT_EQ(m.limit_is_lo, m.defect < m.good) << m.name;
+  for (const auto& m : weak.measurements) EXPECT_EQ(m.limit_is_lo, m.defect < m.good) << m.name;
 }
 
 TEST(Detectability, StiffClampSeparatesWhatTheSoftOneHides) {

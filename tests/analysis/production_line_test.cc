@@ -55,8 +55,8 @@ TEST(LinePopulation, ModalImpedanceMatchesTheExactChain) {
   double worst = 0.0;
   for (std::size_t k = 0; k < f.size(); ++k) {
     const std::complex<double> exact = u.motor.Impedance(f[k]);
-    const std::complex<double> motional = exact - u.motor.r_ohm -
-                                          std::complex<double>(0, 2 * M_PI * f[k] * u.motor.l_h);
+    const std::complex<double> motional =
+        exact - u.motor.r_ohm - std::complex<double>(0, 2 * M_PI * f[k] * u.motor.l_h);
     worst = std::max(worst, std::abs(z[k] - exact) / std::max(std::abs(motional), 0.05));
   }
   EXPECT_LT(worst, 0.02);  // proportional damping: within 2 % of the motional part

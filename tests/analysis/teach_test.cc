@@ -3,12 +3,13 @@
 // k(10, 0.90, 0.95) = 2.8563; NIST/SEMATECH and Krishnamoorthy-Mathew tables give 3.35 and
 // 2.856), the stated confidence over repeated teaching, outlier rejection, masks from curves
 // and the errors that name the unit or measurement.
+#include "analysis/qc/teach.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "analysis/qc/teach.h"
 #include "analysis/qc/tolerance.h"
 
 namespace eol::analysis {
@@ -72,8 +73,8 @@ TEST(Teach, StatedConfidenceHoldsOverRepetitions) {
   int covered = 0;
   const int reps = 400;
   for (int r = 0; r < reps; ++r) {
-    const TeachSummary s = TeachLimits({Spec("resonance_f_hz", true, true)},
-                                       NormalUnits(30, 1000 + r, 390.0, 4.0), o);
+    const TeachSummary s =
+        TeachLimits({Spec("resonance_f_hz", true, true)}, NormalUnits(30, 1000 + r, 390.0, 4.0), o);
     ASSERT_TRUE(s.usable) << s.message;
     const double lo = *s.limits[0].limit.lo, hi = *s.limits[0].limit.hi;
     const double true_coverage = NormalCdf((hi - 390.0) / 4.0) - NormalCdf((lo - 390.0) / 4.0);
@@ -99,7 +100,7 @@ TEST(Teach, FreshUnitsPassAtTheStatedRate) {
     outside += (v < *s.limits[0].limit.lo || v > *s.limits[0].limit.hi) ? 1 : 0;
   }
   EXPECT_LE(outside / 20000.0, 0.01 + 0.002);  // at most 1 - coverage, up to sampling
-  EXPECT_GT(outside, 0);                        // and not absurdly wide
+  EXPECT_GT(outside, 0);                       // and not absurdly wide
   EXPECT_GT(s.limits[0].limit.marginal, 0.0);
 }
 
@@ -113,10 +114,10 @@ TEST(Teach, CoverageIsSharedBetweenBounds) {
     u.values["resonance_q"] = q(rng);
     u.values["fit_chi2_per_dof"] = chi2(rng);
   }
-  const TeachSummary s = TeachLimits(
-      {Spec("resonance_f_hz", true, true), Spec("resonance_q", true, true),
-       Spec("fit_chi2_per_dof", false, true)},
-      units, o);
+  const TeachSummary s =
+      TeachLimits({Spec("resonance_f_hz", true, true), Spec("resonance_q", true, true),
+                   Spec("fit_chi2_per_dof", false, true)},
+                  units, o);
   ASSERT_TRUE(s.usable) << s.message;
   EXPECT_EQ(s.bounds, 5);
   EXPECT_NEAR(s.p_bound, 1.0 - 2.0 * (1.0 - 0.9973) / 5.0, 1e-12);
@@ -201,7 +202,8 @@ TEST(Teach, MaskFromCurvesPassesGoodAndCatchesAShiftedPeak) {
   std::string why;
   EXPECT_TRUE(s.masks[0].IsValid(&why)) << why;
   int good_outside = 0;
-  for (int i = 0; i < 200; ++i) good_outside += CheckMask(Curve(f0(rng), r(rng), rng), s.masks[0]).lines_outside > 0;
+  for (int i = 0; i < 200; ++i)
+    good_outside += CheckMask(Curve(f0(rng), r(rng), rng), s.masks[0]).lines_outside > 0;
   EXPECT_LE(good_outside, 1);
   EXPECT_GT(CheckMask(Curve(360.0, 0.5, rng), s.masks[0]).lines_outside, 0);
   // With Q known, the resonance band is left to the scalar limits: two masks around it.

@@ -46,8 +46,8 @@ TEST(ProductionBenchCli, TaughtLimitsMeetTheTargetsAtReducedSize) {
     }
   }
   EXPECT_EQ(total, 2000);
-  EXPECT_GT(good, 1600);     // 90 % good at the default rates
-  EXPECT_GT(all_soft, 20);   // 2 % all_soft: the target is exercised
+  EXPECT_GT(good, 1600);    // 90 % good at the default rates
+  EXPECT_GT(all_soft, 20);  // 2 % all_soft: the target is exercised
   EXPECT_LE(j["rates"]["taught"]["false_reject_rate"].get<double>(), 0.003) << j.dump();
   EXPECT_EQ(j["teach"]["units_used"].get<int>() <= 50, true);
 }
@@ -56,8 +56,7 @@ TEST(ProductionBenchCli, BadOptionsAreNamed) {
   int code = -1;
   const nlohmann::json j = Bench({"--units", "0"}, &code);
   EXPECT_EQ(code, 1);
-  EXPECT_NE(j["output"].get<std::string>().find("units must be in"), std::string::npos)
-      << j.dump();
+  EXPECT_NE(j["output"].get<std::string>().find("units must be in"), std::string::npos) << j.dump();
 }
 
 }  // namespace

@@ -35,10 +35,10 @@ CliRun Eol(std::vector<std::string> args, bool merge_stderr = true) {
 std::string Simulated(const eol::testing::TempDir& dir, const std::string& name, int seed,
                       const std::string& defect, double noise_scale) {
   const std::string out = dir / name;
-  const CliRun r = Eol({"simulate", "--motor", kMotor, "--out", out, "--defect", defect, "--seed",
-                        std::to_string(seed), "--model", "steady_state", "--noise-v",
-                        std::to_string(2e-3 * noise_scale), "--noise-a",
-                        std::to_string(1e-3 * noise_scale)});
+  const CliRun r =
+      Eol({"simulate", "--motor", kMotor, "--out", out, "--defect", defect, "--seed",
+           std::to_string(seed), "--model", "steady_state", "--noise-v",
+           std::to_string(2e-3 * noise_scale), "--noise-a", std::to_string(1e-3 * noise_scale)});
   EXPECT_EQ(r.code, 0) << r.output;
   return out;
 }
@@ -48,8 +48,8 @@ class TeachCli : public ::testing::Test {
   void SetUp() override {
     // Spread among the golden units: noise, at four levels (the same motor otherwise).
     for (int i = 0; i < 12; ++i)
-      golden_.push_back(Simulated(dir_, "g" + std::to_string(i) + ".csv", 100 + i, "none",
-                                  1.0 + 0.5 * (i % 4)));
+      golden_.push_back(
+          Simulated(dir_, "g" + std::to_string(i) + ".csv", 100 + i, "none", 1.0 + 0.5 * (i % 4)));
   }
   std::vector<std::string> TeachArgs(const std::string& out) {
     std::vector<std::string> a = {"teach", "--recipe", kRecipe, "--out", out, "--golden"};
@@ -109,8 +109,8 @@ TEST_F(TeachCli, WritesANewVersionAndRefusesToOverwrite) {
 }
 
 TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
-  std::vector<std::string> args = {"teach", "--recipe", kRecipe, "--out", dir_ / "j.json",
-                                   "--json", "--golden"};
+  std::vector<std::string> args = {"teach",         "--recipe", kRecipe,   "--out",
+                                   dir_ / "j.json", "--json",   "--golden"};
   for (std::size_t i = 0; i < 6; ++i) {
     const CliRun a = Eol({"analyze", "--measured", golden_[i], "--json"}, false);
     ASSERT_EQ(a.code, 0) << a.output;
@@ -135,8 +135,8 @@ TEST_F(TeachCli, ErrorsNameTheFile) {
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find(junk), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.json"));
-  r = Eol({"teach", "--recipe", kRecipe, "--out", dir_ / "x.json", "--golden", golden_[0],
-           golden_[1]});
+  r = Eol(
+      {"teach", "--recipe", kRecipe, "--out", dir_ / "x.json", "--golden", golden_[0], golden_[1]});
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_NE(r.output.find("too few golden units"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.json"));
