@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/child_process.h"
+#include "db/test_record.h"
 #include "station/recipe.h"
 
 namespace eol {
@@ -126,6 +127,37 @@ TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
   EXPECT_EQ(j["masks"].size(), 0u);  // no curves in analyze --json: the recipe's mask stays
   EXPECT_EQ(station::LoadRecipe(dir_ / "j.json").masks[0].name, "re_z_low_band");
   EXPECT_GT(j["units_needed"].get<int>(), 6);
+}
+
+// `eol export --format json` records: every finished record is a golden unit, ERROR records
+// are skipped and listed.
+TEST_F(TeachCli, ReadsExportedRecords) {
+  nlohmann::json list = nlohmann::json::array();
+  const char* names[] = {"resonance_f_hz", "resonance_q", "winding_r_ohm", "winding_l_h",
+                         "fit_chi2_per_dof"};
+  for (int i = 0; i < 10; ++i) {
+    db::TestRecord r;
+    r.serial = "SN" + std::to_string(i);
+    r.outcome = i == 4 ? analysis::Outcome::kError : analysis::Outcome::kPass;
+    const double values[] = {390.0 + 0.7 * (i % 5) - 1.4, 50.0 + (i % 3), 0.5 + 0.002 * (i % 4),
+                             2e-3 * (1.0 + 0.01 * (i % 2)), 1.0 + 0.02 * (i % 3)};
+    for (int k = 0; k < 5 && i != 4; ++k) {
+      analysis::Measurement m;
+      m.name = names[k];
+      m.value = values[k];
+      r.measurements.push_back(m);
+    }
+    list.push_back(r);
+  }
+  const std::string path = dir_ / "export.json";
+  std::ofstream(path) << list.dump(1);
+  const CliRun r = Eol({"teach", "--recipe", kRecipe, "--out", dir_ / "e.json", "--golden", path});
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("skipped " + path + "[4] SN4: ERROR"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("9 of 9 golden units used"), std::string::npos) << r.output;
+  const station::Recipe taught = station::LoadRecipe(dir_ / "e.json");
+  EXPECT_LT(*taught.limits[0].limit.lo, 388.6);
+  EXPECT_GT(*taught.limits[0].limit.hi, 391.4);
 }
 
 TEST_F(TeachCli, ErrorsNameTheFile) {
