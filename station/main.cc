@@ -31,6 +31,9 @@ int main(int argc, char** argv) {
   eol::station::cli::AddSafetyBenchCommand(app);
   eol::station::cli::AddStatsCommand(app);
   eol::station::cli::AddCalibrateCommand(app);
+  eol::station::cli::AddTeachCommand(app);
+  eol::station::cli::AddDetectabilityCommand(app);
+  eol::station::cli::AddProductionBenchCommand(app);
   CLI11_PARSE(app, argc, argv);
   return 0;
 }

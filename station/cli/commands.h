@@ -20,5 +20,8 @@ void AddExportCommand(CLI::App& app);
 void AddSafetyBenchCommand(CLI::App& app);
 void AddStatsCommand(CLI::App& app);
 void AddCalibrateCommand(CLI::App& app);
+void AddTeachCommand(CLI::App& app);
+void AddDetectabilityCommand(CLI::App& app);
+void AddProductionBenchCommand(CLI::App& app);
 
 }  // namespace eol::station::cli

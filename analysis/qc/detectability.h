@@ -1,0 +1,93 @@
+// Defect detectability in the real fixture (`eol detectability`).
+//
+// The model: the nominal rotor chain (rotor_chain.h) with the fixture stiffness of the real
+// station (from the gap diagnosis' fixture_compliance, or given), R, L and T of the motor.
+// For the good rotor and each defect class (one soft magnet, two, half, all; every bond at a
+// fraction 0.1..0.9 of its stiffness) the expected measurement is Z on the recipe's lines with
+// the per-line sigma of the recipe's excitation (line_measurement.h), and the station's fit
+// (AnalyzeImpedance) on that noise-free curve predicts the measured values:
+//   f0, Q, Rp, R, L as fitted; chi2/dof as 1 + chi2_0 / dof (chi2_0 of the noise-free fit: the
+//   shape a single mode cannot follow, e.g. a soft magnet's local mode).
+// Measurement sigma: the fit's standard errors at the expected curve (the Cramer-Rao bound of
+// the recipe's excitation), and sqrt(2 / dof) for chi2/dof.
+// Good-unit spread: per measurement, given (from a golden set or the recipe's limits); for
+// chi2/dof the noise alone when not given. Separation of a class in a measurement:
+//   sep = |x_defect - x_good| / sqrt(spread^2 + sigma^2),
+// the recommended limit sits required_sigmas x that spread from the good value on the side of
+// the defect, and miss = Phi((limit - x_defect) / spread) is the share of that class still
+// passing it (spreads assumed equal for good and defective units).
+// A class is separable when its best measurement reaches required_sigmas. Otherwise remedies
+// with numbers: the fixture stiffness that separates it (searched up to 100 x, and rigid), the
+// periods that would (noise-limited measurements only: sigma^2 ~ 1/P, chi2_0 ~ P), and the
+// equivalent phase-pair coupling gain (Rp ~ T^2: a pair with r x the coupling acts as r^2 x
+// the periods).
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/fit/resonance_fit.h"
+#include "analysis/model/rotor_chain.h"
+#include "analysis/signal/multisine.h"
+
+namespace eol::analysis {
+
+struct DetectabilityOptions {
+  RotorChainParams rotor;  // nominal rotor with the real fixture (fixture must be set)
+  double r_ohm = 0.5;
+  double l_h = 2.0e-3;
+  double transmission_nm_per_a = 0.05;
+  MultisineOptions excitation;
+  std::size_t periods = 4;
+  std::size_t transient_periods = 1;
+  double voltage_noise_v = 2.0e-3;
+  double current_noise_a = 1.0e-3;
+  ResonanceFitOptions fit;
+  // Standard deviation of good units per measurement name; measurements without one are not
+  // judged (chi2/dof always is, with its noise spread when absent).
+  std::map<std::string, double> unit_spread;
+  std::vector<double> bond_fractions = {0.1, 0.3, 0.5, 0.7, 0.9};
+  double required_sigmas = 3.0;
+
+  bool IsValid(std::string* why) const;
+};
+
+struct MeasurementSeparation {
+  std::string name;
+  double good = 0.0;
+  double defect = 0.0;
+  double sigma = 0.0;   // measurement
+  double spread = 0.0;  // good units (as given)
+  double separation = 0.0;
+  double recommended_limit = 0.0;  // lo when the defect lies below, else hi
+  bool limit_is_lo = true;
+  double miss_probability = 0.0;
+};
+
+struct DefectPrediction {
+  std::string defect;  // one_soft_magnet, two_soft_magnets, half_soft, all_soft, weak_bonds:0.5
+  bool fit_usable = false;
+  std::string fit_message;
+  double f0_hz = 0.0, q = 0.0, rp_ohm = 0.0, chi2_per_dof = 0.0;
+  double curve_separation = 0.0;  // sqrt(sum 2 |Z_d - Z_g|^2 / sigma^2): noise only
+  std::vector<MeasurementSeparation> measurements;
+  std::string best;  // measurement with the largest separation
+  double best_separation = 0.0;
+  bool separable = false;
+  std::vector<std::string> remedies;
+};
+
+struct DetectabilitySummary {
+  bool usable = false;
+  std::string message;
+  double k_fixture_nm_per_rad = 0.0;
+  double f0_good_hz = 0.0, q_good = 0.0, chi2_good = 0.0;
+  int dof = 0;
+  std::vector<DefectPrediction> classes;
+};
+
+DetectabilitySummary PredictDetectability(const DetectabilityOptions& options);
+
+}  // namespace eol::analysis

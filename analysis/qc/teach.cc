@@ -1,0 +1,301 @@
+#include "analysis/qc/teach.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "analysis/qc/tolerance.h"
+
+namespace eol::analysis {
+namespace {
+
+constexpr double kMadToSigma = 1.4826;
+constexpr double kMadEfficiency = 0.37;
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double RobustScale(const std::vector<double>& v, double median) {
+  std::vector<double> dev;
+  for (double x : v) dev.push_back(std::abs(x - median));
+  return kMadToSigma * Median(dev);
+}
+
+// Six significant digits: limits written into a recipe stay readable.
+double Round6(double v) {
+  if (v == 0.0 || !std::isfinite(v)) return v;
+  const double scale = std::pow(10.0, 5 - std::floor(std::log10(std::abs(v))));
+  return std::round(v * scale) / scale;
+}
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+struct CentreScale {
+  double centre = 0.0;
+  double scale = 0.0;
+};
+
+CentreScale CentreAndScale(const std::vector<double>& v, bool robust) {
+  CentreScale cs;
+  if (robust) {
+    cs.centre = Median(v);
+    cs.scale = RobustScale(v, cs.centre);
+    return cs;
+  }
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  cs.centre = sum / static_cast<double>(v.size());
+  double ss = 0.0;
+  for (double x : v) ss += (x - cs.centre) * (x - cs.centre);
+  cs.scale = std::sqrt(ss / static_cast<double>(v.size() - 1));
+  return cs;
+}
+
+TeachSummary Fail(TeachSummary s, const std::string& why) {
+  s.usable = false;
+  s.message = why;
+  return s;
+}
+
+// The golden curves' common grid, or an empty vector with the reason in *why.
+bool CommonGrid(const std::vector<const GoldenUnit*>& units, std::string* why) {
+  const Frf& first = units.front()->curve;
+  for (const GoldenUnit* u : units) {
+    const Frf& c = u->curve;
+    std::string bad;
+    if (c.size() == 0) {
+      *why = "golden unit " + u->label + " has no curve";
+      return false;
+    }
+    if (!c.Validate(&bad)) {
+      *why = "golden unit " + u->label + ": curve: " + bad;
+      return false;
+    }
+    bool same = c.size() == first.size();
+    for (std::size_t k = 0; same && k < c.size(); ++k)
+      same = std::abs(c.freq_hz[k] - first.freq_hz[k]) <= 1e-9 * first.freq_hz[k];
+    if (!same) {
+      *why = "golden unit " + u->label + ": curve is not on the frequency grid of " +
+             units.front()->label + " (" + std::to_string(first.size()) + " lines " +
+             Num(first.freq_hz.front()) + "-" + Num(first.freq_hz.back()) + " Hz)";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool TeachOptions::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (method != "tolerance_interval" && method != "mad")
+    return fail("method must be tolerance_interval or mad (got " + method + ")");
+  if (!(confidence > 0.5 && confidence < 1.0)) return fail("confidence must be in (0.5, 1)");
+  if (!(coverage > 0.5 && coverage < 1.0)) return fail("coverage must be in (0.5, 1)");
+  if (!(outlier_z >= 2.0)) return fail("outlier_z must be at least 2");
+  if (!(width_margin > 0.0)) return fail("width_margin must be positive");
+  if (mask_segments < 0 || mask_segments > 200) return fail("mask_segments must be in [0, 200]");
+  if (!(mask_guard_sigma >= 0.0)) return fail("mask_guard_sigma must not be negative");
+  if (!(marginal_scales >= 0.0)) return fail("marginal_scales must not be negative");
+  return true;
+}
+
+TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
+                         const std::vector<GoldenUnit>& golden, const TeachOptions& o) {
+  TeachSummary s;
+  s.units_given = static_cast<int>(golden.size());
+  std::string why;
+  if (!o.IsValid(&why)) return Fail(s, "teach options: " + why);
+  if (declared.empty()) return Fail(s, "the recipe declares no scalar limit to teach");
+  const bool robust = o.method == "mad";
+
+  // Every golden unit must carry every declared measurement, finite.
+  for (const GoldenUnit& u : golden)
+    for (const MeasurementSpec& d : declared) {
+      const auto it = u.values.find(d.name);
+      if (it == u.values.end() || !std::isfinite(it->second))
+        return Fail(s, "golden unit " + u.label + " has no finite value of " + d.name);
+    }
+
+  // Outliers: robust z over all given units, any measurement.
+  std::set<std::size_t> out;
+  for (const MeasurementSpec& d : declared) {
+    std::vector<double> v;
+    for (const GoldenUnit& u : golden) v.push_back(u.values.at(d.name));
+    if (v.size() < 3) break;
+    const double med = Median(v);
+    const double sc = RobustScale(v, med);
+    if (!(sc > 0.0)) continue;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const double z = std::abs(v[i] - med) / sc;
+      if (z > o.outlier_z && out.insert(i).second)
+        s.rejected.push_back(golden[i].label + ": " + d.name + " = " + Num(v[i]) +
+                             ", robust z = " + Num(z));
+    }
+  }
+  std::vector<const GoldenUnit*> used;
+  for (std::size_t i = 0; i < golden.size(); ++i)
+    if (!out.count(i)) used.push_back(&golden[i]);
+  s.units_used = static_cast<int>(used.size());
+  const double n = static_cast<double>(used.size());
+  const double n_eff = robust ? kMadEfficiency * n : n;
+  if (n_eff < 2.0 || used.size() < 3)
+    return Fail(s, "too few golden units: " + std::to_string(used.size()) + " used of " +
+                       std::to_string(golden.size()) +
+                       (robust ? " (method mad needs at least 6)" : " (at least 3 needed)"));
+
+  // Masks only when every used unit has a curve on one grid with enough lines.
+  bool with_mask = o.mask_segments > 0;
+  std::string mask_note;
+  if (with_mask) {
+    if (!CommonGrid(used, &why)) {
+      with_mask = false;
+      mask_note = "; no mask taught: " + why;
+    } else if (used.front()->curve.size() < 2 * static_cast<std::size_t>(o.mask_segments)) {
+      with_mask = false;
+      mask_note = "; no mask taught: fewer than 2 lines per segment";
+    }
+  }
+
+  // Runs of mask lines: outside the band where the good units' resonance may lie.
+  struct Run {
+    std::string name;
+    std::size_t a = 0, b = 0;  // [a, b) of the grid's lines
+    std::size_t segments = 0;
+  };
+  std::vector<Run> runs;
+  if (with_mask) {
+    const Frf& grid = used.front()->curve;
+    double ex_lo = INFINITY, ex_hi = -INFINITY;
+    bool resonance = true;
+    std::vector<double> bandwidths;
+    for (const GoldenUnit* u : used) {
+      const auto f0 = u->values.find("resonance_f_hz"), q = u->values.find("resonance_q");
+      if (f0 == u->values.end() || q == u->values.end() || !(q->second > 0.0)) {
+        resonance = false;
+        break;
+      }
+      ex_lo = std::min(ex_lo, f0->second);
+      ex_hi = std::max(ex_hi, f0->second);
+      bandwidths.push_back(f0->second / q->second);
+    }
+    if (resonance) {
+      const double w = 5.0 * Median(bandwidths) + 0.5 * (ex_hi - ex_lo);
+      ex_lo -= w;
+      ex_hi += w;
+      std::size_t k = 0;
+      while (k < grid.size() && grid.freq_hz[k] < ex_lo) ++k;
+      runs.push_back(Run{"re_z_taught_below", 0, k, 0});
+      std::size_t j = k;
+      while (j < grid.size() && grid.freq_hz[j] <= ex_hi) ++j;
+      runs.push_back(Run{"re_z_taught_above", j, grid.size(), 0});
+      mask_note = "; masks exclude " + Num(ex_lo) + "-" + Num(ex_hi) +
+                  " Hz, where the good units' resonance lies (judged by its scalar limits)";
+    } else {
+      runs.push_back(Run{"re_z_taught", 0, grid.size(), 0});
+    }
+    std::erase_if(runs, [](const Run& r) { return r.b < r.a + 4; });
+    std::size_t total = 0;
+    for (const Run& r : runs) total += r.b - r.a;
+    for (Run& r : runs)
+      r.segments = std::clamp<std::size_t>(
+          static_cast<std::size_t>(
+              std::lround(static_cast<double>(o.mask_segments) * static_cast<double>(r.b - r.a) /
+                          static_cast<double>(total))),
+          1, (r.b - r.a) / 2);
+    if (runs.empty()) {
+      with_mask = false;
+      mask_note = "; no mask taught: the resonance band covers the whole curve";
+    }
+  }
+
+  s.bounds = 0;
+  for (const MeasurementSpec& d : declared) s.bounds += (d.limit.lo ? 1 : 0) + (d.limit.hi ? 1 : 0);
+  for (const Run& r : runs) s.bounds += 2 * static_cast<int>(r.segments);
+  s.p_bound = 1.0 - 2.0 * (1.0 - o.coverage) / s.bounds;
+  s.k_factor = ToleranceFactorTwoSided(n_eff, s.p_bound, o.confidence);
+  const int needed = ToleranceUnitsNeeded(s.p_bound, o.confidence, o.width_margin);
+  s.units_needed = robust ? static_cast<int>(std::ceil(needed / kMadEfficiency)) : needed;
+  s.units_needed_distribution_free = WilksUnitsNeeded(s.p_bound, o.confidence);
+
+  for (const MeasurementSpec& d : declared) {
+    std::vector<double> v;
+    for (const GoldenUnit* u : used) v.push_back(u->values.at(d.name));
+    const CentreScale cs = CentreAndScale(v, robust);
+    if (!(cs.scale > 0.0))
+      return Fail(s, "no spread in " + d.name + " among the golden units (" +
+                         std::to_string(used.size()) +
+                         " units, all equal?): a limit cannot be learned from it");
+    TaughtStatistic t{d.name, cs.centre, cs.scale, cs.centre - s.k_factor * cs.scale,
+                      cs.centre + s.k_factor * cs.scale};
+    MeasurementSpec spec = d;
+    if (d.limit.lo) spec.limit.lo = Round6(t.lo);
+    if (d.limit.hi) spec.limit.hi = Round6(t.hi);
+    spec.limit.marginal = Round6(o.marginal_scales * cs.scale);
+    s.limits.push_back(spec);
+    s.statistics.push_back(t);
+  }
+
+  for (const Run& run : runs) {
+    const Frf& grid = used.front()->curve;
+    const std::size_t lines = run.b - run.a, segs = run.segments;
+    CurveMask mask;
+    mask.name = run.name;
+    mask.quantity = MaskQuantity::kReOhm;
+    mask.guard_sigma = o.mask_guard_sigma;
+    mask.max_lines_outside = 0;
+    for (std::size_t g = 0; g < segs; ++g) {
+      const std::size_t a = run.a + g * lines / segs, b = run.a + (g + 1) * lines / segs;
+      std::vector<double> maxima, minima;
+      for (const GoldenUnit* u : used) {
+        double mx = -INFINITY, mn = INFINITY;
+        for (std::size_t k = a; k < b; ++k) {
+          mx = std::max(mx, u->curve.value[k].real());
+          mn = std::min(mn, u->curve.value[k].real());
+        }
+        maxima.push_back(mx);
+        minima.push_back(mn);
+      }
+      const CentreScale hi = CentreAndScale(maxima, robust), lo = CentreAndScale(minima, robust);
+      const std::string band = "[" + Num(grid.freq_hz[a]) + "-" + Num(grid.freq_hz[b - 1]) + " Hz]";
+      TaughtStatistic th{mask.name + band + " max", hi.centre, hi.scale,
+                         hi.centre - s.k_factor * hi.scale, hi.centre + s.k_factor * hi.scale};
+      TaughtStatistic tl{mask.name + band + " min", lo.centre, lo.scale,
+                         lo.centre - s.k_factor * lo.scale, lo.centre + s.k_factor * lo.scale};
+      s.statistics.push_back(th);
+      s.statistics.push_back(tl);
+      double hi_v = Round6(th.hi), lo_v = Round6(tl.lo);
+      if (!(hi_v > lo_v)) hi_v = lo_v + 1e-6;  // degenerate (no spread): keep the mask valid
+      for (std::size_t k : {a, b - 1})
+        mask.points.push_back(MaskPoint{grid.freq_hz[k], lo_v, hi_v});
+    }
+    if (!mask.IsValid(&why)) return Fail(s, "taught mask " + mask.name + " is not valid: " + why);
+    s.masks.push_back(mask);
+  }
+
+  s.usable = true;
+  s.message =
+      std::string("method ") + o.method + ", " + std::to_string(s.units_used) + " of " +
+      std::to_string(s.units_given) + " golden units used (" + std::to_string(s.rejected.size()) +
+      " rejected as outliers), coverage " + Num(o.coverage) + " of good units over " +
+      std::to_string(s.bounds) + " bounds (" + Num(s.p_bound) + " each) at confidence " +
+      Num(o.confidence) + ": k = " + Num(s.k_factor) + "; " + std::to_string(s.units_needed) +
+      " units needed for limits within " + Num(100 * o.width_margin) + " % of a known spread (" +
+      std::to_string(s.units_needed_distribution_free) + " distribution-free)" + mask_note;
+  if (s.units_used < s.units_needed)
+    s.message += "; WARNING: fewer golden units than needed, the limits are wide";
+  return s;
+}
+
+}  // namespace eol::analysis

@@ -1,0 +1,209 @@
+// `eol detectability --recipe R [--gap gap.json | --k-fixture K] [--golden FILES...] [--json]`:
+// where each defect class shows in the real fixture and whether the recipe's measurement can
+// tell it from good units (analysis/qc/detectability.h). The fixture stiffness comes from the
+// gap diagnosis (`eol gap --json`: params.k_fixture_nm_per_rad of fixture_compliance) or
+// --k-fixture, and is applied as the chain's fixture spring; without either the chain's
+// default fixture is used. The good units' spread comes from --golden (standard deviation of
+// each measurement), else from the recipe's two-sided limits taken as +-limit_sigmas.
+// Exit: 0 analysed (warnings on stdout), 1 not analysable, 2 usage/file error.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "analysis/qc/detectability.h"
+#include "station/cli/commands.h"
+#include "station/cli/common.h"
+#include "station/cli/golden_inputs.h"
+#include "station/recipe.h"
+
+namespace eol::station::cli {
+namespace {
+
+using nlohmann::json;
+
+struct DetectArgs {
+  std::string recipe = DefaultRecipePath();
+  std::string gap;
+  double k_fixture = 0.0;
+  std::vector<std::string> golden;
+  double limit_sigmas = 3.0;
+  double required_sigmas = 3.0;
+  bool json = false;
+};
+
+double KFixtureFromGap(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot be read");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::exception& e) {
+    throw std::runtime_error(path + ": not JSON: " + e.what());
+  }
+  const json* p = j.contains("params") ? &j.at("params") : nullptr;
+  if (!p || !p->contains("k_fixture_nm_per_rad") || !p->at("k_fixture_nm_per_rad").is_number())
+    throw std::runtime_error(path +
+                             ": /params/k_fixture_nm_per_rad is missing: the gap diagnosis "
+                             "did not name fixture_compliance (effect: " +
+                             j.value("effect", std::string("?")) + "); give --k-fixture");
+  const double k = p->at("k_fixture_nm_per_rad").get<double>();
+  if (!(k > 0.0 && std::isfinite(k)))
+    throw std::runtime_error(path + ": /params/k_fixture_nm_per_rad must be positive");
+  return k;
+}
+
+std::map<std::string, double> SpreadFromGolden(const std::vector<analysis::GoldenUnit>& units) {
+  std::map<std::string, std::vector<double>> v;
+  for (const auto& u : units)
+    for (const auto& [name, x] : u.values) v[name].push_back(x);
+  std::map<std::string, double> sd;
+  for (const auto& [name, xs] : v) {
+    if (xs.size() < 3) continue;
+    double m = 0.0, ss = 0.0;
+    for (double x : xs) m += x;
+    m /= static_cast<double>(xs.size());
+    for (double x : xs) ss += (x - m) * (x - m);
+    sd[name] = std::sqrt(ss / static_cast<double>(xs.size() - 1));
+  }
+  return sd;
+}
+
+std::string G(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+int RunDetect(const DetectArgs& a) {
+  if (!a.gap.empty() && a.k_fixture > 0.0)
+    throw std::runtime_error("give either --gap or --k-fixture, not both");
+  const Recipe r = LoadRecipe(a.recipe);
+  analysis::DetectabilityOptions o;
+  o.excitation = r.excitation;
+  o.periods = r.periods;
+  o.transient_periods = r.transient_periods;
+  o.fit = r.analysis.fit;
+  o.required_sigmas = a.required_sigmas;
+  std::string source = "the chain's default fixture";
+  if (!a.gap.empty()) {
+    o.rotor.fixture->stiffness_nm_per_rad = KFixtureFromGap(a.gap);
+    source = "gap diagnosis " + a.gap;
+  } else if (a.k_fixture > 0.0) {
+    o.rotor.fixture->stiffness_nm_per_rad = a.k_fixture;
+    source = "--k-fixture";
+  }
+  std::string spread_source;
+  if (!a.golden.empty()) {
+    std::vector<std::string> skipped;
+    o.unit_spread = SpreadFromGolden(ReadGoldenUnits(a.golden, r, &skipped));
+    spread_source = std::to_string(a.golden.size()) + " golden file(s)";
+  } else {
+    for (const auto& l : r.limits)
+      if (l.limit.lo && l.limit.hi)
+        o.unit_spread[l.name] = (*l.limit.hi - *l.limit.lo) / (2.0 * a.limit_sigmas);
+    spread_source = "the recipe's limits as +-" + G(a.limit_sigmas) + " sigma";
+  }
+  const analysis::DetectabilitySummary s = analysis::PredictDetectability(o);
+  if (!s.usable) {
+    std::cerr << "eol detectability: " << s.message << std::endl;
+    if (a.json) std::cout << json{{"usable", false}, {"error", s.message}}.dump() << std::endl;
+    return 1;
+  }
+  if (a.json) {
+    json classes = json::array();
+    for (const auto& c : s.classes) {
+      json ms = json::array();
+      for (const auto& m : c.measurements)
+        ms.push_back({{"name", m.name},
+                      {"good", m.good},
+                      {"defect", m.defect},
+                      {"sigma", m.sigma},
+                      {"spread", m.spread},
+                      {"separation", m.separation},
+                      {"recommended_limit", m.recommended_limit},
+                      {"limit_side", m.limit_is_lo ? "lo" : "hi"},
+                      {"miss_probability", m.miss_probability}});
+      classes.push_back({{"defect", c.defect},
+                         {"fit_usable", c.fit_usable},
+                         {"f0_hz", c.f0_hz},
+                         {"q", c.q},
+                         {"rp_ohm", c.rp_ohm},
+                         {"chi2_per_dof", c.chi2_per_dof},
+                         {"curve_separation", c.curve_separation},
+                         {"best", c.best},
+                         {"best_separation", c.best_separation},
+                         {"separable", c.separable},
+                         {"remedies", c.remedies},
+                         {"measurements", ms}});
+    }
+    std::cout << json{{"usable", true},
+                      {"k_fixture_nm_per_rad", s.k_fixture_nm_per_rad},
+                      {"k_fixture_source", source},
+                      {"spread_source", spread_source},
+                      {"required_sigmas", a.required_sigmas},
+                      {"f0_good_hz", s.f0_good_hz},
+                      {"q_good", s.q_good},
+                      {"chi2_good", s.chi2_good},
+                      {"dof", s.dof},
+                      {"classes", classes},
+                      {"message", s.message}}
+                     .dump()
+              << std::endl;
+    return 0;
+  }
+  std::cout << "detectability (" << r.id << " v" << r.version << "): " << s.message << "\n"
+            << "fixture from " << source << "; good-unit spread from " << spread_source << "\n";
+  std::printf("%-18s %8s %6s %8s %9s  %-16s %6s  %s\n", "defect", "f0 Hz", "Q", "chi2/dof",
+              "curve S", "best", "sep", "recommended limit (miss)");
+  for (const auto& c : s.classes) {
+    std::string rec = "-";
+    for (const auto& m : c.measurements)
+      if (m.name == c.best)
+        rec = std::string(m.limit_is_lo ? "lo " : "hi ") + G(m.recommended_limit) + " (" +
+              G(100.0 * m.miss_probability) + " % pass)";
+    std::printf("%-18s %8.2f %6.1f %8.3f %9.1f  %-16s %6.1f  %s\n", c.defect.c_str(), c.f0_hz, c.q,
+                c.chi2_per_dof, c.curve_separation, c.best.c_str(), c.best_separation, rec.c_str());
+  }
+  for (const auto& c : s.classes) {
+    if (c.separable) continue;
+    std::cout << "WARNING: " << c.defect << " cannot be told apart from good units with this "
+              << "fixture and excitation (best " << c.best << ", " << G(c.best_separation)
+              << " sigma < " << G(a.required_sigmas) << ")\n";
+    for (const auto& rem : c.remedies) std::cout << "  - " << rem << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+void AddDetectabilityCommand(CLI::App& app) {
+  auto args = std::make_shared<DetectArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "detectability",
+      "Predict where each defect class (one, two, half, all soft magnets; weak bonds at 0.1-0.9\n"
+      "of their stiffness) shows in the real fixture, compare it with the good units' spread\n"
+      "and the measurement's sigma, report the separation and the recommended limit, and warn\n"
+      "with a remedy (stiffer clamp, longer measurement, another phase pair) when a class\n"
+      "cannot be told apart. Exit: 0 analysed, 1 not analysable, 2 usage or file error.");
+  cmd->add_option("--recipe", args->recipe, "Recipe: excitation, analysis, limits")
+      ->capture_default_str()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--gap", args->gap, "`eol gap --json` output with fixture_compliance")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--k-fixture", args->k_fixture, "Fixture stiffness, N m/rad")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--golden", args->golden, "Good units for the spread (as `eol teach`)");
+  cmd->add_option("--limit-sigmas", args->limit_sigmas,
+                  "Without --golden: the recipe's limits are taken as +- this many sigma")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--required-sigmas", args->required_sigmas, "Separation needed")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
+  cmd->callback([args] { RunGuarded("detectability", [&] { return RunDetect(*args); }); });
+}
+
+}  // namespace eol::station::cli

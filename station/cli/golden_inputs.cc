@@ -1,0 +1,132 @@
+#include "station/cli/golden_inputs.h"
+
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "analysis/impedance_analysis.h"
+#include "analysis/qc/measurement_names.h"
+#include "analysis/signal/waveform.h"
+#include "db/test_record.h"
+#include "station/files/measured_input.h"
+
+namespace eol::station::cli {
+namespace {
+
+namespace names = analysis::names;
+
+bool EndsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+analysis::GoldenUnit FromMeasured(const std::string& path, const Recipe& recipe) {
+  files::MeasuredInput in = files::ReadMeasured(path, {});
+  analysis::ImpedanceAnalysis a;
+  if (in.kind == files::MeasuredKind::kFrf) {
+    if (in.frf.quantity != analysis::Quantity::kImpedanceOhm)
+      throw std::runtime_error(path +
+                               ": a golden unit must be an impedance FRF (f_hz,re_ohm,im_ohm)");
+    a = analysis::AnalyzeImpedance(in.frf, recipe.analysis.fit);
+  } else {
+    const analysis::MultisineOptions& e = recipe.excitation;
+    in.recording.period_samples =
+        static_cast<std::size_t>(std::llround(e.sample_rate_hz / e.line_spacing_hz));
+    a = analysis::AnalyzeRecording(in.recording,
+                                   analysis::BandLines(e.f_lo_hz, e.f_hi_hz, e.line_spacing_hz),
+                                   recipe.analysis);
+  }
+  if (!a.usable) throw std::runtime_error(path + ": not analysable: " + a.message);
+  analysis::GoldenUnit u;
+  u.label = path;
+  for (const auto& [name, e] : a.values) u.values[name] = e.value;
+  u.curve = a.frf.frf;
+  return u;
+}
+
+analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string& path) {
+  if (!j.value("usable", false))
+    throw std::runtime_error(path + ": the analysis is not usable (\"usable\": false)");
+  static const std::map<std::string, std::string_view> kParams = {
+      {"f0_hz", names::kResonanceFHz},
+      {"Q", names::kResonanceQ},
+      {"R_ohm", names::kWindingROhm},
+      {"L_h", names::kWindingLH},
+      {"Rp_ohm", names::kMotionalRpOhm}};
+  analysis::GoldenUnit u;
+  u.label = path;
+  for (const auto& [param, name] : kParams) {
+    const auto& p = j.at("params");
+    if (p.contains(param)) u.values[std::string(name)] = p.at(param).at("value").get<double>();
+  }
+  if (j.contains("fit") && j.at("fit").contains("chi2_per_dof"))
+    u.values[std::string(names::kFitChi2PerDof)] = j.at("fit").at("chi2_per_dof").get<double>();
+  return u;
+}
+
+analysis::GoldenUnit FromRecord(const db::TestRecord& r, const std::string& label) {
+  analysis::GoldenUnit u;
+  u.label = label;
+  for (const analysis::Measurement& m : r.measurements) u.values[m.name] = m.value;
+  for (const db::Curve& c : r.curves) {
+    if (c.name != "impedance") continue;
+    u.curve.freq_hz = c.freq_hz;
+    for (std::size_t k = 0; k < c.re.size() && k < c.im.size(); ++k)
+      u.curve.value.emplace_back(c.re[k], c.im[k]);
+    u.curve.sigma = c.sigma;
+    u.curve.method = "record";
+  }
+  return u;
+}
+
+}  // namespace
+
+std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>& paths,
+                                                  const Recipe& recipe,
+                                                  std::vector<std::string>* skipped) {
+  std::vector<analysis::GoldenUnit> units;
+  for (const std::string& path : paths) {
+    if (!EndsWith(path, ".json")) {
+      units.push_back(FromMeasured(path, recipe));
+      continue;
+    }
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error(path + ": cannot be read");
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error(path + ": not JSON: " + e.what());
+    }
+    try {
+      if (j.is_object() && j.contains("params")) {
+        units.push_back(FromAnalyzeJson(j, path));
+      } else if (j.is_array() || (j.is_object() && j.contains("measurements"))) {
+        const nlohmann::json list = j.is_array() ? j : nlohmann::json::array({j});
+        for (std::size_t i = 0; i < list.size(); ++i) {
+          const db::TestRecord r = list[i].get<db::TestRecord>();
+          const std::string label = path + "[" + std::to_string(i) + "] " + r.serial;
+          if (r.outcome == analysis::Outcome::kError || r.outcome == analysis::Outcome::kAborted) {
+            if (skipped) skipped->push_back(label + ": " + analysis::ToString(r.outcome));
+            continue;
+          }
+          units.push_back(FromRecord(r, label));
+        }
+      } else {
+        throw std::runtime_error(
+            "neither `eol analyze --json` output (\"params\") nor `eol export --format json` "
+            "records (\"measurements\")");
+      }
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error(path + ": " + e.what());
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      if (what.rfind(path, 0) == 0) throw;
+      throw std::runtime_error(path + ": " + what);
+    }
+  }
+  if (units.empty()) throw std::runtime_error("no golden unit could be read");
+  return units;
+}
+
+}  // namespace eol::station::cli

@@ -1,0 +1,159 @@
+// `eol production-bench --units N --seed S [--json]`: the production benchmark of learned
+// limits (analysis/production/production_bench.h) with the recipe's excitation, analysis and
+// declared measurements. Prints, per defect class, units and how many each rule passes
+// (escapes) or rejects (false rejects for good units): taught limits, the recipe's own limits,
+// and the naive |Z| peak in a fixed window.
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "analysis/production/production_bench.h"
+#include "station/cli/commands.h"
+#include "station/cli/common.h"
+#include "station/recipe.h"
+
+namespace eol::station::cli {
+namespace {
+
+using nlohmann::json;
+
+struct BenchArgs {
+  std::string recipe = DefaultRecipePath();
+  analysis::ProductionBenchOptions options;
+  bool json = false;
+};
+
+std::string Percent(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f %%", 100.0 * v);
+  return buf;
+}
+
+json SummaryJson(const analysis::ProductionBenchSummary& s, const BenchArgs& a) {
+  json classes = json::array();
+  for (analysis::DefectClass c : analysis::kAllDefectClasses) {
+    json rules = json::object();
+    for (analysis::BenchRule r : analysis::kBenchRules) {
+      const analysis::ClassCounts& k = s.Counts(r, c);
+      rules[analysis::ToString(r)] = {{"pass", k.pass}, {"fail", k.fail}, {"error", k.error}};
+    }
+    classes.push_back({{"class", analysis::ToString(c)},
+                       {"units", s.Counts(analysis::BenchRule::kTaught, c).units},
+                       {"rules", rules}});
+  }
+  json rates = json::object();
+  for (analysis::BenchRule r : analysis::kBenchRules) {
+    json esc = json::object();
+    for (analysis::DefectClass c : analysis::kAllDefectClasses)
+      if (c != analysis::DefectClass::kGood) esc[analysis::ToString(c)] = s.EscapeRate(r, c);
+    rates[analysis::ToString(r)] = {{"false_reject_rate", s.FalseRejectRate(r)},
+                                    {"escape_rate", esc}};
+  }
+  json limits = json::array();
+  for (const auto& l : s.teach.limits)
+    limits.push_back({{"name", l.name},
+                      {"lo", l.limit.lo ? json(*l.limit.lo) : json(nullptr)},
+                      {"hi", l.limit.hi ? json(*l.limit.hi) : json(nullptr)}});
+  return {{"usable", s.usable},
+          {"message", s.message},
+          {"units", s.units},
+          {"seed", a.options.seed},
+          {"golden_units", a.options.golden_units},
+          {"threads", a.options.threads},
+          {"recipe", a.recipe},
+          {"teach",
+           {{"message", s.teach.message},
+            {"units_used", s.teach.units_used},
+            {"k", s.teach.k_factor},
+            {"units_needed", s.teach.units_needed},
+            {"limits", limits}}},
+          {"classes", classes},
+          {"rates", rates},
+          {"seconds", s.seconds},
+          {"golden_seconds", s.golden_seconds},
+          {"ms_per_unit", 1000.0 * s.seconds / std::max(1, s.units + a.options.golden_units)}};
+}
+
+int RunBench(BenchArgs a) {
+  const Recipe r = LoadRecipe(a.recipe);
+  analysis::ProductionBenchOptions& o = a.options;
+  o.excitation = r.excitation;
+  o.periods = r.periods;
+  o.fit = r.analysis.fit;
+  o.declared = r.limits;
+  o.recipe_masks = r.masks;
+  o.naive.search_lo_hz = r.analysis.fit.f0_min_hz;
+  o.naive.search_hi_hz = r.analysis.fit.f0_max_hz;
+  const analysis::ProductionBenchSummary s = analysis::RunProductionBench(o);
+  if (!s.usable) {
+    std::cerr << "eol production-bench: " << s.message << std::endl;
+    if (a.json) std::cout << json{{"usable", false}, {"error", s.message}}.dump() << std::endl;
+    return 1;
+  }
+  if (a.json) {
+    std::cout << SummaryJson(s, a).dump() << std::endl;
+    return 0;
+  }
+  std::cout << "production bench: " << s.units << " units, seed " << o.seed << ", recipe " << r.id
+            << " v" << r.version << "\n"
+            << "teach: " << s.teach.message << "\n";
+  for (const auto& l : s.teach.limits)
+    std::cout << "  " << l.name << ": [" << (l.limit.lo ? json(*l.limit.lo).dump() : "-") << ", "
+              << (l.limit.hi ? json(*l.limit.hi).dump() : "-") << "]\n";
+  std::printf("%-18s %6s | %-22s | %-22s | %-22s\n", "class", "units", "taught pass/fail/err",
+              "recipe pass/fail/err", "naive pass/fail");
+  for (analysis::DefectClass c : analysis::kAllDefectClasses) {
+    const auto& t = s.Counts(analysis::BenchRule::kTaught, c);
+    const auto& h = s.Counts(analysis::BenchRule::kRecipe, c);
+    const auto& n = s.Counts(analysis::BenchRule::kNaive, c);
+    char tb[64], hb[64], nb[64];
+    std::snprintf(tb, sizeof tb, "%d/%d/%d", t.pass, t.fail, t.error);
+    std::snprintf(hb, sizeof hb, "%d/%d/%d", h.pass, h.fail, h.error);
+    std::snprintf(nb, sizeof nb, "%d/%d", n.pass, n.fail);
+    std::printf("%-18s %6d | %-22s | %-22s | %-22s\n", analysis::ToString(c), t.units, tb, hb, nb);
+  }
+  for (analysis::BenchRule rule : analysis::kBenchRules) {
+    std::cout << analysis::ToString(rule) << ": false rejects " << Percent(s.FalseRejectRate(rule))
+              << ", escapes";
+    for (analysis::DefectClass c : analysis::kAllDefectClasses)
+      if (c != analysis::DefectClass::kGood)
+        std::cout << " " << analysis::ToString(c) << " " << Percent(s.EscapeRate(rule, c));
+    std::cout << "\n";
+  }
+  std::printf("time: %.1f s (golden and teaching %.1f s), %.2f ms per unit on %d threads\n",
+              s.seconds, s.golden_seconds,
+              1000.0 * s.seconds / std::max(1, s.units + o.golden_units), o.threads);
+  return 0;
+}
+
+}  // namespace
+
+void AddProductionBenchCommand(CLI::App& app) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "production-bench",
+      "Simulate a production line (magnet, bond, clamp and temperature spread, defect classes at\n"
+      "known rates), teach limits from golden units, judge every unit with the taught limits,\n"
+      "the recipe's own limits and a naive |Z|-peak window, and report escapes per defect class\n"
+      "and false rejects. Exit: 0 done, 1 the benchmark could not run, 2 usage error.");
+  cmd->add_option("--units", args->options.units, "Production units")->capture_default_str();
+  cmd->add_option("--seed", args->options.seed, "Seed of the population and the noise")
+      ->capture_default_str();
+  cmd->add_option("--golden-units", args->options.golden_units, "Good units to teach from")
+      ->capture_default_str();
+  cmd->add_option("--threads", args->options.threads, "Worker threads")->capture_default_str();
+  cmd->add_option("--recipe", args->recipe, "Recipe: excitation, analysis, declared limits")
+      ->capture_default_str()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--confidence", args->options.teach.confidence, "Teaching confidence")
+      ->capture_default_str();
+  cmd->add_option("--coverage", args->options.teach.coverage, "Teaching coverage of good units")
+      ->capture_default_str();
+  cmd->add_option("--method", args->options.teach.method, "tolerance_interval or mad")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"tolerance_interval", "mad"}));
+  cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
+  cmd->callback([args] { RunGuarded("production-bench", [&] { return RunBench(*args); }); });
+}
+
+}  // namespace eol::station::cli

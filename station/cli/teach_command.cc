@@ -1,0 +1,209 @@
+// `eol teach --recipe R --golden FILES... --out R2`: limits learned from good units
+// (analysis/qc/teach.h). The new recipe is R with every declared scalar limit's bounds and
+// marginal band replaced by the learned ones, its masks replaced by the learned Re Z mask
+// (kept when no curve was given), version + 1 and a note in the description. It is validated
+// (ParseRecipe) before it is written, and an existing file is never overwritten without
+// --force. Exit: 0 written, 1 nothing could be learned (reason on stderr), 2 usage/file error.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "station/cli/commands.h"
+#include "station/cli/common.h"
+#include "station/cli/golden_inputs.h"
+#include "station/recipe.h"
+
+namespace eol::station::cli {
+namespace {
+
+using nlohmann::json;
+
+struct TeachArgs {
+  std::string recipe;
+  std::vector<std::string> golden;
+  std::string out;
+  analysis::TeachOptions options;
+  bool force = false;
+  bool json = false;
+};
+
+json MaskJson(const analysis::CurveMask& m) {
+  json points = json::array();
+  for (const analysis::MaskPoint& p : m.points) {
+    json pt = {{"f_hz", p.f_hz}};
+    if (p.lo) pt["lo"] = *p.lo;
+    if (p.hi) pt["hi"] = *p.hi;
+    points.push_back(pt);
+  }
+  return {{"name", m.name},
+          {"quantity", m.quantity == analysis::MaskQuantity::kReOhm ? "re_ohm" : "abs_ohm"},
+          {"max_lines_outside", m.max_lines_outside},
+          {"guard_sigma", m.guard_sigma},
+          {"points", points}};
+}
+
+// The recipe's JSON with the taught limits and masks, version + 1.
+json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
+                      const analysis::TeachOptions& o) {
+  json j = r.source;
+  j["version"] = r.version + 1;
+  for (json& l : j["limits"]) {
+    for (const analysis::MeasurementSpec& spec : s.limits) {
+      if (l.at("name") != spec.name) continue;
+      if (spec.limit.lo) l["lo"] = *spec.limit.lo;
+      if (spec.limit.hi) l["hi"] = *spec.limit.hi;
+      l["marginal"] = spec.limit.marginal;
+    }
+  }
+  if (!s.masks.empty()) {
+    j["masks"] = json::array();
+    for (const analysis::CurveMask& m : s.masks) j["masks"].push_back(MaskJson(m));
+  }
+  const std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
+                           std::to_string(s.units_used) + " golden units (" + o.method +
+                           ", coverage " + json(o.coverage).dump() + ", confidence " +
+                           json(o.confidence).dump() + ", k " + json(s.k_factor).dump() + ").";
+  j["description"] = j.value("description", std::string()) + note;
+  return j;
+}
+
+void WriteNew(const std::string& path, const json& j, bool force) {
+  if (std::filesystem::exists(path) && !force)
+    throw std::runtime_error(path +
+                             " exists: refusing to overwrite it (choose another --out, or "
+                             "--force)");
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw std::runtime_error(tmp + ": cannot be written");
+    f << j.dump(2) << "\n";
+    f.flush();
+    if (!f) throw std::runtime_error(tmp + ": writing failed");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+int RunTeach(const TeachArgs& a) {
+  std::string why;
+  if (!a.options.IsValid(&why)) throw std::runtime_error("options: " + why);
+  const Recipe recipe = LoadRecipe(a.recipe);
+  if (std::filesystem::exists(a.out) && !a.force)
+    throw std::runtime_error(a.out +
+                             " exists: refusing to overwrite it (choose another --out, or "
+                             "--force)");
+  std::vector<std::string> skipped;
+  const std::vector<analysis::GoldenUnit> golden = ReadGoldenUnits(a.golden, recipe, &skipped);
+  const analysis::TeachSummary s = analysis::TeachLimits(recipe.limits, golden, a.options);
+  for (const std::string& k : skipped) std::cerr << "eol teach: skipped " << k << "\n";
+  if (!s.usable) {
+    std::cerr << "eol teach: nothing learned: " << s.message << std::endl;
+    if (a.json) std::cout << json{{"usable", false}, {"error", s.message}}.dump() << std::endl;
+    return 1;
+  }
+  const json taught = TaughtRecipeJson(recipe, s, a.options);
+  const Recipe next = ParseRecipe(taught, a.out);  // validated before anything is written
+  WriteNew(a.out, taught, a.force);
+
+  if (a.json) {
+    json limits = json::array(), stats = json::array();
+    for (const auto& l : s.limits)
+      limits.push_back({{"name", l.name},
+                        {"lo", l.limit.lo ? json(*l.limit.lo) : json(nullptr)},
+                        {"hi", l.limit.hi ? json(*l.limit.hi) : json(nullptr)},
+                        {"marginal", l.limit.marginal}});
+    for (const auto& t : s.statistics)
+      stats.push_back({{"name", t.name}, {"centre", t.centre}, {"scale", t.scale}});
+    json masks = json::array();
+    for (const auto& m : s.masks) masks.push_back(MaskJson(m));
+    std::cout << json{{"usable", true},
+                      {"recipe",
+                       {{"path", a.out},
+                        {"id", next.id},
+                        {"version", next.version},
+                        {"hash", next.hash}}},
+                      {"previous",
+                       {{"path", a.recipe}, {"version", recipe.version}, {"hash", recipe.hash}}},
+                      {"method", a.options.method},
+                      {"confidence", a.options.confidence},
+                      {"coverage", a.options.coverage},
+                      {"bounds", s.bounds},
+                      {"p_bound", s.p_bound},
+                      {"k", s.k_factor},
+                      {"units_given", s.units_given},
+                      {"units_used", s.units_used},
+                      {"units_needed", s.units_needed},
+                      {"units_needed_distribution_free", s.units_needed_distribution_free},
+                      {"rejected", s.rejected},
+                      {"skipped", skipped},
+                      {"limits", limits},
+                      {"masks", masks},
+                      {"statistics", stats},
+                      {"message", s.message}}
+                     .dump()
+              << std::endl;
+    return 0;
+  }
+  std::cout << "teach: " << s.message << "\n";
+  for (const std::string& r : s.rejected) std::cout << "  rejected golden unit " << r << "\n";
+  for (std::size_t i = 0; i < s.limits.size(); ++i) {
+    const auto& old = recipe.limits[i].limit;
+    const auto& now = s.limits[i].limit;
+    auto bound = [](const std::optional<double>& v) {
+      return v ? json(*v).dump() : std::string("-");
+    };
+    std::cout << "  " << s.limits[i].name << ": [" << bound(old.lo) << ", " << bound(old.hi)
+              << "] -> [" << bound(now.lo) << ", " << bound(now.hi) << "], marginal "
+              << now.marginal << " (centre " << s.statistics[i].centre << ", scale "
+              << s.statistics[i].scale << ")\n";
+  }
+  for (const auto& m : s.masks)
+    std::cout << "  mask " << m.name << ": " << m.points.size() / 2 << " segments "
+              << m.points.front().f_hz << "-" << m.points.back().f_hz << " Hz on Re Z, guard "
+              << m.guard_sigma << " sigma\n";
+  std::cout << "units needed for the stated confidence: " << s.units_needed << " ("
+            << s.units_needed_distribution_free << " distribution-free); used " << s.units_used
+            << "\n";
+  std::cout << "wrote " << a.out << ": " << next.id << " v" << next.version << " (was v"
+            << recipe.version << "), sha256 " << next.hash << "\n";
+  return 0;
+}
+
+}  // namespace
+
+void AddTeachCommand(CLI::App& app) {
+  auto args = std::make_shared<TeachArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "teach",
+      "Learn a recipe's limits from good units: tolerance intervals (or median/MAD) for every\n"
+      "declared measurement and a Re Z mask over frequency, at a stated coverage of good units\n"
+      "and confidence. Writes a new recipe version (never overwrites without --force) and\n"
+      "prints its SHA-256 and how many golden units the stated confidence needs.\n"
+      "Golden files: FRF CSV / .zma / recording CSV (analysed with the recipe), `eol analyze\n"
+      "--json` output, or `eol export --format json` records.\n"
+      "Exit: 0 written, 1 nothing could be learned, 2 usage or file error.");
+  cmd->add_option("--recipe", args->recipe, "Recipe whose limits are taught")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--golden", args->golden, "Files of good units")->required()->expected(1, -1);
+  cmd->add_option("--out", args->out, "The new recipe file")->required();
+  cmd->add_option("--confidence", args->options.confidence, "Confidence of the tolerance intervals")
+      ->capture_default_str();
+  cmd->add_option("--coverage", args->options.coverage,
+                  "Share of good units that pass every taught bound together")
+      ->capture_default_str();
+  cmd->add_option("--method", args->options.method, "tolerance_interval or mad")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"tolerance_interval", "mad"}));
+  cmd->add_option("--mask-segments", args->options.mask_segments,
+                  "Segments of the taught Re Z mask (0: keep the recipe's masks)")
+      ->capture_default_str();
+  cmd->add_option("--outlier-z", args->options.outlier_z,
+                  "Robust z beyond which a golden unit is left out")
+      ->capture_default_str();
+  cmd->add_flag("--force", args->force, "Overwrite --out if it exists");
+  cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
+  cmd->callback([args] { RunGuarded("teach", [&] { return RunTeach(*args); }); });
+}
+
+}  // namespace eol::station::cli

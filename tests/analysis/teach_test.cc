@@ -1,0 +1,227 @@
+// Learned limits (analysis/qc/teach.h, tolerance.h): the tolerance factor against known values
+// (computed independently with scipy.stats/integrate: k(30, 0.99, 0.95) = 3.3546,
+// k(10, 0.90, 0.95) = 2.8563; NIST/SEMATECH and Krishnamoorthy-Mathew tables give 3.35 and
+// 2.856), the stated confidence over repeated teaching, outlier rejection, masks from curves
+// and the errors that name the unit or measurement.
+#include "analysis/qc/teach.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "analysis/qc/tolerance.h"
+
+namespace eol::analysis {
+namespace {
+
+TEST(Tolerance, NormalAndChiSquareKnownValues) {
+  EXPECT_NEAR(NormalQuantile(0.975), 1.959963985, 1e-8);
+  EXPECT_NEAR(NormalQuantile(0.00135), -3.0000, 2e-4);
+  EXPECT_NEAR(NormalCdf(NormalQuantile(0.999)), 0.999, 1e-12);
+  EXPECT_NEAR(ChiSquareUpperTail(3.841458821, 1), 0.05, 1e-8);
+  EXPECT_NEAR(ChiSquareUpperTail(18.30703805, 10), 0.05, 1e-8);
+}
+
+TEST(Tolerance, TwoSidedFactorMatchesTables) {
+  EXPECT_NEAR(ToleranceFactorTwoSided(30, 0.99, 0.95), 3.3546, 0.002);
+  EXPECT_NEAR(ToleranceFactorTwoSided(10, 0.90, 0.95), 2.8563, 0.002);
+  // Large n: the known-distribution quantile.
+  EXPECT_NEAR(ToleranceFactorTwoSided(100000, 0.99, 0.95), NormalQuantile(0.995), 0.01);
+  // Fewer units, wider limits.
+  EXPECT_GT(ToleranceFactorTwoSided(10, 0.99, 0.95), ToleranceFactorTwoSided(30, 0.99, 0.95));
+}
+
+TEST(Tolerance, UnitsNeeded) {
+  // Wilks: the range of 59 units covers 95 % with 95 % confidence (one-sided classic is 59;
+  // two-sided range needs 93).
+  EXPECT_EQ(WilksUnitsNeeded(0.95, 0.95), 93);
+  const int n = ToleranceUnitsNeeded(0.99, 0.95, 0.2);
+  EXPECT_LE(ToleranceFactorTwoSided(n, 0.99, 0.95), 1.2 * NormalQuantile(0.995));
+  EXPECT_GT(ToleranceFactorTwoSided(n - 1, 0.99, 0.95), 1.2 * NormalQuantile(0.995));
+}
+
+MeasurementSpec Spec(const std::string& name, bool lo, bool hi) {
+  MeasurementSpec s;
+  s.name = name;
+  if (lo) s.limit.lo = -1e9;
+  if (hi) s.limit.hi = 1e9;
+  return s;
+}
+
+std::vector<GoldenUnit> NormalUnits(int n, std::uint64_t seed, double mean, double sd) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(mean, sd);
+  std::vector<GoldenUnit> units;
+  for (int i = 0; i < n; ++i) {
+    GoldenUnit u;
+    u.label = "unit-" + std::to_string(i);
+    u.values["resonance_f_hz"] = normal(rng);
+    units.push_back(u);
+  }
+  return units;
+}
+
+// Teaching 400 times from 30 normal units: the limits cover at least the stated share of the
+// population in about `confidence` of the repetitions (binomial sd 1.1 %).
+TEST(Teach, StatedConfidenceHoldsOverRepetitions) {
+  TeachOptions o;
+  o.coverage = 0.99;
+  o.confidence = 0.95;
+  o.mask_segments = 0;
+  o.outlier_z = 100.0;  // keep every unit: the statement is about all n
+  int covered = 0;
+  const int reps = 400;
+  for (int r = 0; r < reps; ++r) {
+    const TeachSummary s =
+        TeachLimits({Spec("resonance_f_hz", true, true)}, NormalUnits(30, 1000 + r, 390.0, 4.0), o);
+    ASSERT_TRUE(s.usable) << s.message;
+    const double lo = *s.limits[0].limit.lo, hi = *s.limits[0].limit.hi;
+    const double true_coverage = NormalCdf((hi - 390.0) / 4.0) - NormalCdf((lo - 390.0) / 4.0);
+    covered += true_coverage >= 0.99 ? 1 : 0;
+  }
+  EXPECT_NEAR(static_cast<double>(covered) / reps, 0.95, 0.035);
+}
+
+// Fresh good units pass the taught limits at the stated rate.
+TEST(Teach, FreshUnitsPassAtTheStatedRate) {
+  TeachOptions o;
+  o.coverage = 0.99;
+  o.mask_segments = 0;
+  const TeachSummary s =
+      TeachLimits({Spec("resonance_f_hz", true, true)}, NormalUnits(50, 7, 390.0, 4.0), o);
+  ASSERT_TRUE(s.usable) << s.message;
+  EXPECT_EQ(s.bounds, 2);
+  EXPECT_NEAR(s.p_bound, 0.99, 1e-12);
+  const std::vector<GoldenUnit> fresh = NormalUnits(20000, 8, 390.0, 4.0);
+  int outside = 0;
+  for (const auto& u : fresh) {
+    const double v = u.values.at("resonance_f_hz");
+    outside += (v < *s.limits[0].limit.lo || v > *s.limits[0].limit.hi) ? 1 : 0;
+  }
+  EXPECT_LE(outside / 20000.0, 0.01 + 0.002);  // at most 1 - coverage, up to sampling
+  EXPECT_GT(outside, 0);                       // and not absurdly wide
+  EXPECT_GT(s.limits[0].limit.marginal, 0.0);
+}
+
+TEST(Teach, CoverageIsSharedBetweenBounds) {
+  TeachOptions o;
+  o.mask_segments = 0;
+  std::vector<GoldenUnit> units = NormalUnits(40, 3, 390.0, 4.0);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> q(50.0, 5.0), chi2(1.0, 0.05);
+  for (auto& u : units) {
+    u.values["resonance_q"] = q(rng);
+    u.values["fit_chi2_per_dof"] = chi2(rng);
+  }
+  const TeachSummary s =
+      TeachLimits({Spec("resonance_f_hz", true, true), Spec("resonance_q", true, true),
+                   Spec("fit_chi2_per_dof", false, true)},
+                  units, o);
+  ASSERT_TRUE(s.usable) << s.message;
+  EXPECT_EQ(s.bounds, 5);
+  EXPECT_NEAR(s.p_bound, 1.0 - 2.0 * (1.0 - 0.9973) / 5.0, 1e-12);
+  EXPECT_FALSE(s.limits[2].limit.lo.has_value());  // only the declared side
+  ASSERT_TRUE(s.limits[2].limit.hi.has_value());
+  EXPECT_GT(*s.limits[2].limit.hi, 1.0);
+  EXPECT_GE(s.units_needed, 10);
+  EXPECT_GT(s.units_needed_distribution_free, s.units_needed);
+}
+
+TEST(Teach, RejectsAnOutlierAndNamesIt) {
+  TeachOptions o;
+  o.mask_segments = 0;
+  std::vector<GoldenUnit> units = NormalUnits(30, 11, 390.0, 4.0);
+  units[7].values["resonance_f_hz"] = 350.0;  // a defective unit among the golden ones
+  const TeachSummary s = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
+  ASSERT_TRUE(s.usable) << s.message;
+  ASSERT_EQ(s.rejected.size(), 1u);
+  EXPECT_NE(s.rejected[0].find("unit-7"), std::string::npos) << s.rejected[0];
+  EXPECT_EQ(s.units_used, 29);
+  EXPECT_GT(*s.limits[0].limit.lo, 360.0);
+}
+
+TEST(Teach, MadIsWiderThanTheIntervalForTheSameUnits) {
+  TeachOptions o;
+  o.mask_segments = 0;
+  const auto units = NormalUnits(40, 21, 390.0, 4.0);
+  const TeachSummary t = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
+  o.method = "mad";
+  const TeachSummary m = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
+  ASSERT_TRUE(t.usable && m.usable) << t.message << m.message;
+  EXPECT_GT(m.k_factor, t.k_factor);
+  EXPECT_GT(m.units_needed, t.units_needed);
+}
+
+TEST(Teach, ErrorsNameTheCause) {
+  TeachOptions o;
+  o.mask_segments = 0;
+  auto units = NormalUnits(10, 1, 390.0, 4.0);
+  units[3].values.erase("resonance_f_hz");
+  TeachSummary s = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
+  EXPECT_FALSE(s.usable);
+  EXPECT_NE(s.message.find("unit-3"), std::string::npos) << s.message;
+  units = NormalUnits(10, 1, 390.0, 0.0);
+  s = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
+  EXPECT_FALSE(s.usable);
+  EXPECT_NE(s.message.find("no spread in resonance_f_hz"), std::string::npos) << s.message;
+  s = TeachLimits({Spec("resonance_f_hz", true, true)}, NormalUnits(2, 1, 390.0, 4.0), o);
+  EXPECT_FALSE(s.usable);
+  EXPECT_NE(s.message.find("too few golden units"), std::string::npos) << s.message;
+  o.coverage = 1.5;
+  s = TeachLimits({Spec("resonance_f_hz", true, true)}, NormalUnits(20, 1, 390.0, 4.0), o);
+  EXPECT_FALSE(s.usable);
+  EXPECT_NE(s.message.find("coverage"), std::string::npos) << s.message;
+}
+
+// A resonance curve per unit: Re Z = R + Rp / (1 + Q^2 (f/f0 - f0/f)^2).
+Frf Curve(double f0, double r, std::mt19937_64& rng) {
+  std::normal_distribution<double> noise(0.0, 0.002);
+  Frf z;
+  for (double f = 300.0; f <= 500.0; f += 1.0) {
+    const double x = 50.0 * (f / f0 - f0 / f);
+    z.freq_hz.push_back(f);
+    z.value.emplace_back(r + 0.5 / (1.0 + x * x) + noise(rng), 0.0);
+    z.sigma.push_back(0.002);
+  }
+  return z;
+}
+
+TEST(Teach, MaskFromCurvesPassesGoodAndCatchesAShiftedPeak) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> f0(400.0, 2.0), r(0.5, 0.005);
+  std::vector<GoldenUnit> units = NormalUnits(40, 4, 400.0, 2.0);
+  for (auto& u : units) u.curve = Curve(u.values["resonance_f_hz"], r(rng), rng);
+  TeachOptions o;
+  o.mask_segments = 8;
+  const TeachSummary s = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
+  ASSERT_TRUE(s.usable) << s.message;
+  ASSERT_EQ(s.masks.size(), 1u);
+  EXPECT_EQ(s.masks[0].points.size(), 16u);
+  EXPECT_EQ(s.bounds, 2 + 16);
+  std::string why;
+  EXPECT_TRUE(s.masks[0].IsValid(&why)) << why;
+  int good_outside = 0;
+  for (int i = 0; i < 200; ++i)
+    good_outside += CheckMask(Curve(f0(rng), r(rng), rng), s.masks[0]).lines_outside > 0;
+  EXPECT_LE(good_outside, 1);
+  EXPECT_GT(CheckMask(Curve(360.0, 0.5, rng), s.masks[0]).lines_outside, 0);
+  // With Q known, the resonance band is left to the scalar limits: two masks around it.
+  for (auto& u : units) u.values["resonance_q"] = 50.0;
+  const TeachSummary q = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
+  ASSERT_TRUE(q.usable) << q.message;
+  ASSERT_EQ(q.masks.size(), 2u);
+  EXPECT_LT(q.masks[0].points.back().f_hz, 390.0);
+  EXPECT_GT(q.masks[1].points.front().f_hz, 410.0);
+  EXPECT_EQ(q.masks[0].points.size() + q.masks[1].points.size(), 16u);
+  EXPECT_GT(CheckMask(Curve(330.0, 0.5, rng), q.masks[0]).lines_outside, 0);
+  // A unit on another grid: no mask, and the reason names it.
+  units[5].curve.freq_hz[0] = 299.5;
+  const TeachSummary t = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
+  ASSERT_TRUE(t.usable);
+  EXPECT_TRUE(t.masks.empty());
+  EXPECT_NE(t.message.find("unit-5"), std::string::npos) << t.message;
+}
+
+}  // namespace
+}  // namespace eol::analysis

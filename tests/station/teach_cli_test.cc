@@ -1,0 +1,178 @@
+// `eol teach` through the built binary: golden FRFs made by `eol simulate` (the default motor,
+// different noise seeds and magnet defects), a new recipe version with its hash, refusal to
+// overwrite, limits that pass a fresh good unit and fail a poorly cemented one, and errors
+// that name the file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "../support/child_process.h"
+#include "db/test_record.h"
+#include "station/recipe.h"
+
+namespace eol {
+namespace {
+
+using namespace std::chrono_literals;
+using eol::testing::ChildProcess;
+
+const std::string kMotor = std::string(EOL_SOURCE_DIR) + "/recipes/motors/pmsm-10pole.json";
+const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json";
+
+struct CliRun {
+  int code = -1;
+  std::string output;
+};
+
+CliRun Eol(std::vector<std::string> args, bool merge_stderr = true) {
+  args.insert(args.begin(), EOL_BINARY);
+  ChildProcess p(args, merge_stderr);
+  const auto code = p.Wait(300s);
+  return CliRun{code.value_or(-1), p.output()};
+}
+
+std::string Simulated(const eol::testing::TempDir& dir, const std::string& name, int seed,
+                      const std::string& defect, double noise_scale) {
+  const std::string out = dir / name;
+  const CliRun r =
+      Eol({"simulate", "--motor", kMotor, "--out", out, "--defect", defect, "--seed",
+           std::to_string(seed), "--model", "steady_state", "--noise-v",
+           std::to_string(2e-3 * noise_scale), "--noise-a", std::to_string(1e-3 * noise_scale)});
+  EXPECT_EQ(r.code, 0) << r.output;
+  return out;
+}
+
+class TeachCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // Spread among the golden units: noise, at four levels (the same motor otherwise).
+    for (int i = 0; i < 12; ++i)
+      golden_.push_back(
+          Simulated(dir_, "g" + std::to_string(i) + ".csv", 100 + i, "none", 1.0 + 0.5 * (i % 4)));
+  }
+  std::vector<std::string> TeachArgs(const std::string& out) {
+    std::vector<std::string> a = {"teach", "--recipe", kRecipe, "--out", out, "--golden"};
+    a.insert(a.end(), golden_.begin(), golden_.end());
+    return a;
+  }
+  eol::testing::TempDir dir_;
+  std::vector<std::string> golden_;
+};
+
+TEST_F(TeachCli, WritesANewVersionAndRefusesToOverwrite) {
+  const std::string out = dir_ / "taught.json";
+  CliRun r = Eol(TeachArgs(out));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const station::Recipe before = station::LoadRecipe(kRecipe);
+  const station::Recipe after = station::LoadRecipe(out);
+  EXPECT_EQ(after.version, before.version + 1);
+  EXPECT_EQ(after.id, before.id);
+  EXPECT_NE(after.hash, before.hash);
+  EXPECT_NE(r.output.find("sha256 " + after.hash), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("units needed for the stated confidence:"), std::string::npos);
+  // The limits changed to the golden units' spread: f0 limits around the motor's 390 Hz, far
+  // narrower than the hand-set 370-420 (the golden units differ by noise only).
+  const auto& f0 = after.limits[0];
+  ASSERT_EQ(f0.name, "resonance_f_hz");
+  EXPECT_GT(*f0.limit.lo, 380.0);
+  EXPECT_LT(*f0.limit.hi, 400.0);
+  EXPECT_LT(*f0.limit.lo, 390.0);
+  EXPECT_GT(*f0.limit.hi, 389.0);
+  // Masks below and above the resonance band (the scalar limits judge the band itself).
+  ASSERT_EQ(after.masks.size(), 2u);
+  EXPECT_EQ(after.masks[0].name, "re_z_taught_below");
+  EXPECT_EQ(after.masks[1].name, "re_z_taught_above");
+  EXPECT_LT(after.masks[0].points.back().f_hz, 385.0);
+  EXPECT_GT(after.masks[1].points.front().f_hz, 395.0);
+
+  // Never overwrite silently.
+  const auto mtime = std::filesystem::last_write_time(out);
+  r = Eol(TeachArgs(out));
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find(out + " exists: refusing to overwrite"), std::string::npos) << r.output;
+  EXPECT_EQ(std::filesystem::last_write_time(out), mtime);
+  std::vector<std::string> forced = TeachArgs(out);
+  forced.push_back("--force");
+  r = Eol(forced);
+  EXPECT_EQ(r.code, 0) << r.output;
+
+  // A fresh good unit passes the taught recipe; one with every magnet poorly cemented fails.
+  const std::string fresh = Simulated(dir_, "fresh.csv", 999, "none", 1.0);
+  r = Eol({"analyze", "--measured", fresh, "--recipe", out, "--json"}, false);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(r.output)["verdict"]["outcome"], "PASS") << r.output;
+  const std::string bad = Simulated(dir_, "bad.csv", 998, "all_soft", 1.0);
+  r = Eol({"analyze", "--measured", bad, "--recipe", out, "--json"}, false);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(r.output)["verdict"]["outcome"], "FAIL") << r.output;
+}
+
+TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
+  std::vector<std::string> args = {"teach",         "--recipe", kRecipe,   "--out",
+                                   dir_ / "j.json", "--json",   "--golden"};
+  for (std::size_t i = 0; i < 6; ++i) {
+    const CliRun a = Eol({"analyze", "--measured", golden_[i], "--json"}, false);
+    ASSERT_EQ(a.code, 0) << a.output;
+    const std::string path = dir_ / ("a" + std::to_string(i) + ".json");
+    std::ofstream(path) << a.output;
+    args.push_back(path);
+  }
+  const CliRun r = Eol(args, false);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["units_used"], 6);
+  EXPECT_EQ(j["recipe"]["version"], 2);
+  EXPECT_EQ(j["masks"].size(), 0u);  // no curves in analyze --json: the recipe's mask stays
+  EXPECT_EQ(station::LoadRecipe(dir_ / "j.json").masks[0].name, "re_z_low_band");
+  EXPECT_GT(j["units_needed"].get<int>(), 6);
+}
+
+// `eol export --format json` records: every finished record is a golden unit, ERROR records
+// are skipped and listed.
+TEST_F(TeachCli, ReadsExportedRecords) {
+  nlohmann::json list = nlohmann::json::array();
+  const char* names[] = {"resonance_f_hz", "resonance_q", "winding_r_ohm", "winding_l_h",
+                         "fit_chi2_per_dof"};
+  for (int i = 0; i < 10; ++i) {
+    db::TestRecord r;
+    r.serial = "SN" + std::to_string(i);
+    r.outcome = i == 4 ? analysis::Outcome::kError : analysis::Outcome::kPass;
+    const double values[] = {390.0 + 0.7 * (i % 5) - 1.4, 50.0 + (i % 3), 0.5 + 0.002 * (i % 4),
+                             2e-3 * (1.0 + 0.01 * (i % 2)), 1.0 + 0.02 * (i % 3)};
+    for (int k = 0; k < 5 && i != 4; ++k) {
+      analysis::Measurement m;
+      m.name = names[k];
+      m.value = values[k];
+      r.measurements.push_back(m);
+    }
+    list.push_back(r);
+  }
+  const std::string path = dir_ / "export.json";
+  std::ofstream(path) << list.dump(1);
+  const CliRun r = Eol({"teach", "--recipe", kRecipe, "--out", dir_ / "e.json", "--golden", path});
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("skipped " + path + "[4] SN4: ERROR"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("9 of 9 golden units used"), std::string::npos) << r.output;
+  const station::Recipe taught = station::LoadRecipe(dir_ / "e.json");
+  EXPECT_LT(*taught.limits[0].limit.lo, 388.6);
+  EXPECT_GT(*taught.limits[0].limit.hi, 391.4);
+}
+
+TEST_F(TeachCli, ErrorsNameTheFile) {
+  const std::string junk = dir_ / "junk.json";
+  std::ofstream(junk) << "{\"hello\": 1}";
+  CliRun r = Eol({"teach", "--recipe", kRecipe, "--out", dir_ / "x.json", "--golden", junk});
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find(junk), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x.json"));
+  r = Eol(
+      {"teach", "--recipe", kRecipe, "--out", dir_ / "x.json", "--golden", golden_[0], golden_[1]});
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("too few golden units"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x.json"));
+}
+
+}  // namespace
+}  // namespace eol
