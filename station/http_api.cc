@@ -3,10 +3,13 @@
 #include <httplib.h>
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
 #include "db/store.h"
+#include "station/qc_service.h"
 #include "station/serial_number.h"
 #include "station/stats_report.h"
 
@@ -222,6 +225,93 @@ void HttpApi::Routes() {
       report = StatsReport(*db_, q);
     }
     SendJson(res, 200, report);
+  });
+
+  s.Get("/api/detectability", [this](const httplib::Request& req, httplib::Response& res) {
+    double k_fixture = 0.0, limit_sigmas = 3.0, required_sigmas = 3.0;
+    for (auto [name, target] : {std::pair<const char*, double*>{"k_fixture", &k_fixture},
+                                {"limit_sigmas", &limit_sigmas},
+                                {"required_sigmas", &required_sigmas}}) {
+      if (!req.has_param(name)) continue;
+      const std::string v = req.get_param_value(name);
+      char* end = nullptr;
+      const double x = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !(x > 0.0) || !std::isfinite(x))
+        return SendError(res, 400, "bad_parameter",
+                         std::string(name) + " must be a positive number, got '" + v + "'");
+      *target = x;
+    }
+    const auto recipe = handlers_.current_recipe();
+    const analysis::DetectabilitySummary summary = analysis::PredictDetectability(
+        DetectabilityOptionsFor(*recipe, k_fixture, limit_sigmas, required_sigmas));
+    const std::string source = k_fixture > 0.0 ? "k_fixture parameter" : "the chain's default fixture";
+    nlohmann::json body = DetectabilityJson(summary, source,
+                                            "the recipe's limits as +-" +
+                                                nlohmann::json(limit_sigmas).dump() + " sigma",
+                                            required_sigmas);
+    body["recipe"] = {{"id", recipe->id}, {"version", recipe->version}, {"hash", recipe->hash}};
+    SendJson(res, summary.usable ? 200 : 422, body);
+  });
+
+  s.Post("/api/teach", [this](const httplib::Request& req, httplib::Response& res) {
+    const ApiToken* who = FindToken(options_.tokens, req);
+    if (!who) return SendError(res, 401, "unauthorized", "an engineer's bearer token is required");
+    if (who->role != "engineer")
+      return SendError(res, 403, "forbidden", "only engineers may teach limits");
+    nlohmann::json body;
+    try {
+      body = nlohmann::json::parse(req.body);
+    } catch (const std::exception&) {
+      return SendError(res, 400, "bad_json", "request body is not JSON");
+    }
+    if (!body.is_object() || !body.contains("serials") || !body["serials"].is_array() ||
+        body["serials"].empty())
+      return SendError(res, 400, "bad_request", "body must be {\"serials\": [\"...\", ...]}");
+    analysis::TeachOptions options;
+    try {
+      options.method = body.value("method", options.method);
+      options.confidence = body.value("confidence", options.confidence);
+      options.coverage = body.value("coverage", options.coverage);
+    } catch (const std::exception& e) {
+      return SendError(res, 400, "bad_request", std::string("options: ") + e.what());
+    }
+    std::string why;
+    if (!options.IsValid(&why)) return SendError(res, 400, "bad_request", "options: " + why);
+    std::vector<analysis::GoldenUnit> golden;
+    nlohmann::json skipped = nlohmann::json::array();
+    {
+      std::lock_guard<std::mutex> lock(db_mu_);
+      for (const auto& s : body["serials"]) {
+        if (!s.is_string() || !ValidSerial(s.get<std::string>(), &why))
+          return SendError(res, 400, "bad_serial", "serials: " + s.dump() + ": " + why);
+        const std::string serial = s.get<std::string>();
+        const auto latest = db_->LatestOfSerial(serial);
+        if (!latest || latest->outcome == analysis::Outcome::kError ||
+            latest->outcome == analysis::Outcome::kAborted) {
+          skipped.push_back(serial + (latest ? ": latest test is " +
+                                                   std::string(analysis::ToString(latest->outcome))
+                                             : ": no test stored"));
+          continue;
+        }
+        const auto full = db_->Test(latest->id, true);
+        if (full) golden.push_back(GoldenFromRecord(*full, serial));
+      }
+    }
+    const auto recipe = handlers_.current_recipe();
+    const analysis::TeachSummary summary = analysis::TeachLimits(recipe->limits, golden, options);
+    nlohmann::json answer = TeachSummaryJson(summary, options);
+    answer["skipped"] = skipped;
+    answer["previous"] = {{"id", recipe->id}, {"version", recipe->version}, {"hash", recipe->hash}};
+    if (!summary.usable) return SendJson(res, 422, answer);
+    const nlohmann::json proposed = TaughtRecipeJson(*recipe, summary, options);
+    try {
+      const Recipe checked = ParseRecipe(proposed, "taught recipe");
+      answer["recipe"] = proposed;
+      answer["recipe_hash"] = checked.hash;
+    } catch (const std::exception& e) {
+      return SendError(res, 422, "invalid_recipe", e.what());
+    }
+    SendJson(res, 200, answer);
   });
 
   s.Post("/api/tests", [this](const httplib::Request& req, httplib::Response& res) {

@@ -11,6 +11,13 @@
 //   GET  /api/recipe            the recipe in use with its hash (limits and masks)
 //   GET  /api/stats?from=&to=&recipe_hash=&gauge=&reference=NAME=VALUE&sigma_span=
 //                               capability, drift alarms, gauge study (station/stats_report.h)
+//   GET  /api/detectability?k_fixture=&limit_sigmas=&required_sigmas=
+//                               where each defect class shows with this recipe and fixture
+//                               (station/qc_service.h; k_fixture from the gap diagnosis)
+//   POST /api/teach             {"serials": [...], "method", "confidence", "coverage"}: limits
+//                               learned from those units' latest stored tests; returns the
+//                               proposed recipe (version + 1) and the summary; engineer
+//                               token; nothing changes until the recipe is PUT
 //   GET  /metrics               Prometheus text: tests by outcome, state, last resonance
 //   GET  /                      the operator page (station/web)
 //
@@ -28,6 +35,7 @@
 #include <vector>
 
 #include "station/config.h"
+#include "station/recipe.h"
 #include "station/status_board.h"
 
 namespace httplib {
@@ -55,6 +63,8 @@ struct HttpHandlers {
   std::function<bool(const std::string& serial, std::string* why)> start_test;
   // The recipe in use as JSON, with its "hash".
   std::function<nlohmann::json()> recipe;
+  // The recipe in use, parsed (teaching and detectability work from it).
+  std::function<std::shared_ptr<const Recipe>()> current_recipe;
   // Validates, stores and activates a new recipe version; returns the HTTP status and body.
   std::function<std::pair<int, nlohmann::json>(const nlohmann::json& recipe, const ApiToken& who)>
       change_recipe;

@@ -64,6 +64,7 @@ void Station::StartHttp(const std::string& web_root) {
     j["hash"] = r->hash;
     return j;
   };
+  h.current_recipe = [this] { return recipe(); };
   h.change_recipe = [this](const nlohmann::json& j, const ApiToken& who) {
     return ChangeRecipe(j, who);
   };

@@ -16,6 +16,7 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/golden_inputs.h"
+#include "station/qc_service.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {
@@ -80,30 +81,22 @@ int RunDetect(const DetectArgs& a) {
   if (!a.gap.empty() && a.k_fixture > 0.0)
     throw std::runtime_error("give either --gap or --k-fixture, not both");
   const Recipe r = LoadRecipe(a.recipe);
-  analysis::DetectabilityOptions o;
-  o.excitation = r.excitation;
-  o.periods = r.periods;
-  o.transient_periods = r.transient_periods;
-  o.fit = r.analysis.fit;
-  o.required_sigmas = a.required_sigmas;
   std::string source = "the chain's default fixture";
+  double k_fixture = 0.0;
   if (!a.gap.empty()) {
-    o.rotor.fixture->stiffness_nm_per_rad = KFixtureFromGap(a.gap);
+    k_fixture = KFixtureFromGap(a.gap);
     source = "gap diagnosis " + a.gap;
   } else if (a.k_fixture > 0.0) {
-    o.rotor.fixture->stiffness_nm_per_rad = a.k_fixture;
+    k_fixture = a.k_fixture;
     source = "--k-fixture";
   }
-  std::string spread_source;
+  analysis::DetectabilityOptions o =
+      DetectabilityOptionsFor(r, k_fixture, a.limit_sigmas, a.required_sigmas);
+  std::string spread_source = "the recipe's limits as +-" + G(a.limit_sigmas) + " sigma";
   if (!a.golden.empty()) {
     std::vector<std::string> skipped;
     o.unit_spread = SpreadFromGolden(ReadGoldenUnits(a.golden, r, &skipped));
     spread_source = std::to_string(a.golden.size()) + " golden file(s)";
-  } else {
-    for (const auto& l : r.limits)
-      if (l.limit.lo && l.limit.hi)
-        o.unit_spread[l.name] = (*l.limit.hi - *l.limit.lo) / (2.0 * a.limit_sigmas);
-    spread_source = "the recipe's limits as +-" + G(a.limit_sigmas) + " sigma";
   }
   const analysis::DetectabilitySummary s = analysis::PredictDetectability(o);
   if (!s.usable) {
@@ -112,44 +105,7 @@ int RunDetect(const DetectArgs& a) {
     return 1;
   }
   if (a.json) {
-    json classes = json::array();
-    for (const auto& c : s.classes) {
-      json ms = json::array();
-      for (const auto& m : c.measurements)
-        ms.push_back({{"name", m.name},
-                      {"good", m.good},
-                      {"defect", m.defect},
-                      {"sigma", m.sigma},
-                      {"spread", m.spread},
-                      {"separation", m.separation},
-                      {"recommended_limit", m.recommended_limit},
-                      {"limit_side", m.limit_is_lo ? "lo" : "hi"},
-                      {"miss_probability", m.miss_probability}});
-      classes.push_back({{"defect", c.defect},
-                         {"fit_usable", c.fit_usable},
-                         {"f0_hz", c.f0_hz},
-                         {"q", c.q},
-                         {"rp_ohm", c.rp_ohm},
-                         {"chi2_per_dof", c.chi2_per_dof},
-                         {"curve_separation", c.curve_separation},
-                         {"best", c.best},
-                         {"best_separation", c.best_separation},
-                         {"separable", c.separable},
-                         {"remedies", c.remedies},
-                         {"measurements", ms}});
-    }
-    std::cout << json{{"usable", true},
-                      {"k_fixture_nm_per_rad", s.k_fixture_nm_per_rad},
-                      {"k_fixture_source", source},
-                      {"spread_source", spread_source},
-                      {"required_sigmas", a.required_sigmas},
-                      {"f0_good_hz", s.f0_good_hz},
-                      {"q_good", s.q_good},
-                      {"chi2_good", s.chi2_good},
-                      {"dof", s.dof},
-                      {"classes", classes},
-                      {"message", s.message}}
-                     .dump()
+    std::cout << DetectabilityJson(s, source, spread_source, a.required_sigmas).dump()
               << std::endl;
     return 0;
   }

@@ -9,6 +9,7 @@
 #include "analysis/qc/measurement_names.h"
 #include "analysis/signal/waveform.h"
 #include "db/test_record.h"
+#include "station/qc_service.h"
 #include "station/files/measured_input.h"
 
 namespace eol::station::cli {
@@ -64,21 +65,6 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
   return u;
 }
 
-analysis::GoldenUnit FromRecord(const db::TestRecord& r, const std::string& label) {
-  analysis::GoldenUnit u;
-  u.label = label;
-  for (const analysis::Measurement& m : r.measurements) u.values[m.name] = m.value;
-  for (const db::Curve& c : r.curves) {
-    if (c.name != "impedance") continue;
-    u.curve.freq_hz = c.freq_hz;
-    for (std::size_t k = 0; k < c.re.size() && k < c.im.size(); ++k)
-      u.curve.value.emplace_back(c.re[k], c.im[k]);
-    u.curve.sigma = c.sigma;
-    u.curve.method = "record";
-  }
-  return u;
-}
-
 }  // namespace
 
 std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>& paths,
@@ -110,7 +96,7 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
             if (skipped) skipped->push_back(label + ": " + analysis::ToString(r.outcome));
             continue;
           }
-          units.push_back(FromRecord(r, label));
+          units.push_back(GoldenFromRecord(r, label));
         }
       } else {
         throw std::runtime_error(

@@ -12,6 +12,7 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/golden_inputs.h"
+#include "station/qc_service.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {
@@ -27,46 +28,6 @@ struct TeachArgs {
   bool force = false;
   bool json = false;
 };
-
-json MaskJson(const analysis::CurveMask& m) {
-  json points = json::array();
-  for (const analysis::MaskPoint& p : m.points) {
-    json pt = {{"f_hz", p.f_hz}};
-    if (p.lo) pt["lo"] = *p.lo;
-    if (p.hi) pt["hi"] = *p.hi;
-    points.push_back(pt);
-  }
-  return {{"name", m.name},
-          {"quantity", m.quantity == analysis::MaskQuantity::kReOhm ? "re_ohm" : "abs_ohm"},
-          {"max_lines_outside", m.max_lines_outside},
-          {"guard_sigma", m.guard_sigma},
-          {"points", points}};
-}
-
-// The recipe's JSON with the taught limits and masks, version + 1.
-json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
-                      const analysis::TeachOptions& o) {
-  json j = r.source;
-  j["version"] = r.version + 1;
-  for (json& l : j["limits"]) {
-    for (const analysis::MeasurementSpec& spec : s.limits) {
-      if (l.at("name") != spec.name) continue;
-      if (spec.limit.lo) l["lo"] = *spec.limit.lo;
-      if (spec.limit.hi) l["hi"] = *spec.limit.hi;
-      l["marginal"] = spec.limit.marginal;
-    }
-  }
-  if (!s.masks.empty()) {
-    j["masks"] = json::array();
-    for (const analysis::CurveMask& m : s.masks) j["masks"].push_back(MaskJson(m));
-  }
-  const std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
-                           std::to_string(s.units_used) + " golden units (" + o.method +
-                           ", coverage " + json(o.coverage).dump() + ", confidence " +
-                           json(o.confidence).dump() + ", k " + json(s.k_factor).dump() + ").";
-  j["description"] = j.value("description", std::string()) + note;
-  return j;
-}
 
 void WriteNew(const std::string& path, const json& j, bool force) {
   if (std::filesystem::exists(path) && !force)
@@ -106,41 +67,11 @@ int RunTeach(const TeachArgs& a) {
   WriteNew(a.out, taught, a.force);
 
   if (a.json) {
-    json limits = json::array(), stats = json::array();
-    for (const auto& l : s.limits)
-      limits.push_back({{"name", l.name},
-                        {"lo", l.limit.lo ? json(*l.limit.lo) : json(nullptr)},
-                        {"hi", l.limit.hi ? json(*l.limit.hi) : json(nullptr)},
-                        {"marginal", l.limit.marginal}});
-    for (const auto& t : s.statistics)
-      stats.push_back({{"name", t.name}, {"centre", t.centre}, {"scale", t.scale}});
-    json masks = json::array();
-    for (const auto& m : s.masks) masks.push_back(MaskJson(m));
-    std::cout << json{{"usable", true},
-                      {"recipe",
-                       {{"path", a.out},
-                        {"id", next.id},
-                        {"version", next.version},
-                        {"hash", next.hash}}},
-                      {"previous",
-                       {{"path", a.recipe}, {"version", recipe.version}, {"hash", recipe.hash}}},
-                      {"method", a.options.method},
-                      {"confidence", a.options.confidence},
-                      {"coverage", a.options.coverage},
-                      {"bounds", s.bounds},
-                      {"p_bound", s.p_bound},
-                      {"k", s.k_factor},
-                      {"units_given", s.units_given},
-                      {"units_used", s.units_used},
-                      {"units_needed", s.units_needed},
-                      {"units_needed_distribution_free", s.units_needed_distribution_free},
-                      {"rejected", s.rejected},
-                      {"skipped", skipped},
-                      {"limits", limits},
-                      {"masks", masks},
-                      {"statistics", stats},
-                      {"message", s.message}}
-                     .dump()
+    json out = TeachSummaryJson(s, a.options);
+    out["recipe"] = {{"path", a.out}, {"id", next.id}, {"version", next.version}, {"hash", next.hash}};
+    out["previous"] = {{"path", a.recipe}, {"version", recipe.version}, {"hash", recipe.hash}};
+    out["skipped"] = skipped;
+    std::cout << out.dump()
               << std::endl;
     return 0;
   }

@@ -1,0 +1,147 @@
+#include "station/qc_service.h"
+
+namespace eol::station {
+
+using nlohmann::json;
+
+json MaskJson(const analysis::CurveMask& m) {
+  json points = json::array();
+  for (const analysis::MaskPoint& p : m.points) {
+    json pt = {{"f_hz", p.f_hz}};
+    if (p.lo) pt["lo"] = *p.lo;
+    if (p.hi) pt["hi"] = *p.hi;
+    points.push_back(pt);
+  }
+  return {{"name", m.name},
+          {"quantity", m.quantity == analysis::MaskQuantity::kReOhm ? "re_ohm" : "abs_ohm"},
+          {"max_lines_outside", m.max_lines_outside},
+          {"guard_sigma", m.guard_sigma},
+          {"points", points}};
+}
+
+json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
+                      const analysis::TeachOptions& o) {
+  json j = r.source;
+  j["version"] = r.version + 1;
+  for (json& l : j["limits"]) {
+    for (const analysis::MeasurementSpec& spec : s.limits) {
+      if (l.at("name") != spec.name) continue;
+      if (spec.limit.lo) l["lo"] = *spec.limit.lo;
+      if (spec.limit.hi) l["hi"] = *spec.limit.hi;
+      l["marginal"] = spec.limit.marginal;
+    }
+  }
+  if (!s.masks.empty()) {
+    j["masks"] = json::array();
+    for (const analysis::CurveMask& m : s.masks) j["masks"].push_back(MaskJson(m));
+  }
+  const std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
+                           std::to_string(s.units_used) + " golden units (" + o.method +
+                           ", coverage " + json(o.coverage).dump() + ", confidence " +
+                           json(o.confidence).dump() + ", k " + json(s.k_factor).dump() + ").";
+  j["description"] = j.value("description", std::string()) + note;
+  return j;
+}
+
+json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOptions& o) {
+  json limits = json::array(), stats = json::array(), masks = json::array();
+  for (const auto& l : s.limits)
+    limits.push_back({{"name", l.name},
+                      {"lo", l.limit.lo ? json(*l.limit.lo) : json(nullptr)},
+                      {"hi", l.limit.hi ? json(*l.limit.hi) : json(nullptr)},
+                      {"marginal", l.limit.marginal}});
+  for (const auto& t : s.statistics)
+    stats.push_back({{"name", t.name}, {"centre", t.centre}, {"scale", t.scale}});
+  for (const auto& m : s.masks) masks.push_back(MaskJson(m));
+  return {{"usable", s.usable},
+          {"method", o.method},
+          {"confidence", o.confidence},
+          {"coverage", o.coverage},
+          {"bounds", s.bounds},
+          {"p_bound", s.p_bound},
+          {"k", s.k_factor},
+          {"units_given", s.units_given},
+          {"units_used", s.units_used},
+          {"units_needed", s.units_needed},
+          {"units_needed_distribution_free", s.units_needed_distribution_free},
+          {"rejected", s.rejected},
+          {"limits", limits},
+          {"masks", masks},
+          {"statistics", stats},
+          {"message", s.message}};
+}
+
+analysis::GoldenUnit GoldenFromRecord(const db::TestRecord& r, const std::string& label) {
+  analysis::GoldenUnit u;
+  u.label = label;
+  for (const analysis::Measurement& m : r.measurements) u.values[m.name] = m.value;
+  for (const db::Curve& c : r.curves) {
+    if (c.name != "impedance") continue;
+    u.curve.freq_hz = c.freq_hz;
+    for (std::size_t k = 0; k < c.re.size() && k < c.im.size(); ++k)
+      u.curve.value.emplace_back(c.re[k], c.im[k]);
+    u.curve.sigma = c.sigma;
+    u.curve.method = "record";
+  }
+  return u;
+}
+
+analysis::DetectabilityOptions DetectabilityOptionsFor(const Recipe& r, double k_fixture_nm_per_rad,
+                                                       double limit_sigmas,
+                                                       double required_sigmas) {
+  analysis::DetectabilityOptions o;
+  o.excitation = r.excitation;
+  o.periods = r.periods;
+  o.transient_periods = r.transient_periods;
+  o.fit = r.analysis.fit;
+  o.required_sigmas = required_sigmas;
+  if (k_fixture_nm_per_rad > 0.0) o.rotor.fixture->stiffness_nm_per_rad = k_fixture_nm_per_rad;
+  for (const auto& l : r.limits)
+    if (l.limit.lo && l.limit.hi)
+      o.unit_spread[l.name] = (*l.limit.hi - *l.limit.lo) / (2.0 * limit_sigmas);
+  return o;
+}
+
+json DetectabilityJson(const analysis::DetectabilitySummary& s, const std::string& source,
+                       const std::string& spread_source, double required_sigmas) {
+  if (!s.usable) return {{"usable", false}, {"error", s.message}};
+  json classes = json::array();
+  for (const auto& c : s.classes) {
+    json ms = json::array();
+    for (const auto& m : c.measurements)
+      ms.push_back({{"name", m.name},
+                    {"good", m.good},
+                    {"defect", m.defect},
+                    {"sigma", m.sigma},
+                    {"spread", m.spread},
+                    {"separation", m.separation},
+                    {"recommended_limit", m.recommended_limit},
+                    {"limit_side", m.limit_is_lo ? "lo" : "hi"},
+                    {"miss_probability", m.miss_probability}});
+    classes.push_back({{"defect", c.defect},
+                       {"fit_usable", c.fit_usable},
+                       {"f0_hz", c.f0_hz},
+                       {"q", c.q},
+                       {"rp_ohm", c.rp_ohm},
+                       {"chi2_per_dof", c.chi2_per_dof},
+                       {"curve_separation", c.curve_separation},
+                       {"best", c.best},
+                       {"best_separation", c.best_separation},
+                       {"separable", c.separable},
+                       {"remedies", c.remedies},
+                       {"measurements", ms}});
+  }
+  return {{"usable", true},
+          {"k_fixture_nm_per_rad", s.k_fixture_nm_per_rad},
+          {"k_fixture_source", source},
+          {"spread_source", spread_source},
+          {"required_sigmas", required_sigmas},
+          {"f0_good_hz", s.f0_good_hz},
+          {"q_good", s.q_good},
+          {"chi2_good", s.chi2_good},
+          {"dof", s.dof},
+          {"classes", classes},
+          {"message", s.message}};
+}
+
+}  // namespace eol::station

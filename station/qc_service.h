@@ -1,0 +1,43 @@
+// Learning limits and predicting detectability, shared by the CLI (`eol teach`,
+// `eol detectability`) and the HTTP API (POST /api/teach, GET /api/detectability), so both
+// give the same recipe and the same report.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/qc/detectability.h"
+#include "analysis/qc/teach.h"
+#include "db/test_record.h"
+#include "station/recipe.h"
+
+namespace eol::station {
+
+nlohmann::json MaskJson(const analysis::CurveMask& mask);
+
+// The recipe's JSON with the taught limits and masks, version + 1, a note in the description.
+nlohmann::json TaughtRecipeJson(const Recipe& recipe, const analysis::TeachSummary& summary,
+                                const analysis::TeachOptions& options);
+
+// The summary as JSON: usable, bounds, k, units given/used/needed, rejected, limits, masks.
+nlohmann::json TeachSummaryJson(const analysis::TeachSummary& summary,
+                                const analysis::TeachOptions& options);
+
+// A stored test as a golden unit: its measurements and its "impedance" curve.
+analysis::GoldenUnit GoldenFromRecord(const db::TestRecord& record, const std::string& label);
+
+// Detectability options for the recipe's excitation and fit; `k_fixture_nm_per_rad` > 0
+// replaces the chain's fixture spring; the good-unit spread is the recipe's two-sided limits
+// taken as +-limit_sigmas (override unit_spread afterwards for a measured spread).
+analysis::DetectabilityOptions DetectabilityOptionsFor(const Recipe& recipe,
+                                                       double k_fixture_nm_per_rad,
+                                                       double limit_sigmas,
+                                                       double required_sigmas);
+
+nlohmann::json DetectabilityJson(const analysis::DetectabilitySummary& summary,
+                                 const std::string& k_fixture_source,
+                                 const std::string& spread_source, double required_sigmas);
+
+}  // namespace eol::station

@@ -1,0 +1,155 @@
+// Teaching and detectability over the HTTP API: an engineer teaches limits from stored good
+// units (POST /api/teach returns a proposed recipe, version + 1, that the station accepts when
+// it is PUT), operators may not; GET /api/detectability reports every defect class for the
+// recipe in use and the fixture stiffness given.
+#include <httplib.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <regex>
+#include <thread>
+
+#include "tests/support/child_process.h"
+
+namespace eol {
+namespace {
+
+using namespace std::chrono_literals;
+using eol::testing::ChildProcess;
+
+constexpr char kOperator[] = "operator-token-0123456789";
+constexpr char kEngineer[] = "engineer-token-0123456789";
+
+int PortFromReadyLine(const std::string& out) {
+  std::smatch m;
+  static const std::regex re("ready, .* http://127\\.0\\.0\\.1:([0-9]+)/");
+  return std::regex_search(out, m, re) ? std::stoi(m[1]) : 0;
+}
+
+httplib::Headers Bearer(const char* token) {
+  return {{"Authorization", std::string("Bearer ") + token}};
+}
+
+class QcApi : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::filesystem::copy_file(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json",
+                               dir_ / "pmsm-10pole.json");
+    std::ofstream(dir_ / "station.json") << nlohmann::json{
+        {"station_id", "qc-api"},
+        {"recipe", "pmsm-10pole.json"},
+        {"db", "s.sqlite"},
+        {"http",
+         {{"listen", "127.0.0.1"},
+          {"port", 0},
+          {"tokens", {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
+                      {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
+        {"fixture", {{"driver", "sim"}}},
+        {"daq", {{"driver", "sim"}}},
+        {"sim", {{"clamp_close_s", 0.02}, {"clamp_open_s", 0.02},
+                 {"population", {{"defect_share", 0.0}, {"seed", 5}}}}}}.dump();
+    station_ = std::make_unique<ChildProcess>(
+        std::vector<std::string>{EOL_BINARY, "station", "--config", dir_ / "station.json"});
+    ASSERT_TRUE(station_->WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; },
+                                  30s))
+        << station_->output();
+    http_ = std::make_unique<httplib::Client>("127.0.0.1", PortFromReadyLine(station_->output()));
+    http_->set_read_timeout(120, 0);
+  }
+
+  // Runs a test of `serial` and waits for its verdict.
+  std::string Test(const std::string& serial) {
+    const auto res = http_->Post("/api/tests", Bearer(kOperator),
+                                 nlohmann::json{{"serial", serial}}.dump(), "application/json");
+    if (!res || res->status != 202) return "not started";
+    for (int i = 0; i < 600; ++i) {
+      const auto unit = http_->Get(("/api/units/" + serial).c_str());
+      if (unit && unit->status == 200) {
+        const auto tests = nlohmann::json::parse(unit->body)["tests"];
+        if (!tests.empty() && !tests.front()["finished_at"].get<std::string>().empty())
+          return tests.front()["outcome"];
+      }
+      std::this_thread::sleep_for(50ms);
+    }
+    return "timeout";
+  }
+
+  eol::testing::TempDir dir_;
+  std::unique_ptr<ChildProcess> station_;
+  std::unique_ptr<httplib::Client> http_;
+};
+
+TEST_F(QcApi, EngineersTeachFromStoredUnitsAndTheProposalIsAValidNextVersion) {
+  nlohmann::json serials = nlohmann::json::array();
+  for (int i = 0; i < 8; ++i) {
+    const std::string serial = "GOLD-" + std::to_string(i);
+    ASSERT_EQ(Test(serial), "PASS") << station_->output();
+    serials.push_back(serial);
+  }
+  serials.push_back("NEVER-TESTED");
+  const std::string body = nlohmann::json{{"serials", serials}}.dump();
+
+  auto res = http_->Post("/api/teach", body, "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 401);
+  res = http_->Post("/api/teach", Bearer(kOperator), body, "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 403);
+  res = http_->Post("/api/teach", Bearer(kEngineer), "{\"serials\": []}", "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400);
+
+  res = http_->Post("/api/teach", Bearer(kEngineer), body, "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const auto taught = nlohmann::json::parse(res->body);
+  EXPECT_EQ(taught["units_used"], 8);
+  ASSERT_EQ(taught["skipped"].size(), 1u);
+  EXPECT_NE(taught["skipped"][0].get<std::string>().find("NEVER-TESTED: no test stored"),
+            std::string::npos);
+  EXPECT_EQ(taught["recipe"]["version"], 2);
+  // The learned resonance window is centred on the golden units (all near 390 Hz) and, with
+  // only 8 of them, wide: the summary says how many units the stated confidence needs.
+  bool saw_f0 = false;
+  for (const auto& l : taught["recipe"]["limits"]) {
+    if (l["name"] != "resonance_f_hz") continue;
+    saw_f0 = true;
+    EXPECT_LT(l["lo"].get<double>(), 389.0);
+    EXPECT_GT(l["hi"].get<double>(), 391.0);
+    EXPECT_NEAR(0.5 * (l["lo"].get<double>() + l["hi"].get<double>()), 390.0, 5.0);
+  }
+  EXPECT_TRUE(saw_f0);
+  EXPECT_GT(taught["units_needed"].get<int>(), 8);
+  // Nothing changed yet; PUT makes it the recipe in use, and the next test is judged with it.
+  EXPECT_EQ(nlohmann::json::parse(http_->Get("/api/recipe")->body)["version"], 1);
+  res = http_->Put("/api/recipe", Bearer(kEngineer), taught["recipe"].dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const auto in_use = nlohmann::json::parse(http_->Get("/api/recipe")->body);
+  EXPECT_EQ(in_use["version"], 2);
+  EXPECT_EQ(in_use["hash"], taught["recipe_hash"]);
+  EXPECT_EQ(Test("AFTER-TEACH"), "PASS");
+}
+
+TEST_F(QcApi, DetectabilityReportsEveryDefectClassAndRejectsBadParameters) {
+  auto res = http_->Get("/api/detectability?k_fixture=abc");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400);
+  EXPECT_NE(res->body.find("k_fixture must be a positive number"), std::string::npos);
+
+  res = http_->Get("/api/detectability?k_fixture=864");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const auto report = nlohmann::json::parse(res->body);
+  EXPECT_DOUBLE_EQ(report["k_fixture_nm_per_rad"].get<double>(), 864.0);
+  EXPECT_EQ(report["recipe"]["id"], "pmsm-10pole");
+  bool all_soft_separable = false;
+  for (const auto& c : report["classes"])
+    if (c["defect"] == "all_soft") all_soft_separable = c["separable"].get<bool>();
+  EXPECT_TRUE(all_soft_separable) << report.dump();
+  EXPECT_NEAR(report["f0_good_hz"].get<double>(), 390.0, 5.0);
+}
+
+}  // namespace
+}  // namespace eol
