@@ -226,8 +226,27 @@ TEST_F(CanFixtureTest, StopsAnsweringNamesTheTimeoutAndDropsTheRelay) {
   bench_->InjectFault(SimFault::kStopsAnswering, 0ms, /*on_excitation=*/false);
   const Status w = fixture.Write(FixtureOutput::kLampFail, true);
   ASSERT_FALSE(w.ok());
-  EXPECT_CONTAINS(w.message(), "write lamp_fail = 1: no status frame 0x181 from node 1");
+  EXPECT_CONTAINS(w.message(), "write lamp_fail=1: command frame 0x201 (lamp_fail = 1): no "
+                               "status frame 0x181 from node 1");
   EXPECT_CONTAINS(w.message(), "(confirm_timeout_ms)");
+}
+
+TEST_F(CanFixtureTest, LampWriteNeverReenergisesADroppedRelay) {
+  StartNode();
+  CanFixture fixture(settings_);
+  ASSERT_TRUE(fixture.Connect().ok());
+  ASSERT_TRUE(fixture.Activate().ok());
+  ASSERT_TRUE(fixture.Write(FixtureOutput::kExcitationEnable, true).ok());
+  bench_->InjectFault(SimFault::kStopsAnswering, 0ms, /*on_excitation=*/false);
+  ASSERT_FALSE(ReadUntilError(fixture).ok());
+  ASSERT_FALSE(bench_->excitation_connected());
+  bench_->ClearFaults();  // the controller comes back; the fixture is in kError
+  ASSERT_EQ(fixture.lifecycle(), Lifecycle::kError);
+  const Status s = fixture.Write(FixtureOutput::kLampFail, true);  // allowed in kError
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_TRUE(bench_->output(FixtureOutput::kLampFail));
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable))
+      << "a lamp write re-energised the excitation relay";
 }
 
 TEST_F(CanFixtureTest, MalformedStatusFrameIsNamed) {
