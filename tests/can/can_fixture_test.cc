@@ -159,7 +159,8 @@ TEST_F(CanFixtureTest, PressureScaleIsTheDrivers) {
 
 TEST_F(CanFixtureTest, OtherNodeIdAndIdsFromConfig) {
   nlohmann::json config = R"({
-    "fixture": {"driver": "socketcan", "interface": "can9", "node_id": 5, "status_timeout_ms": 300, "confirm_timeout_ms": 1000,
+    "fixture": {"driver": "socketcan", "interface": "can9", "node_id": 5,
+                "status_timeout_ms": 300, "confirm_timeout_ms": 1000,
                 "map": {"status_base_id": 1024, "clamp_pressure": {"byte": 6},
                         "pressure_bar_per_count": 0.01}},
     "daq": {"driver": "sim"}})"_json;
@@ -198,8 +199,10 @@ TEST_F(CanFixtureTest, HeartbeatFreezesNamesTheTimeout) {
   bench_->InjectFault(SimFault::kHeartbeatFreezes, 0ms, /*on_excitation=*/false);
   const Status s = ReadUntilError(fixture);
   ASSERT_FALSE(s.ok()) << "reads kept succeeding with a frozen heartbeat";
-  EXPECT_CONTAINS(s.message(), "fixture 'socketcan': read inputs: no heartbeat frame 0x701 "
-                               "from node 1 on " + std::string(kInterface));
+  EXPECT_CONTAINS(s.message(),
+                  "fixture 'socketcan': read inputs: no heartbeat frame 0x701 "
+                  "from node 1 on " +
+                      std::string(kInterface));
   EXPECT_CONTAINS(s.message(), "(heartbeat_timeout_ms 600)");
   EXPECT_EQ(fixture.lifecycle(), Lifecycle::kError);
 }
@@ -226,8 +229,9 @@ TEST_F(CanFixtureTest, StopsAnsweringNamesTheTimeoutAndDropsTheRelay) {
   bench_->InjectFault(SimFault::kStopsAnswering, 0ms, /*on_excitation=*/false);
   const Status w = fixture.Write(FixtureOutput::kLampFail, true);
   ASSERT_FALSE(w.ok());
-  EXPECT_CONTAINS(w.message(), "write lamp_fail=1: command frame 0x201 (lamp_fail = 1): no "
-                               "status frame 0x181 from node 1");
+  EXPECT_CONTAINS(w.message(),
+                  "write lamp_fail=1: command frame 0x201 (lamp_fail = 1): no "
+                  "status frame 0x181 from node 1");
   EXPECT_CONTAINS(w.message(), "(confirm_timeout_ms)");
 }
 
@@ -296,10 +300,10 @@ class BusOffPort final : public CanPort {
 TEST_F(CanFixtureTest, BusOffErrorFrameFailsReadsAndWrites) {
   StartNode();
   auto bus_off = std::make_shared<std::atomic<bool>>(false);
-  CanFixture fixture(settings_, [bus_off](const std::string& ifname,
-                                          const std::vector<CanFilter>& filters) {
-    return std::make_unique<BusOffPort>(SocketCanPortFactory()(ifname, filters), bus_off);
-  });
+  CanFixture fixture(
+      settings_, [bus_off](const std::string& ifname, const std::vector<CanFilter>& filters) {
+        return std::make_unique<BusOffPort>(SocketCanPortFactory()(ifname, filters), bus_off);
+      });
   ASSERT_TRUE(fixture.Connect().ok());
   ASSERT_TRUE(fixture.ReadInputs().ok());
   *bus_off = true;
@@ -354,8 +358,10 @@ TEST(CanMapTest, BadMapsAreNamed) {
             "bytes");
   EXPECT_EQ(error(R"({"status_base_id": 512})"_json).rfind("/fixture/map: the command, status", 0),
             0u);
-  EXPECT_EQ(error(R"({"clamped": {"byte": 9}})"_json).rfind("/fixture/map/clamped/byte: must be "
-                                                            "in 0..7", 0),
+  EXPECT_EQ(error(R"({"clamped": {"byte": 9}})"_json)
+                .rfind("/fixture/map/clamped/byte: must be "
+                       "in 0..7",
+                       0),
             0u);
   EXPECT_CONTAINS(error(R"({"clampd": 3})"_json), "/fixture/map/clampd");
   EXPECT_CONTAINS(error(R"({"clampd": 3})"_json), "known: command_base_id");

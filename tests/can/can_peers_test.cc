@@ -51,7 +51,8 @@ std::string Peer() { return std::string(EOL_SOURCE_DIR) + "/tests/peers/can_fixt
   for (const char* tool : {"/usr/bin/cansend", "/usr/bin/candump"})
     if (access(tool, X_OK) != 0)
       return ::testing::AssertionFailure()
-             << tool << " not found: can-utils is a declared dependency (apt-get install can-utils)";
+             << tool
+             << " not found: can-utils is a declared dependency (apt-get install can-utils)";
   return ::testing::AssertionSuccess();
 }
 
@@ -144,8 +145,8 @@ TEST(CanPeersTest, DriverNamesAFrozenPeerHeartbeat) {
   ASSERT_TRUE(fixture.Connect().ok());
   const Status s = ReadUntilError(fixture);
   ASSERT_FALSE(s.ok()) << "reads kept succeeding after the peer's heartbeat stopped";
-  EXPECT_CONTAINS(s.message(), "no heartbeat frame 0x701 from node 1 on " +
-                                   std::string(kInterface));
+  EXPECT_CONTAINS(s.message(),
+                  "no heartbeat frame 0x701 from node 1 on " + std::string(kInterface));
   EXPECT_CONTAINS(s.message(), "(heartbeat_timeout_ms 600)");
 }
 
@@ -167,12 +168,11 @@ TEST(CanPeersTest, DriverRejectsMalformedPeerStatus) {
 std::unique_ptr<ChildProcess> StartFixtureSim(const TempDir& dir,
                                               const std::vector<std::string>& extra) {
   const std::string ready = dir / "ready";
-  std::vector<std::string> argv = {EOL_BINARY, "fixture-sim", "--port",    "0",
-                                   "--ready-file", ready,      "--can",     kInterface};
+  std::vector<std::string> argv = {EOL_BINARY,     "fixture-sim", "--port", "0",
+                                   "--ready-file", ready,         "--can",  kInterface};
   argv.insert(argv.end(), extra.begin(), extra.end());
   auto sim = std::make_unique<ChildProcess>(argv);
-  EXPECT_TRUE(sim->WaitFor([&](const std::string&) { return std::filesystem::exists(ready); },
-                           30s))
+  EXPECT_TRUE(sim->WaitFor([&](const std::string&) { return std::filesystem::exists(ready); }, 30s))
       << sim->output();
   return sim;
 }
