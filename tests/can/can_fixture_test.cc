@@ -66,10 +66,11 @@ class CanFixtureTest : public ::testing::Test {
     bench_->LoadPart("SN-CAN-1");
     node_settings_.interface = kInterface;
     settings_.interface = kInterface;
-    settings_.status_timeout_ms = 300;
-    settings_.heartbeat_timeout_ms = 600;
-    settings_.confirm_timeout_ms = 1000;
-    settings_.connect_timeout_ms = 3000;
+    // Generous, so that a loaded machine never trips them; tests of the timeouts set their own.
+    settings_.status_timeout_ms = 2000;
+    settings_.heartbeat_timeout_ms = 3000;
+    settings_.confirm_timeout_ms = 3000;
+    settings_.connect_timeout_ms = 5000;
   }
 
   void StartNode() {
@@ -160,7 +161,7 @@ TEST_F(CanFixtureTest, PressureScaleIsTheDrivers) {
 TEST_F(CanFixtureTest, OtherNodeIdAndIdsFromConfig) {
   nlohmann::json config = R"({
     "fixture": {"driver": "socketcan", "interface": "can9", "node_id": 5,
-                "status_timeout_ms": 300, "confirm_timeout_ms": 1000,
+                "status_timeout_ms": 2000, "confirm_timeout_ms": 3000,
                 "map": {"status_base_id": 1024, "clamp_pressure": {"byte": 6},
                         "pressure_bar_per_count": 0.01}},
     "daq": {"driver": "sim"}})"_json;
@@ -192,6 +193,7 @@ TEST_F(CanFixtureTest, OtherNodeIdAndIdsFromConfig) {
 }
 
 TEST_F(CanFixtureTest, HeartbeatFreezesNamesTheTimeout) {
+  settings_.heartbeat_timeout_ms = 600;
   StartNode();
   CanFixture fixture(settings_);
   ASSERT_TRUE(fixture.Connect().ok());
@@ -208,6 +210,9 @@ TEST_F(CanFixtureTest, HeartbeatFreezesNamesTheTimeout) {
 }
 
 TEST_F(CanFixtureTest, StopsAnsweringNamesTheTimeoutAndDropsTheRelay) {
+  settings_.status_timeout_ms = 300;
+  settings_.confirm_timeout_ms = 1000;
+  settings_.connect_timeout_ms = 1000;
   StartNode();
   CanFixture fixture(settings_);
   ASSERT_TRUE(fixture.Connect().ok());
