@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -18,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "drivers/factory.h"
 #include "drivers/fixture/can_fixture.h"
 #include "tests/support/child_process.h"
 
@@ -287,6 +289,34 @@ TEST(CanPeersTest, DriverAgainstFixtureSimUntilItStopsAnswering) {
   EXPECT_CONTAINS(s.message(), "(status_timeout_ms 1000)");
   ASSERT_TRUE(sim->WaitFor(
       [](const std::string& o) { return o.find("excitation relay dropped out") != o.npos; }, 10s))
+      << sim->output();
+  EXPECT_EQ(sim->Stop(SIGTERM, 10s), 0) << sim->output();
+}
+
+TEST(CanPeersTest, FixtureSimAndDriverShareTheStationConfig) {
+  // One config file for both ends: node id 7 and the pressure moved to bytes 6..7.
+  TempDir dir;
+  nlohmann::json config = R"({
+    "fixture": {"driver": "socketcan", "interface": "can9", "node_id": 7,
+                "status_timeout_ms": 2000, "heartbeat_timeout_ms": 3000,
+                "confirm_timeout_ms": 3000, "connect_timeout_ms": 5000,
+                "map": {"clamp_pressure": {"byte": 6}}},
+    "daq": {"driver": "sim"}})"_json;
+  config["fixture"]["interface"] = kInterface;
+  const std::string path = dir / "station.json";
+  std::ofstream(path) << config.dump(2);
+  auto sim = StartFixtureSim(dir, {"--config", path, "--part", "SN-CFG-1"});
+  DriverSet set = MakeDrivers(config);
+  ASSERT_TRUE(set.fixture->Connect().ok());
+  ASSERT_TRUE(set.fixture->Activate().ok());
+  ASSERT_TRUE(set.fixture->Write(FixtureOutput::kClampCmd, true).ok());
+  const auto in = ReadUntil(*set.fixture, [](const FixtureInputs& i) { return i.clamped; });
+  ASSERT_TRUE(in.ok()) << in.status().message();
+  EXPECT_NEAR(in.value().clamp_pressure_bar, 5.5, 0.035);
+  set.fixture->Disconnect();
+  const std::string line = "CAN node 7 on " + std::string(kInterface) +
+                           " (command 0x207, status 0x187, heartbeat 0x707)";
+  EXPECT_TRUE(sim->WaitFor([&](const std::string& o) { return o.find(line) != o.npos; }, 10s))
       << sim->output();
   EXPECT_EQ(sim->Stop(SIGTERM, 10s), 0) << sim->output();
 }
