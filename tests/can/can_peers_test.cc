@@ -206,8 +206,10 @@ TEST(CanPeersTest, FixtureSimAgainstPythonCanClient) {
   EXPECT_EQ(out["nmt_state"], 5);
   const auto beats = out["heartbeats"].get<std::vector<int>>();
   ASSERT_GE(beats.size(), 2u) << out.dump();
+  // Heartbeat frames every 100 ms, the counter advancing every 200 ms: steps of 0 or 1.
   for (std::size_t i = 1; i < beats.size(); ++i)
-    EXPECT_EQ(beats[i], (beats[i - 1] + 1) % 256) << out.dump();
+    EXPECT_LE((beats[i] - beats[i - 1] + 256) % 256, 1) << out.dump();
+  EXPECT_NE(beats.front(), beats.back()) << out.dump();
   EXPECT_EQ(sim->Stop(SIGTERM, 10s), 0) << sim->output();
 }
 
