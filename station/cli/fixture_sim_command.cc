@@ -205,6 +205,8 @@ void AddFixtureSimCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--fault-on-excitation", opt->fault_on_excitation,
                 "Count --fault-after-ms from the next excitation-enable edge");
+  cmd->add_option("--ready-file", opt->ready_file,
+                  "Once serving, write the TCP port number here (written atomically)");
   cmd->add_option("--can", opt->can_interface,
                   "Also serve the bench as a CAN node on this SocketCAN interface, with the "
                   "frame map of drivers/fixture/can_map.h (the config's \"socketcan\" fixture "
@@ -215,8 +217,6 @@ void AddFixtureSimCommand(CLI::App& app) {
   cmd->add_option("--status-period-ms", opt->status_period_ms, "CAN status frame period")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
-  cmd->add_option("--ready-file", opt->ready_file,
-                  "Once serving, write the TCP port number here (written atomically)");
   cmd->callback([opt] { RunGuarded("fixture-sim", [opt] { return RunFixtureSim(*opt); }); });
 }
 
