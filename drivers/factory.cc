@@ -5,6 +5,9 @@
 
 #include "drivers/fixture/modbus_fixture.h"
 #include "drivers/fixture/sim_fixture.h"
+#if EOL_WITH_SOCKETCAN
+#include "drivers/fixture/can_fixture.h"
+#endif
 
 namespace eol::drivers {
 
@@ -121,9 +124,17 @@ DriverSet MakeDrivers(const nlohmann::json& station_config, std::shared_ptr<SimB
   } else if (fixture_driver == "modbus-rtu") {
     set.fixture = std::make_unique<ModbusFixture>(
         ParseModbusFixtureSettings(fixture, ModbusLink::Transport::kRtu));
+  } else if (fixture_driver == "socketcan") {
+#if EOL_WITH_SOCKETCAN
+    set.fixture = std::make_unique<CanFixture>(ParseCanFixtureSettings(fixture));
+#else
+    throw ConfigError(fixture.PathOf("driver") +
+                      ": the socketcan fixture driver was not compiled in (build with "
+                      "-DEOL_WITH_SOCKETCAN=ON)");
+#endif
   } else {
     throw ConfigError(fixture.PathOf("driver") + ": unknown fixture driver '" + fixture_driver +
-                      "' (known: sim, modbus-tcp, modbus-rtu)");
+                      "' (known: sim, modbus-tcp, modbus-rtu, socketcan)");
   }
 
   if (daq_driver == "sim") {

@@ -1,8 +1,10 @@
 // `eol fixture-sim`: a fixture controller emulator. It builds a simulated bench and serves
 // it as a Modbus TCP server (and, with --rtu, as a Modbus RTU server on a serial device)
 // through the fixture signal map, so that the station's modbus-tcp/modbus-rtu drivers, or
-// any Modbus tool, can be run without hardware. The server itself is
-// drivers::ModbusFixtureServer; this file only wires options to it.
+// any Modbus tool, can be run without hardware; with --can IFNAME it also serves the bench
+// as a CAN node (drivers::CanFixtureNode, frame map drivers/fixture/can_map.h) for the
+// socketcan driver, can-utils or python-can. The servers are drivers::ModbusFixtureServer
+// and drivers::CanFixtureNode; this file only wires options to them.
 #include <signal.h>
 #include <spdlog/spdlog.h>
 
@@ -19,6 +21,9 @@
 #include "drivers/fixture/modbus_fixture_server.h"
 #include "drivers/json_config.h"
 #include "drivers/sim/sim_bench.h"
+#if EOL_WITH_SOCKETCAN
+#include "drivers/fixture/can_fixture_node.h"
+#endif
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 
@@ -42,6 +47,9 @@ struct FixtureSimOptions {
   int fault_duration_ms = 0;  // 0: until the emulator stops
   bool fault_on_excitation = false;
   std::string ready_file;
+  std::string can_interface;
+  int node_id = 0;  // 0: the config's fixture "node_id", else 1
+  int status_period_ms = 50;
 };
 
 std::string FaultNames() {
@@ -75,14 +83,20 @@ int RunFixtureSim(const FixtureSimOptions& opt) {
 
   drivers::SimBenchSettings bench_settings;
   drivers::ModbusMap map;
+  std::optional<drivers::JsonObject> can_fixture;  // a "socketcan" fixture object
+  nlohmann::json config;
   if (!opt.config.empty()) {
-    const nlohmann::json config = drivers::ReadJsonFile(opt.config);
+    config = drivers::ReadJsonFile(opt.config);
     const drivers::JsonObject root(config, "");
     if (const auto sim = root.OptionalObject("sim"))
       bench_settings = drivers::ParseSimBenchSettings(*sim);
     // The station's own fixture map, so that one config file serves both ends.
-    if (const auto fixture = root.OptionalObject("fixture"); fixture && fixture->Has("map"))
+    const auto fixture = root.OptionalObject("fixture");
+    if (fixture && fixture->String("driver", "") == "socketcan") {
+      can_fixture.emplace(*fixture);  // its frame map, for --can
+    } else if (fixture && fixture->Has("map")) {
       map = drivers::ParseModbusMap(fixture->Raw("map"), fixture->PathOf("map"));
+    }
   }
   auto bench = std::make_shared<drivers::SimBench>(bench_settings);
   if (!opt.part.empty()) bench->LoadPart(opt.part);
@@ -121,10 +135,31 @@ int RunFixtureSim(const FixtureSimOptions& opt) {
       throw std::runtime_error(s.message());
   }
 
+#if EOL_WITH_SOCKETCAN
+  std::optional<drivers::CanFixtureNode> can_node;
+  if (!opt.can_interface.empty()) {
+    drivers::CanFixtureNodeSettings can;
+    can.interface = opt.can_interface;
+    if (can_fixture) can.map = drivers::ParseCanFixtureSettings(*can_fixture).map;
+    if (opt.node_id != 0) can.map.node_id = opt.node_id;
+    can.status_period_ms = opt.status_period_ms;
+    can.load_part_on_clamp = opt.load_part_on_clamp;
+    can_node.emplace(bench, can);
+    if (const drivers::Status s = can_node->Start(); !s.ok()) throw std::runtime_error(s.message());
+  }
+#else
+  if (!opt.can_interface.empty())
+    throw std::runtime_error("--can: SocketCAN was not compiled in (build with "
+                             "-DEOL_WITH_SOCKETCAN=ON)");
+#endif
+
   if (!opt.ready_file.empty()) WriteReadyFile(opt.ready_file, tcp_server.port());
   int sig = 0;
   sigwait(&stop_signals, &sig);
   spdlog::info("fixture-sim: {} received, stopping", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+#if EOL_WITH_SOCKETCAN
+  if (can_node) can_node->Stop();
+#endif
   if (rtu_server) rtu_server->Stop();
   tcp_server.Stop();
   return 0;
@@ -137,8 +172,8 @@ void AddFixtureSimCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "fixture-sim",
       "Fixture controller emulator: serves a simulated bench over Modbus TCP (and RTU with\n"
-      "--rtu) through the fixture signal map (drivers/fixture/modbus_map.h). Stops on\n"
-      "SIGTERM or SIGINT.");
+      "--rtu) through the fixture signal map (drivers/fixture/modbus_map.h), and as a CAN\n"
+      "node with --can (drivers/fixture/can_map.h). Stops on SIGTERM or SIGINT.");
   cmd->add_option("--config", opt->config,
                   "Station config JSON: its \"sim\" object sets up the bench, its fixture "
                   "\"map\" the register map")
@@ -180,6 +215,16 @@ void AddFixtureSimCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--ready-file", opt->ready_file,
                   "Once serving, write the TCP port number here (written atomically)");
+  cmd->add_option("--can", opt->can_interface,
+                  "Also serve the bench as a CAN node on this SocketCAN interface, with the "
+                  "frame map of drivers/fixture/can_map.h (the config's \"socketcan\" fixture "
+                  "map, if any)");
+  cmd->add_option("--node-id", opt->node_id,
+                  "CAN node id served (default: the config's fixture node_id, else 1)")
+      ->check(CLI::Range(1, 127));
+  cmd->add_option("--status-period-ms", opt->status_period_ms, "CAN status frame period")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   cmd->callback([opt] { RunGuarded("fixture-sim", [opt] { return RunFixtureSim(*opt); }); });
 }
 

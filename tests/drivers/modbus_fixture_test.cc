@@ -506,7 +506,7 @@ TEST(ModbusFactoryTest, MakesModbusFixturesByName) {
   };
   EXPECT_EQ(error(R"({"fixture": {"driver": "modbus"}, "daq": {"driver": "sim"}})"_json),
             "/fixture/driver: unknown fixture driver 'modbus' (known: sim, modbus-tcp, "
-            "modbus-rtu)");
+            "modbus-rtu, socketcan)");
   EXPECT_EQ(error(R"({"fixture": {"driver": "modbus-rtu"}, "daq": {"driver": "sim"}})"_json),
             "/fixture/device: missing (required)");
   EXPECT_EQ(error(R"({"fixture": {"driver": "modbus-tcp", "prot": 5},
