@@ -4,6 +4,7 @@
 #include <cmath>
 #include <locale>
 #include <sstream>
+#include <string>
 #include <vector>
 
 namespace eol::analysis {
@@ -15,6 +16,16 @@ inline std::ostringstream MessageStream() {
   os.imbue(std::locale::classic());
   os.precision(6);
   return os;
+}
+
+// v with `digits` decimals, classic locale ("390.12"), for messages and records.
+inline std::string Fixed(double v, int digits) {
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os.setf(std::ios::fixed);
+  os.precision(digits);
+  os << v;
+  return os.str();
 }
 
 // n >= 2 log-spaced points from lo to hi inclusive (lo, hi > 0); the last point is exactly hi.

@@ -3,14 +3,12 @@
 #include <cmath>
 #include <cstdio>
 
+#include "analysis/text.h"
+
 namespace eol::station {
 namespace {
 
-std::string Fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
+using analysis::Fixed;
 
 // Empty when inside; otherwise the line naming the value and the window.
 std::string Outside(const std::string& what, double v, const analysis::Limit& l,

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <random>
 
+#include <unistd.h>
+
 #include "drivers/daq/sim_daq.h"
 #include "drivers/fixture/modbus_fixture.h"
 #include "drivers/fixture/modbus_fixture_server.h"
@@ -52,7 +54,8 @@ double Percentile(std::vector<double> v, double p) {
 std::vector<ReactionStats> RunSafetyBench(const SafetyBenchOptions& o) {
   const auto recipe = std::make_shared<const Recipe>(LoadRecipe(o.recipe_path));
   const std::string db_path = (std::filesystem::temp_directory_path() /
-                               ("eol-safety-bench-" + std::to_string(o.seed) + ".sqlite"))
+                               ("eol-safety-bench-" + std::to_string(::getpid()) + "-" +
+                                o.fixture + "-" + std::to_string(o.seed) + ".sqlite"))
                                   .string();
   std::filesystem::remove(db_path);
   auto store = db::Store::Open(db_path);

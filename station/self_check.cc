@@ -6,16 +6,13 @@
 #include <string_view>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/text.h"
 #include "db/clock.h"
 
 namespace eol::station {
 namespace {
 
-std::string Fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
+using analysis::Fixed;
 
 std::string LimitText(const analysis::Limit& l) {
   return (l.lo ? Fixed(*l.lo, 1) : std::string("-inf")) + ".." +

@@ -9,6 +9,7 @@
 
 #include "analysis/impedance_analysis.h"
 #include "analysis/qc/measurement_names.h"
+#include "analysis/text.h"
 #include "db/clock.h"
 #include "drivers/daq/calibration_file.h"
 #include "station/self_check.h"
@@ -20,13 +21,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using drivers::FixtureOutput;
 
-std::string Fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
+using analysis::Fixed;
 
 db::Curve ToCurve(const analysis::Frf& z, const std::string& name) {
   db::Curve c;

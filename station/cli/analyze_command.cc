@@ -16,6 +16,7 @@
 #include "analysis/model/two_mass.h"
 #include "analysis/signal/waveform.h"
 #include "analysis/signal/welch.h"
+#include "analysis/text.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/files/file_error.h"
@@ -154,14 +155,7 @@ json Param(const analysis::FittedParameter& p) {
   return {{"value", p.value}, {"sigma", p.sigma}, {"unit", p.unit}};
 }
 
-std::string Fixed(double v, int digits) {
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
-  os.setf(std::ios::fixed);
-  os.precision(digits);
-  os << v;
-  return os.str();
-}
+using analysis::Fixed;
 
 std::string Sci(double v) {
   std::ostringstream os;

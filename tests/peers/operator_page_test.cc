@@ -11,6 +11,7 @@
 #include <regex>
 
 #include "../support/child_process.h"
+#include "../support/station_ready.h"
 
 namespace eol {
 namespace {
@@ -20,11 +21,7 @@ using eol::testing::ChildProcess;
 
 const std::string kBrowserDir = std::string(EOL_SOURCE_DIR) + "/tests/peers/browser";
 
-int PortFromReadyLine(const std::string& out) {
-  std::smatch m;
-  static const std::regex re("ready, .* http://127\\.0\\.0\\.1:([0-9]+)/");
-  return std::regex_search(out, m, re) ? std::stoi(m[1]) : 0;
-}
+using eol::testing::PortFromReadyLine;
 
 std::string NodeBinary() {
   for (const char* p : {"/usr/local/bin/node", "/usr/bin/node", "/usr/bin/nodejs"})

@@ -11,6 +11,7 @@
 
 #include "db/store.h"
 #include "../support/child_process.h"
+#include "../support/station_ready.h"
 
 namespace eol {
 namespace {
@@ -24,11 +25,7 @@ nlohmann::json LastJsonLine(const std::string& out) {
   return nlohmann::json::parse(out.substr(start == std::string::npos ? 0 : start + 1));
 }
 
-int PortFromReadyLine(const std::string& out) {
-  std::smatch m;
-  static const std::regex re("ready, .* http://127\\.0\\.0\\.1:([0-9]+)/");
-  return std::regex_search(out, m, re) ? std::stoi(m[1]) : 0;
-}
+using eol::testing::PortFromReadyLine;
 
 TEST(DemoEndToEnd, CatchesEveryDefectAndRecordsAreServed) {
   eol::testing::TempDir dir;

@@ -16,6 +16,7 @@
 
 #include "db/store.h"
 #include "tests/support/child_process.h"
+#include "tests/support/station_ready.h"
 
 namespace eol {
 namespace {
@@ -31,11 +32,7 @@ struct FaultCase {
 
 std::ostream& operator<<(std::ostream& os, const FaultCase& c) { return os << c.fault; }
 
-int PortFromReadyLine(const std::string& out) {
-  std::smatch m;
-  static const std::regex re("ready, .* http://127\\.0\\.0\\.1:([0-9]+)/");
-  return std::regex_search(out, m, re) ? std::stoi(m[1]) : 0;
-}
+using eol::testing::PortFromReadyLine;
 
 int ReadPortFile(const std::string& path) {
   std::ifstream in(path);

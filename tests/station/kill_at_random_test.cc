@@ -11,6 +11,7 @@
 
 #include "db/store.h"
 #include "../support/child_process.h"
+#include "../support/station_ready.h"
 
 namespace eol {
 namespace {
@@ -18,11 +19,7 @@ namespace {
 using namespace std::chrono_literals;
 using eol::testing::ChildProcess;
 
-int PortFromReadyLine(const std::string& out) {
-  std::smatch m;
-  static const std::regex re("ready, .* http://127\\.0\\.0\\.1:([0-9]+)/");
-  return std::regex_search(out, m, re) ? std::stoi(m[1]) : 0;
-}
+using eol::testing::PortFromReadyLine;
 
 TEST(KillAtRandom, DatabaseStaysConsistentAndInterruptedTestsBecomeAborted) {
   eol::testing::TempDir dir;

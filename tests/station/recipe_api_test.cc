@@ -11,6 +11,7 @@
 #include "db/store.h"
 #include "drivers/json_config.h"
 #include "../support/child_process.h"
+#include "../support/station_ready.h"
 
 namespace eol {
 namespace {
@@ -21,11 +22,7 @@ using eol::testing::ChildProcess;
 constexpr char kOperator[] = "operator-token-0123456789";
 constexpr char kEngineer[] = "engineer-token-0123456789";
 
-int PortFromReadyLine(const std::string& out) {
-  std::smatch m;
-  static const std::regex re("ready, .* http://127\\.0\\.0\\.1:([0-9]+)/");
-  return std::regex_search(out, m, re) ? std::stoi(m[1]) : 0;
-}
+using eol::testing::PortFromReadyLine;
 
 TEST(RecipeApi, EngineersChangeRecipesAuditedAndVersioned) {
   eol::testing::TempDir dir;
