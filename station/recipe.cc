@@ -23,7 +23,20 @@ void ParseExcitation(const JsonObject& e, Recipe& r) {
   r.excitation.crest_iterations = e.Integer("crest_iterations", r.excitation.crest_iterations);
   const int periods = e.Integer("periods", 4);
   const int transient = e.Integer("transient_periods", 1);
-  const int pair = e.Integer("phase_pair", 0);
+  std::vector<int> pairs;
+  e.Require(!(e.Has("phase_pair") && e.Has("phase_pairs")), "phase_pairs",
+            "give phase_pair or phase_pairs, not both");
+  if (e.Has("phase_pairs")) {
+    const nlohmann::json& list = e.Raw("phase_pairs");
+    e.Require(list.is_array() && !list.empty() && list.size() <= 3, "phase_pairs",
+              "must be a list of 1 to 3 phase pairs");
+    for (const nlohmann::json& p : list) {
+      e.Require(p.is_number_integer(), "phase_pairs", "must hold integers 0, 1 or 2");
+      pairs.push_back(p.get<int>());
+    }
+  } else {
+    pairs.push_back(e.Integer("phase_pair", 0));
+  }
   e.Require(r.excitation.f_lo_hz > 0, "f_lo_hz", "must be positive");
   e.Require(r.excitation.f_hi_hz > r.excitation.f_lo_hz, "f_hi_hz",
             "must be greater than " + e.PathOf("f_lo_hz"));
@@ -33,13 +46,20 @@ void ParseExcitation(const JsonObject& e, Recipe& r) {
             "must be in (0, 50] V");
   e.Require(periods >= 2 && periods <= 1000, "periods", "must be in [2, 1000]");
   e.Require(transient >= 0 && transient <= 100, "transient_periods", "must be in [0, 100]");
-  e.Require(pair >= 0 && pair <= 2, "phase_pair", "must be 0 (U-V), 1 (V-W) or 2 (W-U)");
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    e.Require(pairs[i] >= 0 && pairs[i] <= 2, e.Has("phase_pairs") ? "phase_pairs" : "phase_pair",
+              "must be 0 (U-V), 1 (V-W) or 2 (W-U)");
+    for (std::size_t j = 0; j < i; ++j)
+      e.Require(pairs[i] != pairs[j], "phase_pairs", "names a phase pair twice");
+  }
   std::string why;
   e.Require(r.excitation.IsValid(&why), "line_spacing_hz", why);
   r.periods = static_cast<std::size_t>(periods);
   r.transient_periods = static_cast<std::size_t>(transient);
   r.analysis.frf.transient_periods = r.transient_periods;
-  r.phase_pair = static_cast<drivers::PhasePair>(pair);
+  r.phase_pairs.clear();
+  for (int p : pairs) r.phase_pairs.push_back(static_cast<drivers::PhasePair>(p));
+  r.phase_pair = r.phase_pairs.front();
   e.RejectUnknown();
 }
 

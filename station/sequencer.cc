@@ -369,6 +369,41 @@ void Sequencer::AnalyseAndJudge(db::TestRecord& record, const analysis::Recordin
   }
 }
 
+void Sequencer::MeasureFurtherPair(db::TestRecord& record, drivers::PhasePair pair) {
+  static constexpr const char* kPairNames[] = {"U-V", "V-W", "W-U"};
+  const std::string name = kPairNames[static_cast<int>(pair)];
+  ThrowIfAborted();
+  Enter(record, SeqState::kClamp, "phase pair " + std::to_string(static_cast<int>(pair)));
+  if (const drivers::Status s = fixture_.SelectPhasePair(pair); !s.ok())
+    throw Fault{analysis::Outcome::kError, "phase pair " + name + ": " + s.message()};
+  const analysis::Outcome first_outcome = record.outcome;
+  std::vector<std::string> reasons = std::move(record.reasons);
+  std::vector<analysis::Measurement> measurements = std::move(record.measurements);
+  const nlohmann::json first_fit = record.fit;
+  const std::size_t first_curves = record.curves.size();
+  record.reasons.clear();
+  record.measurements.clear();
+
+  const analysis::Recording recording = ExciteAndRecord(record);
+  AnalyseAndJudge(record, recording);
+
+  for (analysis::Measurement& m : record.measurements) {
+    m.name += "@" + name;
+    measurements.push_back(std::move(m));
+  }
+  for (std::size_t i = first_curves; i < record.curves.size(); ++i)
+    record.curves[i].name += "@" + name;
+  for (const std::string& r : record.reasons) reasons.push_back("phase pair " + name + ": " + r);
+  record.fit = first_fit;
+  record.fit["further_pairs"][name] = {{"outcome", analysis::ToString(record.outcome)}};
+  auto rank = [](analysis::Outcome o) {
+    return o == analysis::Outcome::kPass ? 0 : o == analysis::Outcome::kFail ? 1 : 2;
+  };
+  if (rank(first_outcome) > rank(record.outcome)) record.outcome = first_outcome;
+  record.reasons = std::move(reasons);
+  record.measurements = std::move(measurements);
+}
+
 void Sequencer::Unclamp(db::TestRecord& record) {
   Enter(record, SeqState::kUnclamp);
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false); !s.ok())
@@ -487,6 +522,8 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
     ClampAndConfirm(record);
     const analysis::Recording recording = ExciteAndRecord(record);
     AnalyseAndJudge(record, recording);
+    for (std::size_t k = 1; k < recipe_->phase_pairs.size(); ++k)
+      MeasureFurtherPair(record, recipe_->phase_pairs[k]);
     Unclamp(record);
   } catch (const Fault& f) {
     record.outcome = f.outcome;

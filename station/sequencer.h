@@ -104,6 +104,10 @@ class Sequencer {
   void ClampAndConfirm(db::TestRecord& record);
   analysis::Recording ExciteAndRecord(db::TestRecord& record);
   void AnalyseAndJudge(db::TestRecord& record, const analysis::Recording& recording);
+  // A further phase pair of the recipe in the same clamping: relay off, switch the pair,
+  // excite, analyse; its measurements and curves are renamed "<name>@<pair>" and merged, the
+  // outcome is the worse of the two.
+  void MeasureFurtherPair(db::TestRecord& record, drivers::PhasePair pair);
   void Unclamp(db::TestRecord& record);
   void SafeState(db::TestRecord& record);
   void StoreAndPublish(db::TestRecord& record);

@@ -58,6 +58,23 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
       {[](auto& j) { j["analysis"]["f0_max_hz"] = 900; },
        "/analysis/f0_max_hz: must lie inside the excited band"},
       {[](auto& j) { j["version"] = 0; }, "/version: must be a whole number >= 1"},
+      {[](auto& j) { j["excitation"]["phase_pairs"] = {0, 1}; },
+       "/excitation/phase_pairs: give phase_pair or phase_pairs, not both"},
+      {[](auto& j) {
+         j["excitation"].erase("phase_pair");
+         j["excitation"]["phase_pairs"] = {0, 3};
+       },
+       "/excitation/phase_pairs: must be 0 (U-V), 1 (V-W) or 2 (W-U)"},
+      {[](auto& j) {
+         j["excitation"].erase("phase_pair");
+         j["excitation"]["phase_pairs"] = {1, 1};
+       },
+       "/excitation/phase_pairs: names a phase pair twice"},
+      {[](auto& j) {
+         j["excitation"].erase("phase_pair");
+         j["excitation"]["phase_pairs"] = nlohmann::json::array();
+       },
+       "/excitation/phase_pairs: must be a list of 1 to 3 phase pairs"},
   };
   for (const Case& c : cases) {
     nlohmann::json j = Good();
@@ -65,6 +82,18 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
     const std::string err = ErrorOf(j);
     EXPECT_NE(err.find(c.expected), std::string::npos) << "got: " << err << "\nwant: " << c.expected;
   }
+}
+
+TEST(Recipe, PhasePairsInOrder) {
+  nlohmann::json j = Good();
+  j["excitation"].erase("phase_pair");
+  j["excitation"]["phase_pairs"] = {2, 0};
+  const Recipe r = ParseRecipe(j, "test.json");
+  ASSERT_EQ(r.phase_pairs.size(), 2u);
+  EXPECT_EQ(r.phase_pairs[0], drivers::PhasePair::kWU);
+  EXPECT_EQ(r.phase_pairs[1], drivers::PhasePair::kUV);
+  EXPECT_EQ(r.phase_pair, drivers::PhasePair::kWU);
+  EXPECT_EQ(LoadRecipe(kRecipe).phase_pairs.size(), 1u);
 }
 
 TEST(Recipe, SyntaxErrorNamesTheFile) {

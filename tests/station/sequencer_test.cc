@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "analysis/qc/measurement_names.h"
@@ -117,6 +118,37 @@ TEST_F(SequencerTest, RetestLimitRefusesASerialBeforeClamping) {
   EXPECT_TRUE(HasReason(refused, "retest limit: serial RETEST-1 already has 3 tests"));
   EXPECT_EQ(store_->TestsOfSerial("RETEST-1").size(), 3u);
   EXPECT_FALSE(bench_->output(FixtureOutput::kClampCmd));
+}
+
+TEST_F(SequencerTest, EveryPhasePairOfTheRecipeIsMeasuredInOneClamping) {
+  Build(0.0);
+  recipe_.phase_pairs = {drivers::PhasePair::kUV, drivers::PhasePair::kVW,
+                         drivers::PhasePair::kWU};
+  SequencerOptions o;
+  o.station_id = "test";
+  sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
+                                           std::make_shared<const Recipe>(recipe_), *board_, o);
+  const db::TestRecord good = Test("PAIRS-GOOD", false);
+  EXPECT_EQ(good.outcome, Outcome::kPass) << (good.reasons.empty() ? "" : good.reasons.front());
+  EXPECT_EQ(good.measurements.size(), 3 * recipe_.Specs().size());
+  std::vector<std::string> curves;
+  const auto stored = store_->Test(good.id);
+  ASSERT_TRUE(stored.has_value());
+  for (const auto& c : stored->curves) curves.push_back(c.name);
+  for (const std::string want : {"impedance", "impedance@V-W", "impedance@W-U"})
+    EXPECT_NE(std::find(curves.begin(), curves.end(), want), curves.end()) << want;
+  double f0_wu = 0;
+  for (const auto& m : good.measurements)
+    if (m.name == std::string(analysis::names::kResonanceFHz) + "@W-U") f0_wu = m.value;
+  EXPECT_NEAR(f0_wu, 390.0, 25.0);
+  EXPECT_EQ(bench_->phase_pair(), drivers::PhasePair::kWU);  // the last pair measured
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+
+  const db::TestRecord bad = Test("PAIRS-BAD", true);
+  EXPECT_EQ(bad.outcome, Outcome::kFail);
+  EXPECT_TRUE(HasReason(bad, "phase pair V-W: "));
+  EXPECT_TRUE(HasReason(bad, "phase pair W-U: "));
+  ExpectStored(bad);
 }
 
 TEST_F(SequencerTest, PoorlyCementedRotorFailsOnResonance) {
