@@ -18,6 +18,7 @@
 #include "station/files/frf_files.h"
 #include "station/files/recording_files.h"
 #include "tests/support/child_process.h"
+#include "tests/support/eol_cli.h"
 
 namespace eol {
 namespace {
@@ -28,16 +29,11 @@ namespace {
 const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json";
 const analysis::MotionalImpedance kGood{0.5, 2.0e-3, 0.51, 390.0, 50.0};
 
-struct CliRun {
-  int code = -1;
-  std::string out;
-};
+using eol::testing::CliRun;
 
 CliRun Eol(std::vector<std::string> args, bool merge_stderr = false) {
-  args.insert(args.begin(), {EOL_BINARY, "analyze"});
-  testing::ChildProcess p(args, merge_stderr);
-  const auto code = p.Wait(std::chrono::seconds(120));
-  return {code ? *code : -1, p.output()};
+  args.insert(args.begin(), "analyze");
+  return testing::RunEol(std::move(args), merge_stderr, std::chrono::seconds(120));
 }
 
 nlohmann::json Json(const CliRun& r) {

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "../support/child_process.h"
+#include "tests/support/eol_cli.h"
 #include "drivers/daq/calibration_file.h"
 #include "drivers/factory.h"
 #include "station/config.h"
@@ -21,16 +22,11 @@ using namespace std::chrono_literals;
 using eol::testing::ChildProcess;
 using eol::testing::TempDir;
 
-struct CliRun {
-  int code = -1;
-  std::string output;
-};
+using eol::testing::CliRun;
 
 CliRun Calibrate(std::vector<std::string> args) {
-  args.insert(args.begin(), {EOL_BINARY, "calibrate"});
-  ChildProcess p(args);
-  const auto code = p.Wait(120s);
-  return CliRun{code.value_or(-1), p.output()};
+  args.insert(args.begin(), "calibrate");
+  return testing::RunEol(std::move(args), true, 120s);
 }
 
 nlohmann::json StationJson(const TempDir& dir, nlohmann::json daq) {
@@ -56,10 +52,10 @@ TEST(CalibrateCli, RecoversInjectedGainAndDelayWithinThreeSigma) {
   WriteJson(dir / "station.json", StationJson(dir, kReferenceDaq));
   const CliRun r = Calibrate({"--config", dir / "station.json", "--reference-ohm", "2.0", "--out",
                               dir / "calibration.json"});
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("calibration " + (dir / "calibration.json") + ": gain"),
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("calibration " + (dir / "calibration.json") + ": gain"),
             std::string::npos)
-      << r.output;
+      << r.out;
   const nlohmann::json j = drivers::ReadJsonFile(dir / "calibration.json");
   const nlohmann::json& e = j["estimate"];
   const double gain = e["gain"], gain_sigma = e["gain_sigma"];
@@ -106,8 +102,8 @@ TEST(CalibrateCli, WrongReferenceWritesNothing) {
   WriteJson(dir / "station.json", StationJson(dir, kReferenceDaq));
   const CliRun r = Calibrate({"--config", dir / "station.json", "--reference-ohm", "20", "--out",
                               dir / "calibration.json"});
-  EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_NE(r.output.find("wrong reference_ohm"), std::string::npos) << r.output;
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("wrong reference_ohm"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "calibration.json"));
 }
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/child_process.h"
+#include "tests/support/eol_cli.h"
 
 namespace eol {
 namespace {
@@ -17,16 +18,10 @@ using eol::testing::ChildProcess;
 
 const std::string kMotors = std::string(EOL_SOURCE_DIR) + "/recipes/motors/";
 
-struct CliRun {
-  int code = -1;
-  std::string output;
-};
+using eol::testing::CliRun;
 
 CliRun Eol(std::vector<std::string> args, bool merge_stderr = true) {
-  args.insert(args.begin(), EOL_BINARY);
-  ChildProcess p(args, merge_stderr);
-  const auto code = p.Wait(600s);
-  return CliRun{code.value_or(-1), p.output()};
+  return testing::RunEol(std::move(args), merge_stderr, 600s);
 }
 
 const nlohmann::json* Class(const nlohmann::json& j, const std::string& name) {
@@ -39,19 +34,19 @@ TEST(DetectabilityCli, FixtureFromTheGapDiagnosis) {
   eol::testing::TempDir dir;
   CliRun r = Eol({"simulate", "--motor", kMotors + "pmsm-10pole-rigid.json", "--out",
                   dir / "sim.csv", "--noise-v", "0", "--noise-a", "0"});
-  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   r = Eol({"simulate", "--motor", kMotors + "pmsm-10pole.json", "--out", dir / "meas.csv",
            "--model", "steady_state"});
-  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   r = Eol({"gap", "--sim", dir / "sim.csv", "--measured", dir / "meas.csv", "--json",
            dir / "gap.json"});
-  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   r = Eol({"detectability", "--gap", dir / "gap.json", "--json"}, false);
-  ASSERT_EQ(r.code, 0) << r.output;
-  const nlohmann::json j = nlohmann::json::parse(r.output);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
   // The gap diagnosis' fixture (about 864 N m/rad) puts the good rotor back near 390 Hz.
-  EXPECT_NEAR(j["k_fixture_nm_per_rad"].get<double>(), 864.0, 40.0) << r.output;
-  EXPECT_NEAR(j["f0_good_hz"].get<double>(), 390.0, 6.0) << r.output;
+  EXPECT_NEAR(j["k_fixture_nm_per_rad"].get<double>(), 864.0, 40.0) << r.out;
+  EXPECT_NEAR(j["f0_good_hz"].get<double>(), 390.0, 6.0) << r.out;
   const nlohmann::json* all = Class(j, "all_soft");
   ASSERT_NE(all, nullptr);
   EXPECT_TRUE((*all)["separable"].get<bool>()) << all->dump();
@@ -59,8 +54,8 @@ TEST(DetectabilityCli, FixtureFromTheGapDiagnosis) {
 
 TEST(DetectabilityCli, SoftFixtureWarnsStiffFixtureSeparates) {
   CliRun soft = Eol({"detectability", "--k-fixture", "533", "--json"}, false);
-  ASSERT_EQ(soft.code, 0) << soft.output;
-  const nlohmann::json s = nlohmann::json::parse(soft.output);
+  ASSERT_EQ(soft.code, 0) << soft.out;
+  const nlohmann::json s = nlohmann::json::parse(soft.out);
   const nlohmann::json* weak = Class(s, "weak_bonds:0.1");
   ASSERT_NE(weak, nullptr);
   EXPECT_FALSE((*weak)["separable"].get<bool>()) << weak->dump();
@@ -70,17 +65,17 @@ TEST(DetectabilityCli, SoftFixtureWarnsStiffFixtureSeparates) {
       << weak->dump();
 
   CliRun stiff = Eol({"detectability", "--k-fixture", "17758", "--json"}, false);
-  ASSERT_EQ(stiff.code, 0) << stiff.output;
-  const nlohmann::json t = nlohmann::json::parse(stiff.output);
+  ASSERT_EQ(stiff.code, 0) << stiff.out;
+  const nlohmann::json t = nlohmann::json::parse(stiff.out);
   const nlohmann::json* weak_stiff = Class(t, "weak_bonds:0.1");
   ASSERT_NE(weak_stiff, nullptr);
   EXPECT_TRUE((*weak_stiff)["separable"].get<bool>()) << weak_stiff->dump();
 
   // The text report warns with the remedy.
   CliRun text = Eol({"detectability", "--k-fixture", "533"});
-  ASSERT_EQ(text.code, 0) << text.output;
-  EXPECT_NE(text.output.find("WARNING: weak_bonds:0.1 cannot be told apart"), std::string::npos)
-      << text.output;
+  ASSERT_EQ(text.code, 0) << text.out;
+  EXPECT_NE(text.out.find("WARNING: weak_bonds:0.1 cannot be told apart"), std::string::npos)
+      << text.out;
 }
 
 TEST(DetectabilityCli, ErrorsNameTheFile) {
@@ -88,12 +83,12 @@ TEST(DetectabilityCli, ErrorsNameTheFile) {
   const std::string gap = dir / "gap.json";
   std::ofstream(gap) << R"({"effect": "none", "params": {}})";
   CliRun r = Eol({"detectability", "--gap", gap});
-  EXPECT_EQ(r.code, 2) << r.output;
-  EXPECT_NE(r.output.find(gap + ": /params/k_fixture_nm_per_rad is missing"), std::string::npos)
-      << r.output;
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(gap + ": /params/k_fixture_nm_per_rad is missing"), std::string::npos)
+      << r.out;
   r = Eol({"detectability", "--gap", gap, "--k-fixture", "900"});
-  EXPECT_EQ(r.code, 2) << r.output;
-  EXPECT_NE(r.output.find("either --gap or --k-fixture"), std::string::npos) << r.output;
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("either --gap or --k-fixture"), std::string::npos) << r.out;
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "db/store.h"
 #include "../support/child_process.h"
+#include "tests/support/eol_cli.h"
 
 namespace eol {
 namespace {
@@ -38,17 +39,10 @@ db::TestRecord Record(const std::string& serial, const std::string& t, analysis:
   return r;
 }
 
-struct CliRun {
-  int code;
-  std::string out;
-};
+using eol::testing::CliRun;
 
 CliRun Eol(const std::vector<std::string>& args) {
-  std::vector<std::string> argv = {EOL_BINARY};
-  argv.insert(argv.end(), args.begin(), args.end());
-  ChildProcess p(argv, /*merge_stderr=*/false);
-  const auto code = p.Wait(60s);
-  return {code.value_or(-1), p.output()};
+  return testing::RunEol(args, false, 60s);
 }
 
 class QueryExportTest : public ::testing::Test {

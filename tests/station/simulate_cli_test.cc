@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "../support/child_process.h"
+#include "tests/support/eol_cli.h"
 #include "analysis/fit/modes_fit.h"
 #include "analysis/fit/resonance_fit.h"
 #include "station/files/frf_files.h"
@@ -21,16 +22,11 @@ using eol::testing::ChildProcess;
 
 const std::string kMotors = std::string(EOL_SOURCE_DIR) + "/recipes/motors/";
 
-struct CliRun {
-  int code = -1;
-  std::string output;
-};
+using eol::testing::CliRun;
 
 CliRun Simulate(std::vector<std::string> args) {
-  args.insert(args.begin(), {EOL_BINARY, "simulate"});
-  ChildProcess p(args);
-  const auto code = p.Wait(120s);
-  return CliRun{code.value_or(-1), p.output()};
+  args.insert(args.begin(), "simulate");
+  return testing::RunEol(std::move(args), true, 120s);
 }
 
 analysis::FitSummary Fit(const analysis::Frf& z, double lo, double hi) {
@@ -45,7 +41,7 @@ void ExpectResonance(const std::string& motor, const std::string& defect, double
   eol::testing::TempDir dir;
   const CliRun r =
       Simulate({"--motor", kMotors + motor, "--out", dir / "z.csv", "--defect", defect});
-  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   const analysis::Frf z = station::files::ReadFrfCsv(dir / "z.csv");
   ASSERT_TRUE(z.has_sigma());
   EXPECT_EQ(z.size(), 601u);  // the recipe's 200-800 Hz at 1 Hz
@@ -55,7 +51,7 @@ void ExpectResonance(const std::string& motor, const std::string& defect, double
   // The chain's mode within the fit's uncertainty (a tenth of a hertz here).
   EXPECT_NEAR(f0->value, f_chain, 5 * f0->sigma + 0.2)
       << motor << " " << defect << ": " << fit.message << "\n"
-      << r.output;
+      << r.out;
   EXPECT_LT(fit.chi2_per_dof, 1.5) << fit.message;
 }
 
@@ -77,7 +73,7 @@ TEST(SimulateCli, PoorCementationInTheFixtureRingsNear366HzWithAMagnetMode) {
   eol::testing::TempDir dir;
   const CliRun r = Simulate(
       {"--motor", kMotors + "pmsm-10pole.json", "--out", dir / "z.csv", "--defect", "all_soft"});
-  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   analysis::ModesFitOptions o;
   o.single.f0_min_hz = 250;
   o.single.f0_max_hz = 790;
@@ -94,8 +90,8 @@ TEST(SimulateCli, OneSoftMagnetOnARigidFixtureShowsTwoModes) {
   eol::testing::TempDir dir;
   const CliRun r = Simulate({"--motor", kMotors + "pmsm-10pole-rigid.json", "--out", dir / "z.csv",
                              "--defect", "one_soft_magnet", "--seed", "3"});
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("567."), std::string::npos) << r.output;  // the stdout mode list
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("567."), std::string::npos) << r.out;  // the stdout mode list
   analysis::ModesFitOptions o;
   o.single.f0_min_hz = 250;
   o.single.f0_max_hz = 790;
@@ -111,7 +107,7 @@ TEST(SimulateCli, RecordingFormatHoldsEveryPeriod) {
   eol::testing::TempDir dir;
   const CliRun r = Simulate(
       {"--motor", kMotors + "pmsm-10pole.json", "--out", dir / "rec.csv", "--format", "recording"});
-  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   std::ifstream in(dir / "rec.csv");
   std::string header;
   std::getline(in, header);
@@ -126,7 +122,7 @@ TEST(SimulateCli, NoCouplingAtAZeroOfTheTransmission) {
   eol::testing::TempDir dir;
   const CliRun r = Simulate({"--motor", kMotors + "pmsm-10pole.json", "--out", dir / "z.csv",
                              "--rotor-position-deg", "36"});
-  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_FALSE(Fit(station::files::ReadFrfCsv(dir / "z.csv"), 250, 700).usable);
 }
 
@@ -134,7 +130,7 @@ TEST(SimulateCli, NoiseFreeFrfIsTheExactModel) {
   eol::testing::TempDir dir;
   const CliRun r = Simulate({"--motor", kMotors + "pmsm-10pole.json", "--out", dir / "z.csv",
                              "--noise-v", "0", "--noise-a", "0"});
-  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   const analysis::Frf z = station::files::ReadFrfCsv(dir / "z.csv");
   EXPECT_FALSE(z.has_sigma());
   const analysis::FitSummary fit = Fit(z, 250, 700);
@@ -147,13 +143,13 @@ TEST(SimulateCli, ErrorsNameTheOptionOrThePath) {
   CliRun r = Simulate(
       {"--motor", kMotors + "pmsm-10pole.json", "--out", dir / "z.csv", "--defect", "cracked"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.output.find("--defect: unknown defect 'cracked'"), std::string::npos) << r.output;
+  EXPECT_NE(r.out.find("--defect: unknown defect 'cracked'"), std::string::npos) << r.out;
 
   std::ofstream(dir / "bad.json") << R"({"id": "x", "electrical": {"r_ohm": 0.5, "l_h": -1},
                                         "transducer": {"transmission_nm_per_a": 0.05}})";
   r = Simulate({"--motor", dir / "bad.json", "--out", dir / "z.csv"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.output.find("/electrical/l_h: must be positive"), std::string::npos) << r.output;
+  EXPECT_NE(r.out.find("/electrical/l_h: must be positive"), std::string::npos) << r.out;
 
   r = Simulate(
       {"--motor", kMotors + "pmsm-10pole.json", "--out", dir / "z.csv", "--format", "wav"});

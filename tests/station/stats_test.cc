@@ -12,6 +12,7 @@
 #include "station/station.h"
 #include "station/stats_report.h"
 #include "../support/child_process.h"
+#include "tests/support/eol_cli.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -53,17 +54,10 @@ db::TestRecord Record(const std::string& serial, int minute, Outcome o, double f
   return r;
 }
 
-struct CliRun {
-  int code;
-  std::string out;
-};
+using eol::testing::CliRun;
 
 CliRun Eol(const std::vector<std::string>& args, bool merge_stderr = false) {
-  std::vector<std::string> argv = {EOL_BINARY};
-  argv.insert(argv.end(), args.begin(), args.end());
-  ChildProcess p(argv, merge_stderr);
-  const auto code = p.Wait(60s);
-  return {code.value_or(-1), p.output()};
+  return testing::RunEol(args, merge_stderr, 60s);
 }
 
 const nlohmann::json& Measurement(const nlohmann::json& recipe, const std::string& name) {

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/child_process.h"
+#include "tests/support/eol_cli.h"
 #include "db/test_record.h"
 #include "station/recipe.h"
 
@@ -21,16 +22,10 @@ using eol::testing::ChildProcess;
 const std::string kMotor = std::string(EOL_SOURCE_DIR) + "/recipes/motors/pmsm-10pole.json";
 const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json";
 
-struct CliRun {
-  int code = -1;
-  std::string output;
-};
+using eol::testing::CliRun;
 
 CliRun Eol(std::vector<std::string> args, bool merge_stderr = true) {
-  args.insert(args.begin(), EOL_BINARY);
-  ChildProcess p(args, merge_stderr);
-  const auto code = p.Wait(300s);
-  return CliRun{code.value_or(-1), p.output()};
+  return testing::RunEol(std::move(args), merge_stderr, 300s);
 }
 
 std::string Simulated(const eol::testing::TempDir& dir, const std::string& name, int seed,
@@ -40,7 +35,7 @@ std::string Simulated(const eol::testing::TempDir& dir, const std::string& name,
       Eol({"simulate", "--motor", kMotor, "--out", out, "--defect", defect, "--seed",
            std::to_string(seed), "--model", "steady_state", "--noise-v",
            std::to_string(2e-3 * noise_scale), "--noise-a", std::to_string(1e-3 * noise_scale)});
-  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.code, 0) << r.out;
   return out;
 }
 
@@ -64,14 +59,14 @@ class TeachCli : public ::testing::Test {
 TEST_F(TeachCli, WritesANewVersionAndRefusesToOverwrite) {
   const std::string out = dir_ / "taught.json";
   CliRun r = Eol(TeachArgs(out));
-  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   const station::Recipe before = station::LoadRecipe(kRecipe);
   const station::Recipe after = station::LoadRecipe(out);
   EXPECT_EQ(after.version, before.version + 1);
   EXPECT_EQ(after.id, before.id);
   EXPECT_NE(after.hash, before.hash);
-  EXPECT_NE(r.output.find("sha256 " + after.hash), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("units needed for the stated confidence:"), std::string::npos);
+  EXPECT_NE(r.out.find("sha256 " + after.hash), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("units needed for the stated confidence:"), std::string::npos);
   // The limits changed to the golden units' spread: f0 limits around the motor's 390 Hz, far
   // narrower than the hand-set 370-420 (the golden units differ by noise only).
   const auto& f0 = after.limits[0];
@@ -90,23 +85,23 @@ TEST_F(TeachCli, WritesANewVersionAndRefusesToOverwrite) {
   // Never overwrite silently.
   const auto mtime = std::filesystem::last_write_time(out);
   r = Eol(TeachArgs(out));
-  EXPECT_EQ(r.code, 2) << r.output;
-  EXPECT_NE(r.output.find(out + " exists: refusing to overwrite"), std::string::npos) << r.output;
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(out + " exists: refusing to overwrite"), std::string::npos) << r.out;
   EXPECT_EQ(std::filesystem::last_write_time(out), mtime);
   std::vector<std::string> forced = TeachArgs(out);
   forced.push_back("--force");
   r = Eol(forced);
-  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.code, 0) << r.out;
 
   // A fresh good unit passes the taught recipe; one with every magnet poorly cemented fails.
   const std::string fresh = Simulated(dir_, "fresh.csv", 999, "none", 1.0);
   r = Eol({"analyze", "--measured", fresh, "--recipe", out, "--json"}, false);
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_EQ(nlohmann::json::parse(r.output)["verdict"]["outcome"], "PASS") << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["verdict"]["outcome"], "PASS") << r.out;
   const std::string bad = Simulated(dir_, "bad.csv", 998, "all_soft", 1.0);
   r = Eol({"analyze", "--measured", bad, "--recipe", out, "--json"}, false);
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_EQ(nlohmann::json::parse(r.output)["verdict"]["outcome"], "FAIL") << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["verdict"]["outcome"], "FAIL") << r.out;
 }
 
 TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
@@ -114,14 +109,14 @@ TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
                                    dir_ / "j.json", "--json",   "--golden"};
   for (std::size_t i = 0; i < 6; ++i) {
     const CliRun a = Eol({"analyze", "--measured", golden_[i], "--json"}, false);
-    ASSERT_EQ(a.code, 0) << a.output;
+    ASSERT_EQ(a.code, 0) << a.out;
     const std::string path = dir_ / ("a" + std::to_string(i) + ".json");
-    std::ofstream(path) << a.output;
+    std::ofstream(path) << a.out;
     args.push_back(path);
   }
   const CliRun r = Eol(args, false);
-  ASSERT_EQ(r.code, 0) << r.output;
-  const nlohmann::json j = nlohmann::json::parse(r.output);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["units_used"], 6);
   EXPECT_EQ(j["recipe"]["version"], 2);
   EXPECT_EQ(j["masks"].size(), 0u);  // no curves in analyze --json: the recipe's mask stays
@@ -152,9 +147,9 @@ TEST_F(TeachCli, ReadsExportedRecords) {
   const std::string path = dir_ / "export.json";
   std::ofstream(path) << list.dump(1);
   const CliRun r = Eol({"teach", "--recipe", kRecipe, "--out", dir_ / "e.json", "--golden", path});
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("skipped " + path + "[4] SN4: ERROR"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("9 of 9 golden units used"), std::string::npos) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("skipped " + path + "[4] SN4: ERROR"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("9 of 9 golden units used"), std::string::npos) << r.out;
   const station::Recipe taught = station::LoadRecipe(dir_ / "e.json");
   EXPECT_LT(*taught.limits[0].limit.lo, 388.6);
   EXPECT_GT(*taught.limits[0].limit.hi, 391.4);
@@ -164,13 +159,13 @@ TEST_F(TeachCli, ErrorsNameTheFile) {
   const std::string junk = dir_ / "junk.json";
   std::ofstream(junk) << "{\"hello\": 1}";
   CliRun r = Eol({"teach", "--recipe", kRecipe, "--out", dir_ / "x.json", "--golden", junk});
-  EXPECT_EQ(r.code, 2) << r.output;
-  EXPECT_NE(r.output.find(junk), std::string::npos) << r.output;
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(junk), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.json"));
   r = Eol(
       {"teach", "--recipe", kRecipe, "--out", dir_ / "x.json", "--golden", golden_[0], golden_[1]});
-  EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_NE(r.output.find("too few golden units"), std::string::npos) << r.output;
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("too few golden units"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.json"));
 }
 
