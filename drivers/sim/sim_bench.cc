@@ -146,10 +146,8 @@ void SimBench::Write(FixtureOutput output, bool on) {
       }
       break;
     case FixtureOutput::kExcitationEnable:
-      if (on && !excitation_) {
-        excitation_on_at_ = now;
-        if (fault_ && fault_->on_excitation && !fault_->triggered_at) fault_->triggered_at = now;
-      }
+      if (on && !excitation_ && fault_ && fault_->on_excitation && !fault_->triggered_at)
+        fault_->triggered_at = now;
       if (!on && excitation_) excitation_off_at_ = now;
       excitation_ = on;
       break;

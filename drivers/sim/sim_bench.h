@@ -101,7 +101,6 @@ class SimBench {
   bool excitation_ = false;
   bool lamp_pass_ = false, lamp_fail_ = false;
   PhasePair pair_ = PhasePair::kUV;
-  std::optional<Clock::time_point> excitation_on_at_;
   std::optional<Clock::time_point> excitation_off_at_;
   const Clock::time_point born_ = Clock::now();
 
