@@ -25,8 +25,8 @@ bool Frf::Validate(std::string* why) const {
     return fail("frequency response has " + std::to_string(freq_hz.size()) + " frequencies but " +
                 std::to_string(value.size()) + " values");
   if (!sigma.empty() && sigma.size() != freq_hz.size())
-    return fail("frequency response has " + std::to_string(freq_hz.size()) +
-                " frequencies but " + std::to_string(sigma.size()) + " sigmas");
+    return fail("frequency response has " + std::to_string(freq_hz.size()) + " frequencies but " +
+                std::to_string(sigma.size()) + " sigmas");
   for (std::size_t k = 0; k < freq_hz.size(); ++k) {
     std::ostringstream where;
     where << "line " << k << " (" << freq_hz[k] << " Hz)";

@@ -2,6 +2,7 @@
 # package`). See README "Installing on a station PC".
 #   /usr/bin/eol                              the program
 #   /usr/share/eol/recipes/, /usr/share/eol/web/   shipped recipes and the operator page
+#   /usr/share/eol/bench/                     the SciPy peer of `eol fit-bench`
 #   /etc/eol/station.json                     the station config (a conffile)
 #   /lib/systemd/system/eol-station.service   the daemon, with systemd's watchdog
 #   /var/lib/eol/                             records and the recipes in use (made by postinst)
@@ -11,6 +12,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/recipes/ DESTINATION ${CMAKE_INSTALL_DAT
 install(FILES ${PROJECT_SOURCE_DIR}/station/web/index.html ${PROJECT_SOURCE_DIR}/station/web/app.js
               ${PROJECT_SOURCE_DIR}/station/web/style.css
         DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/web)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/deploy/bench/ DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/bench)
 install(FILES ${PROJECT_SOURCE_DIR}/deploy/debian/station.json DESTINATION /etc/eol)
 install(FILES ${PROJECT_SOURCE_DIR}/deploy/eol-station.service DESTINATION /lib/systemd/system)
 
@@ -23,6 +25,8 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION "science")
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+# The packaged program carries no debug information (build/eol.debug keeps it).
+set(CPACK_STRIP_FILES ON)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     ${PROJECT_SOURCE_DIR}/deploy/debian/conffiles ${PROJECT_SOURCE_DIR}/deploy/debian/postinst)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)

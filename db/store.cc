@@ -288,8 +288,8 @@ void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
   s.BindText(6, record.software_version);
   s.BindText(7, record.started_at);
   if (record.kind != "production" && record.kind != "self_check")
-    throw StoreError(Message(path, op, "record.kind '" + record.kind +
-                                           "' is not production or self_check"));
+    throw StoreError(
+        Message(path, op, "record.kind '" + record.kind + "' is not production or self_check"));
   s.BindText(8, record.kind);
   if (!s.Step()) throw StoreError(Message(path, op, "the insert returned no id"));
   const std::int64_t id = s.Int(0);
@@ -351,10 +351,11 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
     if (!c.is_object() || !c.contains("master") || !c["master"].is_string() ||
         !c.contains("passed") || !c["passed"].is_boolean())
       throw StoreError(Message(path, check_op, "record.self_check needs master and passed"));
-    Statement sc(db, path,
-                 "INSERT INTO self_checks (test_id, at, station_id, master, serial, passed, detail) "
-                 "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
-                 check_op);
+    Statement sc(
+        db, path,
+        "INSERT INTO self_checks (test_id, at, station_id, master, serial, passed, detail) "
+        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+        check_op);
     sc.BindInt(1, record.id);
     sc.BindText(2, record.finished_at);
     sc.BindText(3, record.station_id);
@@ -573,8 +574,8 @@ std::string Store::IntegrityCheck() {
 }
 
 int Store::CountRunning() {
-  return static_cast<int>(PragmaInt(db_, path_, "SELECT count(*) FROM tests WHERE outcome = 'RUNNING'",
-                                    "count running tests"));
+  return static_cast<int>(PragmaInt(
+      db_, path_, "SELECT count(*) FROM tests WHERE outcome = 'RUNNING'", "count running tests"));
 }
 
 void Store::AppendAudit(const RecipeAudit& a) {
@@ -586,9 +587,15 @@ void Store::AppendAudit(const RecipeAudit& a) {
   s.BindText(2, a.who);
   s.BindText(3, a.role);
   s.BindText(4, a.recipe_id);
-  if (a.old_version) s.BindInt(5, *a.old_version); else s.BindNull(5);
+  if (a.old_version)
+    s.BindInt(5, *a.old_version);
+  else
+    s.BindNull(5);
   s.BindInt(6, a.new_version);
-  if (a.old_hash.empty()) s.BindNull(7); else s.BindText(7, a.old_hash);
+  if (a.old_hash.empty())
+    s.BindNull(7);
+  else
+    s.BindText(7, a.old_hash);
   s.BindText(8, a.new_hash);
   s.BindText(9, a.path);
   s.Step();
@@ -623,7 +630,8 @@ std::vector<SelfCheckEntry> Store::SelfChecks(int limit) {
 }
 
 std::optional<SelfCheckEntry> Store::LatestSelfCheck(const std::string& master) {
-  Statement s(db_, path_, std::string(kSelectSelfChecks) + "WHERE master = ?1 ORDER BY id DESC LIMIT 1",
+  Statement s(db_, path_,
+              std::string(kSelectSelfChecks) + "WHERE master = ?1 ORDER BY id DESC LIMIT 1",
               "read the latest self-check of the " + master + " master");
   s.BindText(1, master);
   if (!s.Step()) return std::nullopt;

@@ -29,9 +29,14 @@ void from_json(const nlohmann::json& j, Limit& l) {
 }
 
 void to_json(nlohmann::json& j, const Measurement& m) {
-  j = {{"name", m.name},       {"unit", m.unit},   {"doc", m.doc},
-       {"value", Num(m.value)}, {"sigma", Num(m.sigma)}, {"limit", m.limit},
-       {"outcome", ToString(m.outcome)}, {"marginal", m.marginal}};
+  j = {{"name", m.name},
+       {"unit", m.unit},
+       {"doc", m.doc},
+       {"value", Num(m.value)},
+       {"sigma", Num(m.sigma)},
+       {"limit", m.limit},
+       {"outcome", ToString(m.outcome)},
+       {"marginal", m.marginal}};
 }
 
 void from_json(const nlohmann::json& j, Measurement& m) {
@@ -42,7 +47,7 @@ void from_json(const nlohmann::json& j, Measurement& m) {
   m.sigma = NumOr(j, "sigma");
   m.limit = j.value("limit", Limit{});
   const std::string o = j.value("outcome", "UNSET");
-  m.outcome = o == "PASS" ? MeasurementOutcome::kPass
+  m.outcome = o == "PASS"   ? MeasurementOutcome::kPass
               : o == "FAIL" ? MeasurementOutcome::kFail
                             : MeasurementOutcome::kUnset;
   m.marginal = j.value("marginal", false);
@@ -127,8 +132,7 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   const std::string outcome = j.at("outcome").get<std::string>();
   const auto parsed = analysis::ParseOutcome(outcome);
   if (!parsed)
-    throw nlohmann::json::other_error::create(501, "outcome: unknown value '" + outcome + "'",
-                                              &j);
+    throw nlohmann::json::other_error::create(501, "outcome: unknown value '" + outcome + "'", &j);
   r.outcome = *parsed;
   r.reasons = j.value("reasons", std::vector<std::string>{});
   r.measurements = j.value("measurements", std::vector<analysis::Measurement>{});

@@ -5,11 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "analysis/qc/measurement.h"
 
@@ -40,8 +39,8 @@ struct TestRecord {
   int recipe_version = 0;
   std::string recipe_hash;  // SHA-256 of the recipe's canonical JSON
   std::string software_version;
-  std::string started_at;   // ISO 8601 UTC, millisecond precision
-  std::string finished_at;  // empty while the test runs
+  std::string started_at;                 // ISO 8601 UTC, millisecond precision
+  std::string finished_at;                // empty while the test runs
   std::optional<std::int64_t> retest_of;  // id of the first test of this serial, if any
 
   analysis::Outcome outcome = analysis::Outcome::kError;

@@ -4,6 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash deploy/install-deps.sh --tests
+bash deploy/check-format.sh
 (cd tests/peers/browser && npm ci --no-audit --no-fund --loglevel=error)
 bash deploy/build.sh -DEOL_WERROR=ON
 cd build

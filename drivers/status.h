@@ -31,7 +31,7 @@ template <typename T>
 class StatusOr {
  public:
   StatusOr(T value) : value_(std::move(value)), status_(Status::Ok()) {}  // NOLINT: implicit
-  StatusOr(Status error) : status_(std::move(error)) {                      // NOLINT: implicit
+  StatusOr(Status error) : status_(std::move(error)) {                    // NOLINT: implicit
     if (status_.ok()) throw std::logic_error("StatusOr constructed from an ok Status");
   }
   bool ok() const { return status_.ok(); }

@@ -2,7 +2,7 @@
 
 #include <filesystem>
 
-#include "drivers/json_config.h"
+#include "drivers/io/json_config.h"
 #include "station/serial_number.h"
 
 namespace eol::station {
@@ -17,7 +17,7 @@ std::string Resolve(const std::string& base_dir, const std::string& p) {
 
 StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,
                                  const std::string& base_dir) {
-  using drivers::JsonObject;
+  using io::JsonObject;
   try {
     const JsonObject root(j, "");
     StationConfig c;
@@ -30,7 +30,7 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       http->Require(c.http_port >= 0 && c.http_port <= 65535, "port", "must be in [0, 65535]");
       if (http->Has("tokens")) {
         const nlohmann::json& list = http->Raw("tokens");
-        if (!list.is_array()) throw drivers::ConfigError(http->PathOf("tokens") + ": must be an array");
+        if (!list.is_array()) throw io::ConfigError(http->PathOf("tokens") + ": must be an array");
         for (std::size_t i = 0; i < list.size(); ++i) {
           const JsonObject t(list[i], http->PathOf("tokens") + "/" + std::to_string(i));
           ApiToken token{t.RequiredString("name"), t.RequiredString("role"),
@@ -39,10 +39,10 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
                     "must be operator or engineer");
           // Token values never appear in messages.
           if (token.token.size() < 16)
-            throw drivers::ConfigError(t.PathOf("token") + ": must be at least 16 characters");
+            throw io::ConfigError(t.PathOf("token") + ": must be at least 16 characters");
           for (const ApiToken& other : c.tokens)
             if (other.token == token.token)
-              throw drivers::ConfigError(t.PathOf("token") + ": is used twice");
+              throw io::ConfigError(t.PathOf("token") + ": is used twice");
           t.RejectUnknown();
           c.tokens.push_back(token);
         }
@@ -58,8 +58,8 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
                  "watchdog_period_ms", "must be in [1, 50] ms (the reaction target is 50 ms)");
       s->Require(c.safety.heartbeat_timeout_ms >= 600, "heartbeat_timeout_ms",
                  "must be at least 600 ms (the heartbeat increments every 500 ms)");
-      s->Require(c.safety.poll_period_ms >= 1 && c.safety.poll_period_ms <= 500,
-                 "poll_period_ms", "must be in [1, 500] ms");
+      s->Require(c.safety.poll_period_ms >= 1 && c.safety.poll_period_ms <= 500, "poll_period_ms",
+                 "must be in [1, 500] ms");
       s->RejectUnknown();
     }
     c.serial_from_stdin = root.Bool("serial_from_stdin", false);
@@ -95,13 +95,13 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
     if (root.Has("sim")) c.drivers["sim"] = root.Raw("sim");
     root.RejectUnknown();
     return c;
-  } catch (const drivers::ConfigError& e) {
-    throw drivers::ConfigError("config " + source + ": " + e.what());
+  } catch (const io::ConfigError& e) {
+    throw io::ConfigError("config " + source + ": " + e.what());
   }
 }
 
 StationConfig LoadStationConfig(const std::string& path) {
-  const nlohmann::json j = drivers::ReadJsonFile(path);
+  const nlohmann::json j = io::ReadJsonFile(path);
   const std::string dir = std::filesystem::absolute(path).parent_path().string();
   return ParseStationConfig(j, path, dir);
 }

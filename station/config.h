@@ -9,7 +9,7 @@
 //                       {"name": "qe-anna", "role": "engineer", "token": "..."}]},
 //     Reads need no token. With tokens configured, starting a test needs an operator or
 //     engineer token; changing the recipe always needs an engineer token.
-//   "fixture": {"driver": "sim" | ...},              see drivers/factory.h
+//   "fixture": {"driver": "sim" | ...},              see drivers/factory/factory.h
 //   "daq": {"driver": "sim" | ...},
 //   "sim": {...},                                    the simulated bench, when a driver is sim
 //   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500},
@@ -19,10 +19,9 @@
 // }
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace eol::station {
 
@@ -40,10 +39,11 @@ struct ApiToken {
 
 // Self-checks with master parts (station/self_check.h). Off when good_master is empty.
 struct SelfCheckConfig {
-  std::string good_master;    // serial of a known good unit: must PASS
-  std::string limit_master;   // serial of a deliberately soft-bonded rotor: must FAIL on the resonance
-  int every_n_tests = 50;     // production tests a passing check covers (0: no count limit)
-  double every_hours = 8.0;   // hours a passing check stays valid (0: no time limit)
+  std::string good_master;  // serial of a known good unit: must PASS
+  std::string
+      limit_master;        // serial of a deliberately soft-bonded rotor: must FAIL on the resonance
+  int every_n_tests = 50;  // production tests a passing check covers (0: no count limit)
+  double every_hours = 8.0;  // hours a passing check stays valid (0: no time limit)
   bool enabled() const { return !good_master.empty(); }
 };
 
@@ -60,7 +60,7 @@ struct StationConfig {
   nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}
 };
 
-// Throws drivers::ConfigError naming the file and the JSON path.
+// Throws io::ConfigError naming the file and the JSON path.
 StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,
                                  const std::string& base_dir);
 StationConfig LoadStationConfig(const std::string& path);

@@ -116,10 +116,16 @@ void HttpApi::Routes() {
     }
     nlohmann::json list = nlohmann::json::array();
     for (const auto& a : log)
-      list.push_back({{"at", a.at}, {"who", a.who}, {"role", a.role}, {"recipe_id", a.recipe_id},
-                      {"old_version", a.old_version ? nlohmann::json(*a.old_version) : nlohmann::json()},
-                      {"new_version", a.new_version}, {"old_hash", a.old_hash},
-                      {"new_hash", a.new_hash}, {"path", a.path}});
+      list.push_back(
+          {{"at", a.at},
+           {"who", a.who},
+           {"role", a.role},
+           {"recipe_id", a.recipe_id},
+           {"old_version", a.old_version ? nlohmann::json(*a.old_version) : nlohmann::json()},
+           {"new_version", a.new_version},
+           {"old_hash", a.old_hash},
+           {"new_hash", a.new_hash},
+           {"path", a.path}});
     SendJson(res, 200, {{"audit", list}});
   });
 
@@ -129,7 +135,8 @@ void HttpApi::Routes() {
     m << "# HELP eol_tests_total Finished tests since the station started, by outcome.\n"
       << "# TYPE eol_tests_total counter\n";
     for (const char* o : {"pass", "fail", "error", "aborted"})
-      m << "eol_tests_total{outcome=\"" << o << "\"} " << st["counts"][o].get<std::uint64_t>() << "\n";
+      m << "eol_tests_total{outcome=\"" << o << "\"} " << st["counts"][o].get<std::uint64_t>()
+        << "\n";
     m << "# HELP eol_testing 1 while a test is in progress.\n# TYPE eol_testing gauge\n"
       << "eol_testing " << (st["state"] == "wait_serial" || st["state"] == "idle" ? 0 : 1) << "\n";
     if (st["last"].is_object()) {
@@ -169,7 +176,8 @@ void HttpApi::Routes() {
       std::lock_guard<std::mutex> lock(db_mu_);
       t = db_->Test(id, true);
     }
-    if (!t) return SendError(res, 404, "not_found", "no finished test with id " + std::to_string(id));
+    if (!t)
+      return SendError(res, 404, "not_found", "no finished test with id " + std::to_string(id));
     SendJson(res, 200, *t);
   });
 
@@ -214,7 +222,8 @@ void HttpApi::Routes() {
         return SendError(res, 400, "bad_reference", why);
     if (req.has_param("sigma_span")) {
       const std::string v = req.get_param_value("sigma_span");
-      if (v != "4" && v != "6") return SendError(res, 400, "bad_sigma_span", "sigma_span must be 4 or 6");
+      if (v != "4" && v != "6")
+        return SendError(res, 400, "bad_sigma_span", "sigma_span must be 4 or 6");
       q.gauge.sigma_span = std::stod(v);
     }
     if (const std::string bad = ValidateStatsRequest(q); !bad.empty())
@@ -244,11 +253,12 @@ void HttpApi::Routes() {
     const auto recipe = handlers_.current_recipe();
     const analysis::DetectabilitySummary summary = analysis::PredictDetectability(
         DetectabilityOptionsFor(*recipe, k_fixture, limit_sigmas, required_sigmas));
-    const std::string source = k_fixture > 0.0 ? "k_fixture parameter" : "the chain's default fixture";
-    nlohmann::json body = DetectabilityJson(summary, source,
-                                            "the recipe's limits as +-" +
-                                                nlohmann::json(limit_sigmas).dump() + " sigma",
-                                            required_sigmas);
+    const std::string source =
+        k_fixture > 0.0 ? "k_fixture parameter" : "the chain's default fixture";
+    nlohmann::json body = DetectabilityJson(
+        summary, source,
+        "the recipe's limits as +-" + nlohmann::json(limit_sigmas).dump() + " sigma",
+        required_sigmas);
     body["recipe"] = {{"id", recipe->id}, {"version", recipe->version}, {"hash", recipe->hash}};
     SendJson(res, summary.usable ? 200 : 422, body);
   });
@@ -343,8 +353,9 @@ void HttpApi::Routes() {
             return sink.write(ping.data(), ping.size());
           }
           for (const auto& [seq, e] : events) {
-            const std::string msg = "id: " + std::to_string(seq) + "\nevent: " +
-                                    e.value("type", "message") + "\ndata: " + e.dump() + "\n\n";
+            const std::string msg = "id: " + std::to_string(seq) +
+                                    "\nevent: " + e.value("type", "message") +
+                                    "\ndata: " + e.dump() + "\n\n";
             if (!sink.write(msg.data(), msg.size())) return false;
             *last = seq;
           }
@@ -356,23 +367,25 @@ void HttpApi::Routes() {
     std::string page;
     if (!options_.web_root.empty()) page = ReadFile(options_.web_root + "/index.html");
     if (page.empty())
-      page = "<!doctype html><title>EOL station</title><h1>EOL station</h1>"
-             "<p>The operator page is not installed; see <a href=\"/api/status\">/api/status</a>.";
+      page =
+          "<!doctype html><title>EOL station</title><h1>EOL station</h1>"
+          "<p>The operator page is not installed; see <a href=\"/api/status\">/api/status</a>.";
     res.set_content(page, "text/html; charset=utf-8");
   });
   if (!options_.web_root.empty()) s.set_mount_point("/static", options_.web_root);
 
-  s.set_exception_handler([](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
-    std::string what = "unknown";
-    try {
-      std::rethrow_exception(ep);
-    } catch (const std::exception& e) {
-      what = e.what();
-    } catch (...) {
-    }
-    spdlog::error("http: {} {}: {}", req.method, req.path, what);
-    SendError(res, 500, "internal", what);
-  });
+  s.set_exception_handler(
+      [](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+        std::string what = "unknown";
+        try {
+          std::rethrow_exception(ep);
+        } catch (const std::exception& e) {
+          what = e.what();
+        } catch (...) {
+        }
+        spdlog::error("http: {} {}: {}", req.method, req.path, what);
+        SendError(res, 500, "internal", what);
+      });
 }
 
 }  // namespace eol::station

@@ -3,10 +3,9 @@
 // give the same recipe and the same report.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "analysis/qc/detectability.h"
 #include "analysis/qc/teach.h"
@@ -33,8 +32,7 @@ analysis::GoldenUnit GoldenFromRecord(const db::TestRecord& record, const std::s
 // taken as +-limit_sigmas (override unit_spread afterwards for a measured spread).
 analysis::DetectabilityOptions DetectabilityOptionsFor(const Recipe& recipe,
                                                        double k_fixture_nm_per_rad,
-                                                       double limit_sigmas,
-                                                       double required_sigmas);
+                                                       double limit_sigmas, double required_sigmas);
 
 nlohmann::json DetectabilityJson(const analysis::DetectabilitySummary& summary,
                                  const std::string& k_fixture_source,

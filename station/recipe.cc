@@ -6,13 +6,13 @@
 #include <cstdio>
 
 #include "analysis/qc/measurement_names.h"
-#include "drivers/json_config.h"
+#include "drivers/io/json_config.h"
 
 namespace eol::station {
 namespace {
 
-using drivers::ConfigError;
-using drivers::JsonObject;
+using io::ConfigError;
+using io::JsonObject;
 
 void ParseExcitation(const JsonObject& e, Recipe& r) {
   r.excitation.f_lo_hz = e.RequiredNumber("f_lo_hz");
@@ -42,8 +42,7 @@ void ParseExcitation(const JsonObject& e, Recipe& r) {
             "must be greater than " + e.PathOf("f_lo_hz"));
   e.Require(r.excitation.sample_rate_hz >= 2.5 * r.excitation.f_hi_hz, "sample_rate_hz",
             "must be at least 2.5 x f_hi_hz (anti-alias margin)");
-  e.Require(r.excitation.peak_v > 0 && r.excitation.peak_v <= 50, "peak_v",
-            "must be in (0, 50] V");
+  e.Require(r.excitation.peak_v > 0 && r.excitation.peak_v <= 50, "peak_v", "must be in (0, 50] V");
   e.Require(periods >= 2 && periods <= 1000, "periods", "must be in [2, 1000]");
   e.Require(transient >= 0 && transient <= 100, "transient_periods", "must be in [0, 100]");
   for (std::size_t i = 0; i < pairs.size(); ++i) {
@@ -108,8 +107,7 @@ void ParseLimits(const nlohmann::json& limits, const std::string& path, Recipe& 
     for (auto n : all) known += (known.empty() ? "" : ", ") + std::string(n);
     l.Require(std::find(all.begin(), all.end(), s.name) != all.end(), "name",
               "is not a measurement the analysis produces (known: " + known + ")");
-    for (const auto& other : r.limits)
-      l.Require(other.name != s.name, "name", "is declared twice");
+    for (const auto& other : r.limits) l.Require(other.name != s.name, "name", "is declared twice");
     s.unit = l.String("unit", "");
     s.doc = l.String("doc", "");
     s.limit.lo = l.OptionalNumber("lo");
@@ -130,14 +128,16 @@ void ParseMasks(const nlohmann::json& masks, const std::string& path, Recipe& r)
     const JsonObject m(masks[i], path + "/" + std::to_string(i));
     analysis::CurveMask mask;
     mask.name = m.RequiredString("name");
-    const bool name_ok = !mask.name.empty() && mask.name.size() <= 40 &&
-                         mask.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") ==
-                             std::string::npos;
+    const bool name_ok =
+        !mask.name.empty() && mask.name.size() <= 40 &&
+        mask.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") == std::string::npos;
     m.Require(name_ok, "name", "must be 1 to 40 of a-z, 0-9 and _");
-    for (const auto& other : r.masks) m.Require(other.name != mask.name, "name", "is declared twice");
+    for (const auto& other : r.masks)
+      m.Require(other.name != mask.name, "name", "is declared twice");
     const std::string q = m.String("quantity", "re_ohm");
     m.Require(q == "re_ohm" || q == "abs_ohm", "quantity", "must be re_ohm or abs_ohm");
-    mask.quantity = q == "re_ohm" ? analysis::MaskQuantity::kReOhm : analysis::MaskQuantity::kAbsOhm;
+    mask.quantity =
+        q == "re_ohm" ? analysis::MaskQuantity::kReOhm : analysis::MaskQuantity::kAbsOhm;
     mask.max_lines_outside = m.Integer("max_lines_outside", 0);
     mask.guard_sigma = m.Number("guard_sigma", 0.0);
     const nlohmann::json& pts = m.Raw("points");
@@ -258,6 +258,6 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
   }
 }
 
-Recipe LoadRecipe(const std::string& path) { return ParseRecipe(drivers::ReadJsonFile(path), path); }
+Recipe LoadRecipe(const std::string& path) { return ParseRecipe(io::ReadJsonFile(path), path); }
 
 }  // namespace eol::station

@@ -4,7 +4,8 @@
 //   "id": "pmsm-10pole", "version": 1, "description": "...",
 //   "motor":      {"poles": 10, "rotor_inertia_kg_m2": 1.0e-4},
 //   "excitation": {"f_lo_hz": 200, "f_hi_hz": 800, "line_spacing_hz": 1, "sample_rate_hz": 8000,
-//                  "peak_v": 2.0, "periods": 4, "transient_periods": 1, "phase_pair": 0 | "phase_pairs": [0, 1, 2]},
+//                  "peak_v": 2.0, "periods": 4, "transient_periods": 1, "phase_pair": 0 |
+//                  "phase_pairs": [0, 1, 2]},
 //   "fixture":    {"clamp_pressure_bar": {"lo": 4.5, "hi": 6.5}, "clamp_timeout_s": 2.0,
 //                  "release_timeout_s": 2.0},
 //   "analysis":   {"f0_min_hz": 250, "f0_max_hz": 700, "q_min": 5, "q_max": 500},
@@ -24,10 +25,9 @@
 #pragma once
 
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "analysis/impedance_analysis.h"
 #include "analysis/qc/curve_mask.h"
@@ -48,8 +48,8 @@ struct Recipe {
   double rotor_inertia_kg_m2 = 0.0;  // the given J_r of the paper's eq. 24-30
 
   analysis::MultisineOptions excitation;
-  std::size_t periods = 4;            // averaged
-  std::size_t transient_periods = 1;  // played first and dropped
+  std::size_t periods = 4;                                  // averaged
+  std::size_t transient_periods = 1;                        // played first and dropped
   drivers::PhasePair phase_pair = drivers::PhasePair::kUV;  // the first of phase_pairs
   // Measured in this order in one clamping ("phase_pairs": [0, 1, 2], or "phase_pair": 0 for
   // one). The first pair's measurements and curves carry the plain names (limits, masks,
@@ -77,7 +77,7 @@ struct Recipe {
   nlohmann::json source;  // the recipe as loaded
 };
 
-// Throws drivers::ConfigError with "<source>: <json path>: <rule>".
+// Throws io::ConfigError with "<source>: <json path>: <rule>".
 Recipe ParseRecipe(const nlohmann::json& j, const std::string& source);
 Recipe LoadRecipe(const std::string& path);
 

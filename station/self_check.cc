@@ -27,7 +27,7 @@ const analysis::Measurement* FindMeasurement(const db::TestRecord& r, std::strin
 
 nlohmann::json EntryJson(const std::optional<db::SelfCheckEntry>& e) {
   if (!e) return nullptr;
-  return {{"test_id", e->test_id}, {"at", e->at},       {"serial", e->serial},
+  return {{"test_id", e->test_id}, {"at", e->at},         {"serial", e->serial},
           {"master", e->master},   {"passed", e->passed}, {"detail", e->detail}};
 }
 

@@ -17,10 +17,9 @@
 #pragma once
 
 #include <chrono>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "db/store.h"
 #include "db/test_record.h"
@@ -38,7 +37,7 @@ nlohmann::json JudgeMasterTest(const std::string& master, const db::TestRecord& 
 struct LockoutState {
   bool enabled = false;
   bool locked = false;
-  std::string reason;  // why locked; empty when not
+  std::string reason;                             // why locked; empty when not
   std::optional<db::SelfCheckEntry> good, limit;  // latest check of each master
   int tests_since_check = 0;                      // production tests since the older one
   nlohmann::json ToJson() const;

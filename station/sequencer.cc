@@ -104,8 +104,7 @@ std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& r, bo
     if (in.clamp_pressure_bar < r.clamp_pressure_lo_bar ||
         in.clamp_pressure_bar > r.clamp_pressure_hi_bar)
       return "clamp pressure " + Fixed(in.clamp_pressure_bar, 2) + " bar outside " +
-             Fixed(r.clamp_pressure_lo_bar, 2) + ".." + Fixed(r.clamp_pressure_hi_bar, 2) +
-             " bar";
+             Fixed(r.clamp_pressure_lo_bar, 2) + ".." + Fixed(r.clamp_pressure_hi_bar, 2) + " bar";
   }
   return "";
 }
@@ -138,7 +137,8 @@ class Sequencer::Watchdog {
 
  private:
   void Run() {
-    const auto period = std::chrono::duration<double, std::milli>(seq_.options_.safety.watchdog_period_ms);
+    const auto period =
+        std::chrono::duration<double, std::milli>(seq_.options_.safety.watchdog_period_ms);
     while (!stop_) {
       std::string why;
       auto in = seq_.fixture_.ReadInputs();
@@ -188,8 +188,8 @@ Sequencer::Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& st
       board_(board),
       options_(std::move(options)),
       excitation_(analysis::DesignMultisine(recipe_->excitation)),
-      heartbeat_(std::chrono::milliseconds(
-          static_cast<long>(options_.safety.heartbeat_timeout_ms))) {}
+      heartbeat_(
+          std::chrono::milliseconds(static_cast<long>(options_.safety.heartbeat_timeout_ms))) {}
 
 void Sequencer::SetRecipe(std::shared_ptr<const Recipe> recipe) {
   excitation_ = analysis::DesignMultisine(recipe->excitation);
@@ -223,7 +223,8 @@ void Sequencer::Enter(db::TestRecord& record, SeqState s, const std::string& det
 
 drivers::FixtureInputs Sequencer::ReadInputs(const char* purpose) {
   auto in = fixture_.ReadInputs();
-  if (!in.ok()) throw Fault{analysis::Outcome::kError, std::string(purpose) + ": " + in.status().message()};
+  if (!in.ok())
+    throw Fault{analysis::Outcome::kError, std::string(purpose) + ": " + in.status().message()};
   return in.value();
 }
 
@@ -241,14 +242,15 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
   }
   const drivers::FixtureInputs in = ReadInputs("check interlocks");
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
-    throw Fault{analysis::Outcome::kError,
-                "fixture heartbeat frozen for " + Fixed(heartbeat_.stale_ms(Clock::now()), 0) + " ms"};
+    throw Fault{analysis::Outcome::kError, "fixture heartbeat frozen for " +
+                                               Fixed(heartbeat_.stale_ms(Clock::now()), 0) + " ms"};
   if (const std::string why = InterlockFault(in, *recipe_, false); !why.empty())
     throw Fault{analysis::Outcome::kError, "interlock: " + why};
 }
 
 void Sequencer::ClampAndConfirm(db::TestRecord& record) {
-  Enter(record, SeqState::kClamp, "phase pair " + std::to_string(static_cast<int>(recipe_->phase_pair)));
+  Enter(record, SeqState::kClamp,
+        "phase pair " + std::to_string(static_cast<int>(recipe_->phase_pair)));
   if (const drivers::Status s = fixture_.Activate(); !s.ok())
     throw Fault{analysis::Outcome::kError, s.message()};
   if (const drivers::Status s = fixture_.SelectPhasePair(recipe_->phase_pair); !s.ok())
@@ -408,8 +410,9 @@ void Sequencer::Unclamp(db::TestRecord& record) {
   Enter(record, SeqState::kUnclamp);
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false); !s.ok())
     throw Fault{analysis::Outcome::kError, "unclamp: " + s.message()};
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(recipe_->release_timeout_s));
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(recipe_->release_timeout_s));
   while (!ReadInputs("confirm release").released) {
     if (Clock::now() > deadline)
       throw Fault{analysis::Outcome::kError,
@@ -430,9 +433,12 @@ void Sequencer::SafeState(db::TestRecord& record) {
   //    emergency-stop chain is healthy. Otherwise leave the part clamped and say so.
   auto in = fixture_.ReadInputs();
   std::string unsafe;
-  if (!in.ok()) unsafe = "fixture not answering";
-  else if (!in.value().estop_ok) unsafe = "emergency stop open";
-  else if (!in.value().door_closed) unsafe = "door open";
+  if (!in.ok())
+    unsafe = "fixture not answering";
+  else if (!in.value().estop_ok)
+    unsafe = "emergency stop open";
+  else if (!in.value().door_closed)
+    unsafe = "door open";
   if (!unsafe.empty()) {
     record.reasons.push_back("clamp left as it is: " + unsafe);
   } else {
@@ -553,7 +559,8 @@ void Sequencer::PublishLockout() {
     board_.SetLockout(
         EvaluateLockout(options_.self_check, store_, std::chrono::system_clock::now()).ToJson());
   } catch (const std::exception& e) {
-    board_.SetLockout({{"locked", true}, {"reason", std::string("self-check state unknown: ") + e.what()}});
+    board_.SetLockout(
+        {{"locked", true}, {"reason", std::string("self-check state unknown: ") + e.what()}});
   }
 }
 

@@ -124,7 +124,7 @@ class Sequencer {
 
   std::atomic<SeqState> state_{SeqState::kWaitSerial};
   std::atomic<bool> stop_requested_{false};  // sticky: RequestAbort() was called
-  std::atomic<bool> abort_{false};  // read by the DAQ: stop playing now (reset per test)
+  std::atomic<bool> abort_{false};           // read by the DAQ: stop playing now (reset per test)
   std::mutex abort_mu_;
   std::string abort_reason_;
   std::chrono::steady_clock::time_point test_start_{};

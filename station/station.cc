@@ -6,7 +6,6 @@
 #include <fstream>
 
 #include "db/clock.h"
-#include "station/files/recording_files.h"
 #include "station/systemd_notify.h"
 
 namespace eol::station {
@@ -14,13 +13,13 @@ namespace eol::station {
 Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
     : config_(std::move(config)) {
   recipe_ = std::make_shared<const Recipe>(LoadRecipe(config_.recipe_path));
-  spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_->id, recipe_->version,
-               config_.recipe_path, recipe_->hash.substr(0, 12));
+  spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_->id, recipe_->version, config_.recipe_path,
+               recipe_->hash.substr(0, 12));
   store_ = db::Store::Open(config_.db_path);
   if (store_->aborted_on_open() > 0)
     spdlog::warn("store {}: {} test(s) interrupted by a previous stop recorded as ABORTED",
                  config_.db_path, store_->aborted_on_open());
-  drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench), files::ReadRecordingFile);
+  drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench));
   board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_->id, recipe_->hash);
   if (const drivers::Status s = drivers_.fixture->Connect(); !s.ok()) {
     spdlog::error("{} (will retry at the next test)", s.message());
@@ -79,13 +78,13 @@ std::shared_ptr<const Recipe> Station::recipe() const {
 
 std::pair<int, nlohmann::json> Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who) {
   auto error = [](int status, const std::string& code, const std::string& message) {
-    return std::pair<int, nlohmann::json>(
-        status, {{"error", {{"code", code}, {"message", message}}}});
+    return std::pair<int, nlohmann::json>(status,
+                                          {{"error", {{"code", code}, {"message", message}}}});
   };
   std::shared_ptr<const Recipe> next;
   try {
     next = std::make_shared<const Recipe>(ParseRecipe(j, "PUT /api/recipe"));
-  } catch (const drivers::ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     return error(400, "invalid_recipe", e.what());
   }
   // Holding the queue lock keeps the sequencer idle until the new recipe is in place.
@@ -94,16 +93,17 @@ std::pair<int, nlohmann::json> Station::ChangeRecipe(const nlohmann::json& j, co
     return error(409, "busy", "a test is running or waiting; change the recipe between tests");
   const std::shared_ptr<const Recipe> current = recipe();
   if (next->id != current->id)
-    return error(409, "wrong_recipe", "recipe id must stay '" + current->id +
-                                          "' (another motor type needs another station config)");
+    return error(409, "wrong_recipe",
+                 "recipe id must stay '" + current->id +
+                     "' (another motor type needs another station config)");
   if (next->version <= current->version)
     return error(409, "version_not_increased",
                  "version must increase: the station runs version " +
                      std::to_string(current->version) + ", got " + std::to_string(next->version));
   namespace fs = std::filesystem;
   const fs::path path = config_.recipe_path;
-  const fs::path kept = path.parent_path() / (path.stem().string() + ".v" +
-                                              std::to_string(current->version) + ".json");
+  const fs::path kept = path.parent_path() /
+                        (path.stem().string() + ".v" + std::to_string(current->version) + ".json");
   try {
     if (!fs::exists(kept)) fs::copy_file(path, kept);
     const fs::path tmp = path.string() + ".tmp";
@@ -137,10 +137,13 @@ std::pair<int, nlohmann::json> Station::ChangeRecipe(const nlohmann::json& j, co
   spdlog::warn("recipe {} changed by {} ({}): v{} {} -> v{} {}", next->id, who.name, who.role,
                current->version, current->hash.substr(0, 12), next->version,
                next->hash.substr(0, 12));
-  return {200, {{"id", next->id}, {"version", next->version}, {"hash", next->hash},
-                {"path", path.string()},
-                {"previous", {{"version", current->version}, {"hash", current->hash},
-                              {"kept_as", kept.string()}}}}};
+  return {200,
+          {{"id", next->id},
+           {"version", next->version},
+           {"hash", next->hash},
+           {"path", path.string()},
+           {"previous",
+            {{"version", current->version}, {"hash", current->hash}, {"kept_as", kept.string()}}}}};
 }
 
 int Station::http_port() const { return http_ ? http_->port() : 0; }

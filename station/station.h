@@ -11,7 +11,7 @@
 #include <string>
 
 #include "db/store.h"
-#include "drivers/factory.h"
+#include "drivers/factory/factory.h"
 #include "station/config.h"
 #include "station/http_api.h"
 #include "station/recipe.h"

@@ -179,19 +179,20 @@ nlohmann::json StatsReport(db::Store& store, const StatsRequest& req) {
       if (d.alarm)
         alarms.push_back(g.recipe_id + " v" + std::to_string(g.recipe_version) + ": " + d.message);
       const bool have = c.sample.n > 0;
-      measurements.push_back({{"name", name},
-                              {"unit", s.unit},
-                              {"lo", Opt(s.limit.lo)},
-                              {"hi", Opt(s.limit.hi)},
-                              {"n", c.sample.n},
-                              {"mean", have ? nlohmann::json(c.sample.mean) : nlohmann::json()},
-                              {"sd", c.sample.n > 1 ? nlohmann::json(c.sample.sd) : nlohmann::json()},
-                              {"min", have ? nlohmann::json(c.sample.min) : nlohmann::json()},
-                              {"max", have ? nlohmann::json(c.sample.max) : nlohmann::json()},
-                              {"cp", Opt(c.cp)},
-                              {"cpk", Opt(c.cpk)},
-                              {"message", c.message},
-                              {"drift", DriftJson(d)}});
+      measurements.push_back(
+          {{"name", name},
+           {"unit", s.unit},
+           {"lo", Opt(s.limit.lo)},
+           {"hi", Opt(s.limit.hi)},
+           {"n", c.sample.n},
+           {"mean", have ? nlohmann::json(c.sample.mean) : nlohmann::json()},
+           {"sd", c.sample.n > 1 ? nlohmann::json(c.sample.sd) : nlohmann::json()},
+           {"min", have ? nlohmann::json(c.sample.min) : nlohmann::json()},
+           {"max", have ? nlohmann::json(c.sample.max) : nlohmann::json()},
+           {"cp", Opt(c.cp)},
+           {"cpk", Opt(c.cpk)},
+           {"message", c.message},
+           {"drift", DriftJson(d)}});
     }
     recipes.push_back({{"recipe_id", g.recipe_id},
                        {"recipe_version", g.recipe_version},
@@ -200,10 +201,10 @@ nlohmann::json StatsReport(db::Store& store, const StatsRequest& req) {
                        {"outcomes", g.outcomes},
                        {"measurements", measurements}});
   }
-  nlohmann::json window = {{"from", req.from ? nlohmann::json(*req.from) : nlohmann::json()},
-                           {"to", req.to ? nlohmann::json(*req.to) : nlohmann::json()},
-                           {"recipe_hash", req.recipe_hash ? nlohmann::json(*req.recipe_hash)
-                                                           : nlohmann::json()}};
+  nlohmann::json window = {
+      {"from", req.from ? nlohmann::json(*req.from) : nlohmann::json()},
+      {"to", req.to ? nlohmann::json(*req.to) : nlohmann::json()},
+      {"recipe_hash", req.recipe_hash ? nlohmann::json(*req.recipe_hash) : nlohmann::json()}};
   return {{"window", window},
           {"recipes", recipes},
           {"alarms", alarms},

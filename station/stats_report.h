@@ -23,10 +23,9 @@
 #pragma once
 
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "analysis/qc/statistics.h"
 #include "db/store.h"
@@ -50,7 +49,6 @@ std::string ValidateStatsRequest(const StatsRequest& request);
 nlohmann::json StatsReport(db::Store& store, const StatsRequest& request);
 
 // "resonance_f_hz=390.2" -> {name, value}; false with the reason otherwise.
-bool ParseReference(const std::string& text, std::map<std::string, double>& into,
-                    std::string* why);
+bool ParseReference(const std::string& text, std::map<std::string, double>& into, std::string* why);
 
 }  // namespace eol::station

@@ -3,14 +3,15 @@
 namespace eol::station {
 
 nlohmann::json RecordSummary(const db::TestRecord& r) {
-  return {{"id", r.id},
-          {"serial", r.serial},
-          {"outcome", analysis::ToString(r.outcome)},
-          {"reasons", r.reasons},
-          {"measurements", r.measurements},
-          {"started_at", r.started_at},
-          {"finished_at", r.finished_at},
-          {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}}};
+  return {
+      {"id", r.id},
+      {"serial", r.serial},
+      {"outcome", analysis::ToString(r.outcome)},
+      {"reasons", r.reasons},
+      {"measurements", r.measurements},
+      {"started_at", r.started_at},
+      {"finished_at", r.finished_at},
+      {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}}};
 }
 
 StatusBoard::StatusBoard(std::string station_id, std::string recipe_id, std::string recipe_hash)

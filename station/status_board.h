@@ -8,10 +8,9 @@
 #include <cstdint>
 #include <deque>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "db/test_record.h"
 
@@ -57,7 +56,7 @@ class StatusBoard {
   std::string serial_;
   std::string detail_;
   std::string message_;
-  nlohmann::json last_;  // null until the first verdict
+  nlohmann::json last_;     // null until the first verdict
   nlohmann::json lockout_;  // null while self-checks are off
   std::deque<nlohmann::json> recent_;
   std::uint64_t pass_ = 0, fail_ = 0, error_ = 0, aborted_ = 0;

@@ -7,9 +7,7 @@
 namespace eol::station {
 
 #if EOL_WITH_SYSTEMD
-void NotifyReady(const std::string& status) {
-  sd_notify(0, ("READY=1\nSTATUS=" + status).c_str());
-}
+void NotifyReady(const std::string& status) { sd_notify(0, ("READY=1\nSTATUS=" + status).c_str()); }
 void NotifyWatchdog() { sd_notify(0, "WATCHDOG=1"); }
 void NotifyStopping() { sd_notify(0, "STOPPING=1"); }
 #else

@@ -79,8 +79,8 @@ void GuardedResidual(const Eigen::VectorXd& theta, const Data& data, const Layou
 }
 
 // Central differences: the model is cheap and smooth in theta.
-void CentralDifferenceJacobian(const Eigen::VectorXd& theta, const Data& data,
-                               const Layout& layout, Eigen::MatrixXd* jac) {
+void CentralDifferenceJacobian(const Eigen::VectorXd& theta, const Data& data, const Layout& layout,
+                               Eigen::MatrixXd* jac) {
   jac->resize(static_cast<Eigen::Index>(2 * data.f.size()), layout.size());
   Eigen::VectorXd rp, rm;
   for (int i = 0; i < layout.size(); ++i) {
@@ -303,9 +303,8 @@ TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
 
   std::ostringstream os = MessageStream();
   if (!converged) {
-    os << "Levenberg-Marquardt " << out.termination << " (MINPACK status "
-       << lm.minpack_status << ") from f_ar = " << start.f_ar_hz
-       << " Hz, f_r = " << start.f_r_hz << " Hz";
+    os << "Levenberg-Marquardt " << out.termination << " (MINPACK status " << lm.minpack_status
+       << ") from f_ar = " << start.f_ar_hz << " Hz, f_r = " << start.f_r_hz << " Hz";
     out.message = os.str();
     return out;
   }

@@ -58,7 +58,8 @@ MaskCheck CheckMask(const Frf& z, const CurveMask& mask) {
     const double f = z.freq_hz[k];
     if (f < mask.points.front().f_hz || f > mask.points.back().f_hz) continue;
     ++c.lines_checked;
-    const double v = mask.quantity == MaskQuantity::kReOhm ? z.value[k].real() : std::abs(z.value[k]);
+    const double v =
+        mask.quantity == MaskQuantity::kReOhm ? z.value[k].real() : std::abs(z.value[k]);
     const double guard = z.has_sigma() ? mask.guard_sigma * z.sigma[k] : 0.0;
     double excess = 0.0;
     if (const auto hi = BoundAt(mask.points, f, &MaskPoint::hi); hi && v > *hi + guard)

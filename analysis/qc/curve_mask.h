@@ -38,8 +38,8 @@ struct CurveMask {
 struct MaskCheck {
   int lines_checked = 0;
   int lines_outside = 0;
-  double worst_f_hz = 0.0;       // line with the largest excursion (when any is outside)
-  double worst_excess = 0.0;     // how far beyond its bound, ohm
+  double worst_f_hz = 0.0;    // line with the largest excursion (when any is outside)
+  double worst_excess = 0.0;  // how far beyond its bound, ohm
 };
 
 // Lines of z outside the mask's frequency span are not checked.

@@ -4,8 +4,8 @@
 #include <cstdio>
 
 #include "analysis/impedance_analysis.h"
-#include "analysis/production/line_measurement.h"
-#include "analysis/production/line_population.h"
+#include "analysis/qc/line_measurement.h"
+#include "analysis/qc/line_population.h"
 #include "analysis/qc/measurement_names.h"
 #include "analysis/qc/tolerance.h"
 

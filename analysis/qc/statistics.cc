@@ -47,9 +47,12 @@ Capability ComputeCapability(const std::vector<double>& values, const Limit& lim
   std::optional<double> upper, lower;
   if (limits.hi) upper = (*limits.hi - m) / (3.0 * s);
   if (limits.lo) lower = (m - *limits.lo) / (3.0 * s);
-  if (upper && lower) c.cpk = std::min(*upper, *lower);
-  else if (upper) c.cpk = upper;
-  else if (lower) c.cpk = lower;
+  if (upper && lower)
+    c.cpk = std::min(*upper, *lower);
+  else if (upper)
+    c.cpk = upper;
+  else if (lower)
+    c.cpk = lower;
   c.usable = true;
   c.message = c.cpk ? "" : "no limits";
   return c;
@@ -63,9 +66,8 @@ bool DriftOptions::IsValid(std::string* why) const {
   return true;
 }
 
-DriftSummary DetectDrift(const std::vector<double>& y, const Limit& limits,
-                         const std::string& name, const std::string& unit,
-                         const DriftOptions& o) {
+DriftSummary DetectDrift(const std::vector<double>& y, const Limit& limits, const std::string& name,
+                         const std::string& unit, const DriftOptions& o) {
   DriftSummary d;
   d.n = y.size();
   std::string why;
@@ -118,7 +120,8 @@ DriftSummary DetectDrift(const std::vector<double>& y, const Limit& limits,
   if (d.change_of_tolerance)
     text += " = " + Num(100.0 * *d.change_of_tolerance, 3) + " % of the tolerance";
   if (d.alarm)
-    d.message = "drift alarm: " + text + "; check the fixture and the station (wear, clamp, "
+    d.message = "drift alarm: " + text +
+                "; check the fixture and the station (wear, clamp, "
                 "calibration) before the process leaves its limits";
   else if (significant)
     d.message = "no alarm: " + text + " (significant, but below " +
@@ -131,8 +134,7 @@ DriftSummary DetectDrift(const std::vector<double>& y, const Limit& limits,
 bool GaugeOptions::IsValid(std::string* why) const {
   if (!(tolerance_share > 0.0 && tolerance_share <= 1.0))
     return (*why = "tolerance_share must be in (0, 1]", false);
-  if (sigma_span != 4.0 && sigma_span != 6.0)
-    return (*why = "sigma_span must be 4 or 6", false);
+  if (sigma_span != 4.0 && sigma_span != 6.0) return (*why = "sigma_span must be 4 or 6", false);
   if (!(capable_at > 0.0)) return (*why = "capable_at must be positive", false);
   if (min_n < 2) return (*why = "min_n must be at least 2", false);
   return true;
@@ -154,8 +156,8 @@ GaugeStudy GaugeType1(const std::vector<double>& repeats, const Limit& limits,
   }
   g.tolerance = *limits.hi - *limits.lo;
   if (g.sample.n < o.min_n) {
-    g.message = "too few repeats (" + std::to_string(g.sample.n) + " < " +
-                std::to_string(o.min_n) + "; booklet 10 asks for 50, at least 25)";
+    g.message = "too few repeats (" + std::to_string(g.sample.n) + " < " + std::to_string(o.min_n) +
+                "; booklet 10 asks for 50, at least 25)";
     return g;
   }
   if (!(g.sample.sd > 0.0)) {

@@ -96,7 +96,7 @@ struct GaugeStudy {
   std::optional<double> reference;
   std::optional<double> bias;  // mean - reference
   std::optional<double> cgk;
-  bool repeatable = false;       // Cg >= capable_at
+  bool repeatable = false;      // Cg >= capable_at
   std::optional<bool> capable;  // Cg and Cgk >= capable_at; unknown without a reference
 };
 GaugeStudy GaugeType1(const std::vector<double>& repeats, const Limit& limits,

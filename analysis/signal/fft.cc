@@ -55,8 +55,7 @@ std::vector<std::complex<double>> RealFft::Forward(const double* x) const {
   std::memcpy(impl_->in, x, n_ * sizeof(double));
   fftw_execute(impl_->forward);
   std::vector<std::complex<double>> result(n_ / 2 + 1);
-  for (std::size_t k = 0; k < result.size(); ++k)
-    result[k] = {impl_->out[k][0], impl_->out[k][1]};
+  for (std::size_t k = 0; k < result.size(); ++k) result[k] = {impl_->out[k][0], impl_->out[k][1]};
   return result;
 }
 

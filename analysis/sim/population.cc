@@ -35,7 +35,8 @@ bool MotorPopulation::IsValid(std::string* why) const {
   if (!(f_rigid_defect_hz > 0.0 && f_rigid_defect_hz < f_rigid_hz))
     return fail("f_rigid_defect_hz must be positive and below f_rigid_hz");
   if (!(f_fixture_hz > 0.0 && f_fixture_hz < f_rigid_hz))
-    return fail("f_fixture_hz must be positive and below f_rigid_hz (the fixture is a spring in series)");
+    return fail(
+        "f_fixture_hz must be positive and below f_rigid_hz (the fixture is a spring in series)");
   if (!(q_good > 0.5 && q_defect > 0.5)) return fail("q_good and q_defect must be above 0.5");
   if (!(r_ohm > 0.0 && l_h > 0.0)) return fail("r_ohm and l_h must be positive");
   if (!(transmission_nm_per_a > 0.0)) return fail("transmission_nm_per_a must be positive");

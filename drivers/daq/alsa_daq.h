@@ -18,7 +18,7 @@
 // EPIPE, or a suspend, ESTRPIPE, or a capture buffer found over-full (frames lost), stops
 // both streams and throws DeviceError naming the device, the stream, the frame index and how
 // many frames had been transferred. Abort drops the playback first (silence), then the
-// capture. Config: drivers/factory.h ("daq": {"driver": "alsa", ...}).
+// capture. Config: drivers/factory/factory.h ("daq": {"driver": "alsa", ...}).
 #pragma once
 
 #include <cstddef>

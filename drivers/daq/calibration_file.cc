@@ -14,7 +14,7 @@ nlohmann::json CalibrationToJson(const Calibration& c) {
   return j;
 }
 
-Calibration ParseCalibration(const JsonObject& o) {
+Calibration ParseCalibration(const io::JsonObject& o) {
   Calibration c;
   c.shunt_ohm = o.Number("shunt_ohm", c.shunt_ohm);
   c.divider_ratio = o.Number("divider_ratio", c.divider_ratio);
@@ -40,26 +40,26 @@ Calibration ParseCalibration(const JsonObject& o) {
 }
 
 Calibration ReadCalibrationFile(const std::string& path) {
-  const nlohmann::json j = ReadJsonFile(path);
+  const nlohmann::json j = io::ReadJsonFile(path);
   try {
-    return ParseCalibration(JsonObject(j, ""));
-  } catch (const ConfigError& e) {
-    throw ConfigError("calibration file " + path + ": " + e.what());
+    return ParseCalibration(io::JsonObject(j, ""));
+  } catch (const io::ConfigError& e) {
+    throw io::ConfigError("calibration file " + path + ": " + e.what());
   }
 }
 
-Calibration DaqCalibration(const JsonObject& daq, const Calibration& fallback) {
+Calibration DaqCalibration(const io::JsonObject& daq, const Calibration& fallback) {
   const bool has_file = daq.Has("calibration_file");
   const bool has_inline = daq.Has("calibration");
   if (has_file && has_inline)
-    throw ConfigError(daq.PathOf("calibration_file") +
-                      ": give a calibration_file or an inline calibration, not both");
+    throw io::ConfigError(daq.PathOf("calibration_file") +
+                          ": give a calibration_file or an inline calibration, not both");
   if (has_file) {
     const std::string path = daq.RequiredString("calibration_file");
     try {
       return ReadCalibrationFile(path);
-    } catch (const ConfigError& e) {
-      throw ConfigError(daq.PathOf("calibration_file") + ": " + e.what());
+    } catch (const io::ConfigError& e) {
+      throw io::ConfigError(daq.PathOf("calibration_file") + ": " + e.what());
     }
   }
   if (has_inline) return ParseCalibration(daq.Object("calibration"));

@@ -11,23 +11,22 @@
 // kept in the file for people and ignored when reading. Unknown keys are errors.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "drivers/daq/daq.h"
-#include "drivers/json_config.h"
+#include "drivers/io/json_config.h"
 
 namespace eol::drivers {
 
 nlohmann::json CalibrationToJson(const Calibration& calibration);
-// Throws ConfigError naming the JSON path of the offending field.
-Calibration ParseCalibration(const JsonObject& object);
-// Throws ConfigError naming the file (and the JSON path) when it cannot be read or is invalid.
+// Throws io::ConfigError naming the JSON path of the offending field.
+Calibration ParseCalibration(const io::JsonObject& object);
+// Throws io::ConfigError naming the file (and the JSON path) when it cannot be read or is invalid.
 Calibration ReadCalibrationFile(const std::string& path);
 
 // The "daq" config's calibration: "calibration_file" (a file as above) or an inline
 // "calibration" object, never both; neither gives the nominal calibration `fallback`.
-Calibration DaqCalibration(const JsonObject& daq, const Calibration& fallback);
+Calibration DaqCalibration(const io::JsonObject& daq, const Calibration& fallback);
 
 }  // namespace eol::drivers

@@ -40,8 +40,8 @@ StatusOr<analysis::Recording> Daq::Acquire(const AcquisitionRequest& request,
                                            const std::atomic<bool>& abort) {
   std::lock_guard<std::mutex> lock(mu_);
   if (state_ != Lifecycle::kInactive)
-    return Status::Error("daq '" + name_ + "': acquire: not connected (state " +
-                         ToString(state_) + ")");
+    return Status::Error("daq '" + name_ + "': acquire: not connected (state " + ToString(state_) +
+                         ")");
   if (request.sample_rate_hz <= 0.0 || request.excitation_v.empty())
     return Status::Error("daq '" + name_ + "': acquire: empty excitation or no sample rate");
   try {

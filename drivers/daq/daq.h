@@ -16,9 +16,9 @@ namespace eol::drivers {
 
 // How raw channel readings became volts and amperes; stored with every test.
 struct Calibration {
-  double shunt_ohm = 0.1;         // current channel: volts across the shunt / shunt_ohm
-  double divider_ratio = 1.0;     // voltage channel: phase volts per channel volt
-  double channel_delay_s = 0.0;   // current channel lags voltage channel by this much
+  double shunt_ohm = 0.1;          // current channel: volts across the shunt / shunt_ohm
+  double divider_ratio = 1.0;      // voltage channel: phase volts per channel volt
+  double channel_delay_s = 0.0;    // current channel lags voltage channel by this much
   std::string method = "nominal";  // "nominal", or how it was measured (reference resistor)
   // Set by a measured calibration (method "reference_resistor", calibration_file.h): when it
   // was measured (ISO 8601 UTC) and the reference resistor it was measured with.
@@ -28,7 +28,7 @@ struct Calibration {
 
 struct AcquisitionRequest {
   double sample_rate_hz = 0.0;
-  std::size_t period_samples = 0;  // 0 for a non-periodic excitation
+  std::size_t period_samples = 0;    // 0 for a non-periodic excitation
   std::vector<double> excitation_v;  // the whole stream to play
 };
 

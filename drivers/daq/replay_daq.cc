@@ -5,14 +5,14 @@
 #include <exception>
 #include <filesystem>
 
+#include "drivers/io/recording_files.h"
+
 namespace eol::drivers {
 
-ReplayDaq::ReplayDaq(ReplayDaqSettings settings, RecordingFileReader reader)
-    : Daq("replay"), settings_(std::move(settings)), reader_(std::move(reader)) {}
+ReplayDaq::ReplayDaq(ReplayDaqSettings settings) : Daq("replay"), settings_(std::move(settings)) {}
 
 void ReplayDaq::DoConnect() {
   namespace fs = std::filesystem;
-  if (!reader_) throw DeviceError("no recording file reader was given to the replay driver");
   files_ = settings_.files;
   if (!settings_.directory.empty()) {
     std::error_code ec;
@@ -46,7 +46,7 @@ analysis::Recording ReplayDaq::DoAcquire(const AcquisitionRequest& req,
   const std::string& path = settings_.repeat ? files_.front() : files_[next_];
   analysis::Recording rec;
   try {
-    rec = reader_(path, settings_.voltage_v_per_fs, settings_.current_a_per_fs);
+    rec = io::ReadRecordingFile(path, settings_.voltage_v_per_fs, settings_.current_a_per_fs);
   } catch (const std::exception& e) {
     throw DeviceError(std::string("recording ") + e.what());
   }

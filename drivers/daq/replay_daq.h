@@ -5,13 +5,11 @@
 //
 // Each recording must fit the request: the same sample rate (within 1e-6 relative) and the
 // same number of samples as the excitation; the request's period_samples is set on it (the
-// files do not know the excitation). Errors name the file. Files are read through a reader
-// the caller gives (the station's CSV t_s,u_v,i_a and two-channel WAV readers,
-// station/files/recording_files.h), so that drivers need no file formats of their own.
+// files do not know the excitation). Errors name the file. Files are read by the one I/O
+// library's readers (CSV t_s,u_v,i_a and two-channel WAV, drivers/io/recording_files.h).
 #pragma once
 
 #include <cstddef>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -19,11 +17,7 @@
 
 namespace eol::drivers {
 
-// Reads one recording file; throws (any std::exception) with a message naming the file.
 // voltage_v_per_fs and current_a_per_fs scale WAV files (full scale to volts / amperes).
-using RecordingFileReader = std::function<analysis::Recording(
-    const std::string& path, double voltage_v_per_fs, double current_a_per_fs)>;
-
 struct ReplayDaqSettings {
   std::vector<std::string> files;  // in order; with repeat, exactly one
   std::string directory;           // instead of files
@@ -35,7 +29,7 @@ struct ReplayDaqSettings {
 
 class ReplayDaq final : public Daq {
  public:
-  ReplayDaq(ReplayDaqSettings settings, RecordingFileReader reader);
+  explicit ReplayDaq(ReplayDaqSettings settings);
 
   // The files in the order they will be returned (directory listed at Connect).
   const std::vector<std::string>& files() const { return files_; }
@@ -49,7 +43,6 @@ class ReplayDaq final : public Daq {
 
  private:
   ReplayDaqSettings settings_;
-  RecordingFileReader reader_;
   std::vector<std::string> files_;
   std::size_t next_ = 0;
 };

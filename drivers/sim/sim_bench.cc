@@ -26,9 +26,9 @@ const char* ToString(SimFault f) {
 }
 
 std::optional<SimFault> ParseSimFault(const std::string& s) {
-  for (SimFault f : {SimFault::kStopsAnswering, SimFault::kClampDrops, SimFault::kPressureLow,
-                     SimFault::kDoorOpens, SimFault::kEstop, SimFault::kHeartbeatFreezes,
-                     SimFault::kDaqFails})
+  for (SimFault f :
+       {SimFault::kStopsAnswering, SimFault::kClampDrops, SimFault::kPressureLow,
+        SimFault::kDoorOpens, SimFault::kEstop, SimFault::kHeartbeatFreezes, SimFault::kDaqFails})
     if (s == ToString(f)) return f;
   return std::nullopt;
 }
@@ -42,9 +42,9 @@ void SimBench::LoadPart(const std::string& serial) {
     if (m.serial == serial) master = &m;
   if (master) {
     analysis::MotorPopulation nominal = settings_.population;
-    for (double* spread : {&nominal.spread_inertia, &nominal.spread_k_rotor,
-                           &nominal.spread_k_fixture, &nominal.spread_q, &nominal.spread_r,
-                           &nominal.spread_l, &nominal.spread_transmission})
+    for (double* spread :
+         {&nominal.spread_inertia, &nominal.spread_k_rotor, &nominal.spread_k_fixture,
+          &nominal.spread_q, &nominal.spread_r, &nominal.spread_l, &nominal.spread_transmission})
       *spread = 0.0;
     unit = analysis::DrawUnit(nominal, serial, master->defective);
   } else {

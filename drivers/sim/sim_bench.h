@@ -29,25 +29,25 @@ struct SimMaster {
 
 struct SimBenchSettings {
   analysis::MotorPopulation population;
-  double clamp_close_s = 0.15;          // command to clamped sensor
-  double clamp_open_s = 0.10;           // command to released sensor
-  double clamp_pressure_bar = 5.5;      // steady pressure when closed
+  double clamp_close_s = 0.15;      // command to clamped sensor
+  double clamp_open_s = 0.10;       // command to released sensor
+  double clamp_pressure_bar = 5.5;  // steady pressure when closed
   double heartbeat_period_s = 0.2;
-  bool load_part_on_serial = true;      // the simulated operator loads a part per serial
-  std::vector<SimMaster> masters;       // LoadPart of one of these serials loads that master
+  bool load_part_on_serial = true;  // the simulated operator loads a part per serial
+  std::vector<SimMaster> masters;   // LoadPart of one of these serials loads that master
   // Fixture wear: each part loaded softens the fixture spring by this share of its new
   // stiffness (k_fixture x (1 - wear n) after n parts, at least 5 %), which lowers f0 slowly.
   double fixture_wear_per_test = 0.0;
 };
 
 enum class SimFault {
-  kStopsAnswering,   // every fixture call fails (controller off the bus)
-  kClampDrops,       // clamped sensor drops, pressure falls to 0
-  kPressureLow,      // pressure falls to 1 bar (out of any sane window)
+  kStopsAnswering,  // every fixture call fails (controller off the bus)
+  kClampDrops,      // clamped sensor drops, pressure falls to 0
+  kPressureLow,     // pressure falls to 1 bar (out of any sane window)
   kDoorOpens,
-  kEstop,            // emergency-stop chain opens
+  kEstop,  // emergency-stop chain opens
   kHeartbeatFreezes,
-  kDaqFails,         // the acquisition device fails mid-stream
+  kDaqFails,  // the acquisition device fails mid-stream
 };
 const char* ToString(SimFault f);
 std::optional<SimFault> ParseSimFault(const std::string& s);

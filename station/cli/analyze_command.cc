@@ -1,5 +1,5 @@
 // `eol analyze --measured FILE`: the station's analysis on a measured FRF or raw recording,
-// offline. Reads the file (station/files/measured_input.h), estimates Z(f) with sigma for a
+// offline. Reads the file (drivers/io/measured_input.h), estimates Z(f) with sigma for a
 // periodic recording, fits the clamped motor (analysis::AnalyzeImpedance / AnalyzeRecording)
 // and, with --recipe, judges the result against the recipe's limits (analysis::Judge).
 // A mobility FRF (f_hz,re,im[,sigma]) is fitted with the two-mass model instead (no verdict).
@@ -17,10 +17,10 @@
 #include "analysis/signal/waveform.h"
 #include "analysis/signal/welch.h"
 #include "analysis/text.h"
+#include "drivers/io/file_error.h"
+#include "drivers/io/measured_input.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/files/file_error.h"
-#include "station/files/measured_input.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {
@@ -224,14 +224,14 @@ int AnalyzeMobility(const AnalyzeArgs& a, const analysis::Frf& h, json out) {
 int RunAnalyze(const AnalyzeArgs& a) {
   json out = {{"file", a.measured}};
   std::unique_ptr<Recipe> recipe;
-  files::MeasuredInput in;
+  io::MeasuredInput in;
   std::vector<std::size_t> lines;
   analysis::WelchOptions welch;
   try {
     if (a.measured.empty()) throw UsageError("--measured FILE is required");
     if (!a.recipe.empty()) recipe = std::make_unique<Recipe>(LoadRecipe(a.recipe));
-    in = files::ReadMeasured(a.measured, {a.voltage_gain, a.current_gain});
-    const bool recording = in.kind == files::MeasuredKind::kRecording;
+    in = io::ReadMeasured(a.measured, {a.voltage_gain, a.current_gain});
+    const bool recording = in.kind == io::MeasuredKind::kRecording;
     if (recording && a.welch_segment > 0)
       welch = SetUpWelch(a, recipe.get());
     else if (recording)
@@ -243,19 +243,19 @@ int RunAnalyze(const AnalyzeArgs& a) {
           "recordings only");
   } catch (const UsageError& e) {
     return Fail(a, out, 2, std::string("usage: ") + e.what());
-  } catch (const std::exception& e) {  // files::FileError, drivers::ConfigError
+  } catch (const std::exception& e) {  // io::FileError, io::ConfigError
     return Fail(a, out, 2, e.what());
   }
   out["format"] = in.format;
   if (recipe)
     out["recipe"] = {{"id", recipe->id}, {"version", recipe->version}, {"hash", recipe->hash}};
-  if (in.kind == files::MeasuredKind::kFrf && in.frf.quantity == analysis::Quantity::kMobility)
+  if (in.kind == io::MeasuredKind::kFrf && in.frf.quantity == analysis::Quantity::kMobility)
     return AnalyzeMobility(a, in.frf, out);
 
   const analysis::ImpedanceAnalysisOptions options =
       recipe ? recipe->analysis : analysis::ImpedanceAnalysisOptions{};
   analysis::ImpedanceAnalysis result;
-  if (in.kind == files::MeasuredKind::kFrf) {
+  if (in.kind == io::MeasuredKind::kFrf) {
     result = analysis::AnalyzeImpedance(in.frf, options.fit);
   } else if (a.welch_segment > 0) {
     const analysis::WelchSummary w =
@@ -279,7 +279,7 @@ int RunAnalyze(const AnalyzeArgs& a) {
     result = analysis::AnalyzeRecording(in.recording, lines, options);
   }
   const analysis::Frf& z = result.frf.frf;
-  if (in.kind == files::MeasuredKind::kRecording && a.welch_segment == 0)
+  if (in.kind == io::MeasuredKind::kRecording && a.welch_segment == 0)
     out["frf"] = {{"method", z.method},
                   {"periods_used", result.frf.periods_used},
                   {"periods_dropped", result.frf.periods_dropped},
@@ -326,7 +326,7 @@ int RunAnalyze(const AnalyzeArgs& a) {
   }
   std::cout << a.measured << ": " << in.format << ", " << z.size() << " lines "
             << Fixed(z.freq_hz.front(), 1) << "-" << Fixed(z.freq_hz.back(), 1) << " Hz";
-  if (in.kind == files::MeasuredKind::kRecording) std::cout << " (" << result.frf.message << ")";
+  if (in.kind == io::MeasuredKind::kRecording) std::cout << " (" << result.frf.message << ")";
   std::cout << "\n";
   if (noise_estimated)
     std::cout << "noise: the file has no sigma; estimated from the fit residual as "

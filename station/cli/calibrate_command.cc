@@ -15,11 +15,11 @@
 #include "analysis/signal/reference_calibration.h"
 #include "db/clock.h"
 #include "drivers/daq/calibration_file.h"
-#include "drivers/factory.h"
+#include "drivers/factory/factory.h"
+#include "drivers/io/recording_files.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/config.h"
-#include "station/files/recording_files.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {
@@ -57,7 +57,7 @@ analysis::Recording AcquireReference(drivers::DriverSet& d,
 int RunCalibrate(const CalibrateArgs& a) {
   const StationConfig config = LoadStationConfig(a.config);
   const Recipe recipe = LoadRecipe(config.recipe_path);
-  drivers::DriverSet d = drivers::MakeDrivers(config.drivers, nullptr, files::ReadRecordingFile);
+  drivers::DriverSet d = drivers::MakeDrivers(config.drivers);
   const analysis::Excitation excitation = analysis::DesignMultisine(recipe.excitation);
   drivers::AcquisitionRequest req;
   req.sample_rate_hz = excitation.sample_rate_hz;

@@ -8,9 +8,10 @@
 #include <iostream>
 
 #include "analysis/qc/measurement_names.h"
+#include "drivers/emulators/modbus_fixture_server.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "drivers/fixture/modbus_fixture_server.h"
+#include "station/data_files.h"
 #include "station/station.h"
 
 namespace eol::station::cli {
@@ -50,7 +51,7 @@ int RunDemo(const DemoArgs& a) {
   // reaches its clamp and interlocks over real Modbus TCP through the fixture emulator that
   // `eol fixture-sim` runs, on a free port of 127.0.0.1.
   auto bench = std::make_shared<drivers::SimBench>(
-      drivers::ParseSimBenchSettings(drivers::JsonObject(sim, "/sim")));
+      drivers::ParseSimBenchSettings(io::JsonObject(sim, "/sim")));
   std::unique_ptr<drivers::ModbusFixtureServer> emulator;
   if (a.fixture == "modbus") {
     drivers::ModbusFixtureServerSettings es;
@@ -60,31 +61,40 @@ int RunDemo(const DemoArgs& a) {
     emulator = std::make_unique<drivers::ModbusFixtureServer>(bench, es);
     if (const drivers::Status s = emulator->Start(); !s.ok())
       throw std::runtime_error("fixture emulator: " + s.message());
-    cfg["fixture"] = {{"driver", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", emulator->port()},
+    cfg["fixture"] = {{"driver", "modbus-tcp"},
+                      {"host", "127.0.0.1"},
+                      {"port", emulator->port()},
                       {"unit_id", 1}};
   }
   Station station(ParseStationConfig(cfg, "demo", ""), bench);
   station.StartHttp(DefaultWebRoot());
   std::ostream& out = a.json ? std::cerr : std::cout;
   out << "eol demo: " << a.units << " simulated units, defect share " << a.defect_share
-      << ", fixture " << (emulator ? "over Modbus TCP 127.0.0.1:" + std::to_string(emulator->port())
-                                   : std::string("in-process"))
-      << ", recipe " << station.recipe()->id << " v" << station.recipe()->version
-      << ", records in " << a.db << ", status at http://" << a.listen << ":"
-      << station.http_port() << "/api/status\n";
+      << ", fixture "
+      << (emulator ? "over Modbus TCP 127.0.0.1:" + std::to_string(emulator->port())
+                   : std::string("in-process"))
+      << ", recipe " << station.recipe()->id << " v" << station.recipe()->version << ", records in "
+      << a.db << ", status at http://" << a.listen << ":" << station.http_port() << "/api/status\n";
 
   int pass = 0, fail = 0, error = 0, defective = 0, detected = 0, false_rejects = 0;
   nlohmann::json serials = nlohmann::json::array();
   for (int i = 1; i <= a.units; ++i) {
     char serial[64];
-    std::snprintf(serial, sizeof serial, "DEMO-%llu-%04d", static_cast<unsigned long long>(a.seed), i);
+    std::snprintf(serial, sizeof serial, "DEMO-%llu-%04d", static_cast<unsigned long long>(a.seed),
+                  i);
     const db::TestRecord r = station.RunTest(serial);
     const bool is_defective = station.bench()->part() && station.bench()->part()->defective;
     serials.push_back(serial);
     switch (r.outcome) {
-      case analysis::Outcome::kPass: ++pass; break;
-      case analysis::Outcome::kFail: ++fail; break;
-      default: ++error; break;
+      case analysis::Outcome::kPass:
+        ++pass;
+        break;
+      case analysis::Outcome::kFail:
+        ++fail;
+        break;
+      default:
+        ++error;
+        break;
     }
     if (is_defective) {
       ++defective;
@@ -93,8 +103,8 @@ int RunDemo(const DemoArgs& a) {
       ++false_rejects;
     }
     char line[256];
-    std::snprintf(line, sizeof line, "[%3d/%d] %-16s f0 = %7.2f Hz  %-7s truth: %-9s ", i,
-                  a.units, serial, MeasurementValue(r, analysis::names::kResonanceFHz),
+    std::snprintf(line, sizeof line, "[%3d/%d] %-16s f0 = %7.2f Hz  %-7s truth: %-9s ", i, a.units,
+                  serial, MeasurementValue(r, analysis::names::kResonanceFHz),
                   analysis::ToString(r.outcome), is_defective ? "defective" : "good");
     out << line << (r.reasons.empty() ? "" : r.reasons.front()) << "\n" << std::flush;
   }
@@ -102,11 +112,16 @@ int RunDemo(const DemoArgs& a) {
       << " ERROR; " << detected << " of " << defective << " defective rotors caught, "
       << false_rejects << " good rotors rejected\n";
   if (a.json) {
-    const nlohmann::json summary = {{"units", a.units},         {"pass", pass},
-                                    {"fail", fail},             {"error", error},
-                                    {"defective", defective},   {"detected", detected},
-                                    {"false_rejects", false_rejects}, {"serials", serials},
-                                    {"db", a.db},               {"http_port", station.http_port()}};
+    const nlohmann::json summary = {{"units", a.units},
+                                    {"pass", pass},
+                                    {"fail", fail},
+                                    {"error", error},
+                                    {"defective", defective},
+                                    {"detected", detected},
+                                    {"false_rejects", false_rejects},
+                                    {"serials", serials},
+                                    {"db", a.db},
+                                    {"http_port", station.http_port()}};
     std::cout << summary.dump() << std::endl;
   }
   return 0;
@@ -122,26 +137,32 @@ void AddDemoCommand(CLI::App& app) {
       "population with a known share of poorly cemented rotors, store every record, serve the\n"
       "JSON status while running, and score the verdicts against the simulator's truth.");
   cmd->add_option("--units", args->units, "Number of simulated units to test")
-      ->capture_default_str()->check(CLI::Range(1, 1000000));
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
   cmd->add_option("--db", args->db, "SQLite file for the records (created if missing)")
       ->capture_default_str();
   cmd->add_option("--recipe", args->recipe, "Recipe JSON")->capture_default_str();
   cmd->add_flag("--json", args->json,
                 "Print the summary as one JSON object on stdout (unit lines go to stderr)");
   cmd->add_option("--port", args->port, "HTTP port for the JSON status (0: any free port)")
-      ->capture_default_str()->check(CLI::Range(0, 65535));
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
   cmd->add_option("--listen", args->listen, "HTTP listen address")->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed of the simulated population")->capture_default_str();
   cmd->add_option("--defect-share", args->defect_share,
                   "Share of poorly cemented rotors in the population")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--time-scale", args->time_scale,
                   "Pace of the simulated acquisition: 1 real time, 0 as fast as possible")
-      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--fixture", args->fixture,
-                  "modbus: the station talks Modbus TCP to the fixture emulator (eol fixture-sim's\n"
-                  "server) on 127.0.0.1; sim: the in-process simulated fixture")
-      ->capture_default_str()->check(CLI::IsMember({"modbus", "sim"}));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option(
+         "--fixture", args->fixture,
+         "modbus: the station talks Modbus TCP to the fixture emulator (eol fixture-sim's\n"
+         "server) on 127.0.0.1; sim: the in-process simulated fixture")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"modbus", "sim"}));
   cmd->add_flag("--verbose", args->verbose, "Log every sequencer state (to stderr)");
   cmd->callback([args] { RunGuarded("demo", [&] { return RunDemo(*args); }); });
 }

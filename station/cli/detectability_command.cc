@@ -16,6 +16,7 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/golden_inputs.h"
+#include "station/data_files.h"
 #include "station/qc_service.h"
 #include "station/recipe.h"
 
@@ -105,8 +106,7 @@ int RunDetect(const DetectArgs& a) {
     return 1;
   }
   if (a.json) {
-    std::cout << DetectabilityJson(s, source, spread_source, a.required_sigmas).dump()
-              << std::endl;
+    std::cout << DetectabilityJson(s, source, spread_source, a.required_sigmas).dump() << std::endl;
     return 0;
   }
   std::cout << "detectability (" << r.id << " v" << r.version << "): " << s.message << "\n"

@@ -100,15 +100,19 @@ void AddExportCommand(CLI::App& app) {
       "Export finished tests as CSV (one row per test, one column per measurement) or JSON\n"
       "(full records with curves), by serial and/or time range (ISO 8601 UTC, e.g.\n"
       "2026-11-22T00:00:00.000Z; from inclusive, to exclusive).");
-  cmd->add_option("--db", args->db, "SQLite file of the station")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--db", args->db, "SQLite file of the station")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("--serial", args->serial, "Only this serial");
   cmd->add_option("--from", args->from, "Started at or after (ISO 8601 UTC)");
   cmd->add_option("--to", args->to, "Started before (ISO 8601 UTC)");
   cmd->add_option("--format", args->format, "csv or json")
-      ->capture_default_str()->check(CLI::IsMember({"csv", "json"}));
+      ->capture_default_str()
+      ->check(CLI::IsMember({"csv", "json"}));
   cmd->add_option("--out", args->out, "Output file (default: stdout)");
   cmd->add_option("--limit", args->limit, "At most this many tests")
-      ->capture_default_str()->check(CLI::Range(1, 10000));
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000));
   cmd->callback([args] { RunGuarded("export", [&] { return RunExport(*args); }); });
 }
 

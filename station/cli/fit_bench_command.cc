@@ -1,7 +1,8 @@
-// `eol fit-bench`: the benchmark of the identification engine (analysis/fit_bench.h) on the
+// `eol fit-bench`: the benchmark of the identification engine (analysis/bench/fit_bench.h) on the
 // recipe's measurement of the population's nominal good rotor with the simulated DAQ's noise,
-// and the same pipeline in SciPy on the same data for the time ratio (station/fit_bench_peer.h).
-// Prints the five figures of issue 3; README "Benchmarks: identification engine" records them.
+// and the same pipeline in SciPy on the same data for the time ratio
+// (station/bench/fit_bench_peer.h). Prints the five figures of issue 3; README "Benchmarks:
+// identification engine" records them.
 #include <cmath>
 #include <iostream>
 #include <locale>
@@ -9,12 +10,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "analysis/fit_bench.h"
+#include "analysis/bench/fit_bench.h"
 #include "analysis/sim/population.h"
-#include "drivers/daq/sim_daq.h"
+#include "drivers/sim/sim_daq.h"
+#include "station/bench/fit_bench_peer.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/fit_bench_peer.h"
+#include "station/data_files.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {

@@ -17,12 +17,12 @@
 #include <optional>
 #include <string>
 
-#include "drivers/factory.h"
-#include "drivers/fixture/modbus_fixture_server.h"
-#include "drivers/json_config.h"
+#include "drivers/emulators/modbus_fixture_server.h"
+#include "drivers/factory/factory.h"
+#include "drivers/io/json_config.h"
 #include "drivers/sim/sim_bench.h"
 #if EOL_WITH_SOCKETCAN
-#include "drivers/fixture/can_fixture_node.h"
+#include "drivers/emulators/can_fixture_node.h"
 #endif
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
@@ -83,11 +83,11 @@ int RunFixtureSim(const FixtureSimOptions& opt) {
 
   drivers::SimBenchSettings bench_settings;
   drivers::ModbusMap map;
-  std::optional<drivers::JsonObject> can_fixture;  // a "socketcan" fixture object
+  std::optional<io::JsonObject> can_fixture;  // a "socketcan" fixture object
   nlohmann::json config;
   if (!opt.config.empty()) {
-    config = drivers::ReadJsonFile(opt.config);
-    const drivers::JsonObject root(config, "");
+    config = io::ReadJsonFile(opt.config);
+    const io::JsonObject root(config, "");
     if (const auto sim = root.OptionalObject("sim"))
       bench_settings = drivers::ParseSimBenchSettings(*sim);
     // The station's own fixture map, so that one config file serves both ends.
@@ -149,8 +149,9 @@ int RunFixtureSim(const FixtureSimOptions& opt) {
   }
 #else
   if (!opt.can_interface.empty())
-    throw std::runtime_error("--can: SocketCAN was not compiled in (build with "
-                             "-DEOL_WITH_SOCKETCAN=ON)");
+    throw std::runtime_error(
+        "--can: SocketCAN was not compiled in (build with "
+        "-DEOL_WITH_SOCKETCAN=ON)");
 #endif
 
   if (!opt.ready_file.empty()) WriteReadyFile(opt.ready_file, tcp_server.port());

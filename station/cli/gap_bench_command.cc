@@ -1,12 +1,12 @@
-// `eol gap-bench`: the blind benchmark of the gap diagnosis (analysis/gap/bench.h). Prints one
-// line per case, the confusion matrix, top-1 accuracy (overall and on oracle-separable cases),
+// `eol gap-bench`: the blind benchmark of the gap diagnosis (analysis/bench/gap_bench.h). Prints
+// one line per case, the confusion matrix, top-1 accuracy (overall and on oracle-separable cases),
 // band coverage, the held-out shrink of g and how often a strong effect was called "none".
 #include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "analysis/gap/bench.h"
+#include "analysis/bench/gap_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 
@@ -149,7 +149,7 @@ void AddGapBenchCommand(CLI::App& app) {
       "one hidden effect or none at a random detectable strength), diagnosed without the\n"
       "label; prints the confusion matrix, top-1 accuracy (overall and on cases an oracle with\n"
       "the true model families can separate), band coverage, held-out shrink of g, and how\n"
-      "often a strong effect was called 'none' (analysis/gap/bench.h defines each).");
+      "often a strong effect was called 'none' (analysis/bench/gap_bench.h defines each).");
   cmd->add_option("--cases", a->cases, "Number of cases")
       ->capture_default_str()
       ->check(CLI::Range(1, 100000));

@@ -1,8 +1,8 @@
 // `eol gap`: the sim-to-real gap diagnosis (analysis/gap/diagnosis.h) from files: where the
 // measurement leaves the simulation, which unmodelled effect explains it, how far the gap
 // shrinks (also on held-out lines or units), and optionally where a second simulated design
-// would land in the measured set-up (--predict-sim). Inputs: station/files/gap_inputs.h;
-// report: gap_report.h; plot: station/files/svg_plot.h.
+// would land in the measured set-up (--predict-sim). Inputs: drivers/io/gap_inputs.h;
+// report: gap_report.h; plot: drivers/io/svg_plot.h.
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -10,11 +10,12 @@
 #include <sstream>
 
 #include "analysis/gap/noise.h"
+#include "drivers/io/file_error.h"
+#include "drivers/io/svg_plot.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/gap_report.h"
-#include "station/files/file_error.h"
-#include "station/files/svg_plot.h"
+#include "station/data_files.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {
@@ -60,7 +61,7 @@ double RecipeInertia(const std::string& path) {
   }
 }
 
-analysis::CalibrationSummary Calibrate(const files::GapInput& sim, double inertia) {
+analysis::CalibrationSummary Calibrate(const io::GapInput& sim, double inertia) {
   if (sim.model) {
     analysis::CalibrationSummary c;
     c.usable = true;
@@ -76,11 +77,11 @@ analysis::CalibrationSummary Calibrate(const files::GapInput& sim, double inerti
   return analysis::CalibrateNominal(sim.frf, o);
 }
 
-files::SvgFigure Plot(const GapReport& r, const files::GapInput& meas) {
+io::SvgFigure Plot(const GapReport& r, const io::GapInput& meas) {
   const bool mobility = r.quantity == analysis::Quantity::kMobility;
   const analysis::NominalNetwork& n = r.calibration.nominal;
   const auto& f = meas.frf.freq_hz;
-  files::SvgFigure fig;
+  io::SvgFigure fig;
   fig.title = "eol gap: " + r.gap.effect + "  (g " + std::to_string(r.gap.gap_before).substr(0, 6) +
               " -> " + std::to_string(r.gap.gap_after).substr(0, 6) + ")  " + meas.source;
   fig.x_label = "frequency (Hz)";
@@ -115,7 +116,7 @@ files::SvgFigure Plot(const GapReport& r, const files::GapInput& meas) {
   }
   auto panel = [&](const std::string& label, const std::vector<double>& m,
                    const std::vector<double>& s, const std::vector<double>& c, bool log_y) {
-    files::SvgPanel p;
+    io::SvgPanel p;
     p.y_label = label;
     p.log_y = log_y;
     p.shaded = shaded;
@@ -131,7 +132,7 @@ files::SvgFigure Plot(const GapReport& r, const files::GapInput& meas) {
     fig.panels.push_back(panel("Re Z (ohm)", m1, s1, c1, false));
     fig.panels.push_back(panel("Im Z - w L_nominal (ohm)", m2, s2, c2, false));
   }
-  files::SvgPanel res;
+  io::SvgPanel res;
   res.y_label = "|residual| / sigma";
   res.log_y = true;
   res.shaded = shaded;
@@ -143,7 +144,7 @@ files::SvgFigure Plot(const GapReport& r, const files::GapInput& meas) {
 }
 
 int RunGap(const GapArgs& a) {
-  files::GapInputOptions io;
+  io::GapInputOptions io;
   io.quantity =
       a.quantity == "mobility" ? analysis::Quantity::kMobility : analysis::Quantity::kImpedanceOhm;
   io.period_s = a.period_s;
@@ -155,13 +156,13 @@ int RunGap(const GapArgs& a) {
   r.quantity = io.quantity;
   r.sigma_pool = a.sigma_pool;
   for (const std::string& path : a.measured) {
-    files::GapInput m = files::ReadGapMeasurement(path, io);
+    io::GapInput m = io::ReadGapMeasurement(path, io);
     Band(&m.frf, a.f_lo_hz, a.f_hi_hz);
-    if (m.frf.size() < 10) throw files::FileError(path, 0, 0, "fewer than 10 lines in the band");
+    if (m.frf.size() < 10) throw io::FileError(path, 0, 0, "fewer than 10 lines in the band");
     r.measured.push_back(std::move(m));
   }
   const std::vector<double>& lines = r.measured.front().frf.freq_hz;
-  r.simulation = files::ReadGapSimulation(a.sim, io, lines);
+  r.simulation = io::ReadGapSimulation(a.sim, io, lines);
   Band(&r.simulation.frf, a.f_lo_hz, a.f_hi_hz);
   double inertia = a.inertia_kg_m2 > 0.0                              ? a.inertia_kg_m2
                    : r.simulation.inertia_kg_m2 > 0.0                 ? r.simulation.inertia_kg_m2
@@ -174,7 +175,7 @@ int RunGap(const GapArgs& a) {
   }
 
   std::vector<analysis::GapUnit> units;
-  for (const files::GapInput& m : r.measured) {
+  for (const io::GapInput& m : r.measured) {
     analysis::GapUnit u;
     u.name = m.source;
     u.freq_hz = m.frf.freq_hz;
@@ -200,7 +201,7 @@ int RunGap(const GapArgs& a) {
 
   if (!a.predict_sim.empty()) {
     GapPrediction p;
-    p.simulation = files::ReadGapSimulation(a.predict_sim, io, lines);
+    p.simulation = io::ReadGapSimulation(a.predict_sim, io, lines);
     Band(&p.simulation.frf, a.f_lo_hz, a.f_hi_hz);
     const double j2 = p.simulation.inertia_kg_m2 > 0.0 ? p.simulation.inertia_kg_m2 : inertia;
     p.calibration = Calibrate(p.simulation, j2);
@@ -224,11 +225,11 @@ int RunGap(const GapArgs& a) {
     } else {
       std::ofstream out(a.json_out);
       out << j.dump(2) << "\n";
-      if (!out) throw files::FileError(a.json_out, 0, 0, "cannot write the JSON report");
+      if (!out) throw io::FileError(a.json_out, 0, 0, "cannot write the JSON report");
     }
   }
   if (!a.plot.empty()) {
-    files::WriteSvg(a.plot, Plot(r, r.measured.front()));
+    io::WriteSvg(a.plot, Plot(r, r.measured.front()));
     text << "plot written to " << a.plot << "\n";
   }
   return 0;

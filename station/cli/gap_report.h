@@ -42,21 +42,21 @@
 #include "analysis/gap/diagnosis.h"
 #include "analysis/gap/features.h"
 #include "analysis/gap/prediction.h"
-#include "station/files/gap_inputs.h"
+#include "drivers/io/gap_inputs.h"
 
 namespace eol::station::cli {
 
 struct GapPrediction {
-  files::GapInput simulation;
+  io::GapInput simulation;
   analysis::CalibrationSummary calibration;
   analysis::PredictionSummary prediction;
 };
 
 struct GapReport {
   analysis::Quantity quantity = analysis::Quantity::kImpedanceOhm;
-  files::GapInput simulation;
+  io::GapInput simulation;
   analysis::CalibrationSummary calibration;
-  std::vector<files::GapInput> measured;
+  std::vector<io::GapInput> measured;
   int sigma_pool = 0;
   analysis::GapSummary gap;
   std::vector<analysis::FeatureSummary> features;  // per measured unit

@@ -9,8 +9,8 @@
 #include "analysis/qc/measurement_names.h"
 #include "analysis/signal/waveform.h"
 #include "db/test_record.h"
+#include "drivers/io/measured_input.h"
 #include "station/qc_service.h"
-#include "station/files/measured_input.h"
 
 namespace eol::station::cli {
 namespace {
@@ -22,9 +22,9 @@ bool EndsWith(const std::string& s, const std::string& tail) {
 }
 
 analysis::GoldenUnit FromMeasured(const std::string& path, const Recipe& recipe) {
-  files::MeasuredInput in = files::ReadMeasured(path, {});
+  io::MeasuredInput in = io::ReadMeasured(path, {});
   analysis::ImpedanceAnalysis a;
-  if (in.kind == files::MeasuredKind::kFrf) {
+  if (in.kind == io::MeasuredKind::kFrf) {
     if (in.frf.quantity != analysis::Quantity::kImpedanceOhm)
       throw std::runtime_error(path +
                                ": a golden unit must be an impedance FRF (f_hz,re_ohm,im_ohm)");

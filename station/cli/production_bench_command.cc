@@ -1,5 +1,5 @@
 // `eol production-bench --units N --seed S [--json]`: the production benchmark of learned
-// limits (analysis/production/production_bench.h) with the recipe's excitation, analysis and
+// limits (analysis/bench/production_bench.h) with the recipe's excitation, analysis and
 // declared measurements. Prints, per defect class, units and how many each rule passes
 // (escapes) or rejects (false rejects for good units): taught limits, the recipe's own limits,
 // and the naive |Z| peak in a fixed window.
@@ -7,9 +7,10 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "analysis/production/production_bench.h"
+#include "analysis/bench/production_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/data_files.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {

@@ -62,7 +62,9 @@ void AddQueryCommand(CLI::App& app) {
       "query",
       "Show every test of a serial number, newest first, with measurements, limits, verdict,\n"
       "reasons and recipe hash. Exit code 1 when the serial has no tests.");
-  cmd->add_option("--db", args->db, "SQLite file of the station")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--db", args->db, "SQLite file of the station")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("--serial", args->serial, "Serial number")->required();
   cmd->add_flag("--json", args->json, "One JSON object: {serial, latest, tests}");
   cmd->add_flag("--curves", args->curves, "With --json: include the raw curves");

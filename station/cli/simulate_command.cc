@@ -1,8 +1,8 @@
 // `eol simulate`: test data from a simulated motor, so that anyone can make it. The motor is
-// a JSON file (station/files/motor_json.h: winding, transducer, rotor chain, fixture), the
+// a JSON file (drivers/io/motor_json.h: winding, transducer, rotor chain, fixture), the
 // excitation the recipe's multisine (transient and averaged periods), the bench the
 // amplifier, shunt and noisy channels of analysis/sim/. Output:
-//   --format frf        FRF CSV f_hz,re_ohm,im_ohm,sigma_ohm (station/files/frf_files.h): the
+//   --format frf        FRF CSV f_hz,re_ohm,im_ohm,sigma_ohm (drivers/io/frf_files.h): the
 //                       periodic errors-in-variables estimate of the simulated recording, as
 //                       the station would measure it (sigma = std of the complex estimate).
 //                       With both noise levels 0: the exact model Z on the lines, no sigma.
@@ -17,12 +17,13 @@
 #include "analysis/signal/periodic_frf.h"
 #include "analysis/sim/bench_circuit.h"
 #include "analysis/sim/time_domain.h"
-#include "drivers/json_config.h"
+#include "drivers/io/frf_files.h"
+#include "drivers/io/json_config.h"
+#include "drivers/io/motor_json.h"
+#include "drivers/io/recording_files.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/files/frf_files.h"
-#include "station/files/motor_json.h"
-#include "station/files/recording_files.h"
+#include "station/data_files.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {
@@ -60,12 +61,12 @@ std::string VisibleModes(const analysis::ClampedMotor& motor, double lo, double 
 }
 
 int RunSimulate(const SimulateArgs& a) {
-  files::MotorSpec spec = files::LoadMotorJson(a.motor);
+  io::MotorSpec spec = io::LoadMotorJson(a.motor);
   if (!a.defect.empty()) {
     std::string why;
     if (!analysis::SoftMagnetsForDefect(a.defect, spec.rotor.magnets, &spec.rotor.soft_magnets,
                                         &why))
-      throw drivers::ConfigError("--defect: " + why);
+      throw io::ConfigError("--defect: " + why);
   }
   if (!spec.effects.empty())
     std::cerr << "eol simulate: motor " << spec.id << " lists " << spec.effects.size()
@@ -98,17 +99,17 @@ int RunSimulate(const SimulateArgs& a) {
 
   std::string wrote;
   if (a.format == "recording") {
-    files::WriteRecordingCsv(a.out, rec);
+    io::WriteRecordingCsv(a.out, rec);
     wrote = "recording of " + std::to_string(rec.voltage_v.size()) + " samples";
   } else if (a.noise_v == 0.0 && a.noise_a == 0.0) {
-    files::WriteFrfCsv(a.out, motor.Evaluate(ex.LineFrequenciesHz()));
+    io::WriteFrfCsv(a.out, motor.Evaluate(ex.LineFrequenciesHz()));
     wrote = "exact FRF (no noise, no sigma) of " + std::to_string(ex.lines.size()) + " lines";
   } else {
     const analysis::FrfSummary frf =
         analysis::EstimatePeriodicFrf(rec, ex.lines, recipe.analysis.frf);
     if (!frf.usable)
       throw std::runtime_error("the simulated recording gives no FRF: " + frf.message);
-    files::WriteFrfCsv(a.out, frf.frf);
+    io::WriteFrfCsv(a.out, frf.frf);
     wrote = "FRF of " + std::to_string(frf.frf.size()) + " lines";
   }
   std::cout << "motor " << spec.id << ", defect "
@@ -132,7 +133,7 @@ void AddSimulateCommand(CLI::App& app) {
       "recipe's multisine through the bench (amplifier, shunt, noise on both channels).\n"
       "Writes an FRF CSV (f_hz,re_ohm,im_ohm,sigma_ohm) or a raw recording CSV (t_s,u_v,i_a).");
   cmd->add_option("--motor", args->motor,
-                  "Motor JSON (format: station/files/motor_json.h; "
+                  "Motor JSON (format: drivers/io/motor_json.h; "
                   "examples in recipes/motors/)")
       ->required()
       ->check(CLI::ExistingFile);

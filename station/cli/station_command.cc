@@ -10,6 +10,7 @@
 
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/data_files.h"
 #include "station/serial_number.h"
 #include "station/station.h"
 #include "station/systemd_notify.h"
@@ -39,7 +40,8 @@ int RunStation(const std::string& config_path, std::string web_root) {
     spdlog::warn("received {}: stopping (test in flight is aborted safely)",
                  sig == SIGTERM ? "SIGTERM" : "SIGINT");
     NotifyStopping();
-    station.RequestStop(sig == SIGTERM ? "station stopping (SIGTERM)" : "station stopping (SIGINT)");
+    station.RequestStop(sig == SIGTERM ? "station stopping (SIGTERM)"
+                                       : "station stopping (SIGINT)");
   });
   if (station.config().serial_from_stdin) {
     std::thread([&station] {

@@ -41,9 +41,8 @@ void PrintText(const nlohmann::json& r) {
                 "Cpk", "drift");
     for (const auto& m : g["measurements"])
       std::printf("  %-34s %6zu %12s %10s %8s %8s  %s\n", m["name"].get<std::string>().c_str(),
-                  m["n"].get<std::size_t>(), Num(m["mean"], "%.6g").c_str(),
-                  Num(m["sd"]).c_str(), Num(m["cp"], "%.3f").c_str(),
-                  Num(m["cpk"], "%.3f").c_str(),
+                  m["n"].get<std::size_t>(), Num(m["mean"], "%.6g").c_str(), Num(m["sd"]).c_str(),
+                  Num(m["cp"], "%.3f").c_str(), Num(m["cpk"], "%.3f").c_str(),
                   m["drift"]["alarm"].get<bool>() ? "ALARM" : "-");
   }
   if (r["recipes"].empty()) std::printf("no production tests in the window\n");
@@ -94,7 +93,9 @@ void AddStatsCommand(CLI::App& app) {
       "its limits, drift alarms (trend over the passing tests), and with --gauge a type-1\n"
       "gauge study of one serial tested repeatedly. Self-check (master) tests are excluded.\n"
       "Exit code 1 when a drift alarm fired.");
-  cmd->add_option("--db", args->db, "SQLite file of the station")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--db", args->db, "SQLite file of the station")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("--recipe-hash", args->recipe_hash, "Only tests under this recipe SHA-256");
   cmd->add_option("--from", args->from, "ISO 8601 start (inclusive), e.g. 2026-11-01");
   cmd->add_option("--to", args->to, "ISO 8601 end (exclusive)");

@@ -68,11 +68,11 @@ int RunTeach(const TeachArgs& a) {
 
   if (a.json) {
     json out = TeachSummaryJson(s, a.options);
-    out["recipe"] = {{"path", a.out}, {"id", next.id}, {"version", next.version}, {"hash", next.hash}};
+    out["recipe"] = {
+        {"path", a.out}, {"id", next.id}, {"version", next.version}, {"hash", next.hash}};
     out["previous"] = {{"path", a.recipe}, {"version", recipe.version}, {"hash", recipe.hash}};
     out["skipped"] = skipped;
-    std::cout << out.dump()
-              << std::endl;
+    std::cout << out.dump() << std::endl;
     return 0;
   }
   std::cout << "teach: " << s.message << "\n";

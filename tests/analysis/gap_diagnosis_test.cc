@@ -7,7 +7,7 @@
 #include <random>
 
 #include "analysis/gap/diagnosis.h"
-#include "analysis/gap/measurement_sim.h"
+#include "analysis/sim/measurement_sim.h"
 #include "analysis/sim/population.h"
 
 namespace eol::analysis {

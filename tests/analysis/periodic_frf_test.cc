@@ -11,7 +11,7 @@
 #include <limits>
 #include <numbers>
 
-#include "analysis/fit_bench.h"
+#include "analysis/bench/fit_bench.h"
 #include "analysis/model/motor_model.h"
 #include "analysis/signal/multisine.h"
 #include "analysis/sim/steady_state.h"

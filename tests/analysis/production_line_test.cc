@@ -6,11 +6,11 @@
 
 #include <cmath>
 
+#include "analysis/bench/naive_rule.h"
 #include "analysis/fit/resonance_fit.h"
 #include "analysis/model/motor_model.h"
-#include "analysis/production/line_measurement.h"
-#include "analysis/production/line_population.h"
-#include "analysis/production/naive_rule.h"
+#include "analysis/qc/line_measurement.h"
+#include "analysis/qc/line_population.h"
 
 namespace eol::analysis {
 namespace {

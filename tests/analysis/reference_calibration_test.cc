@@ -2,13 +2,13 @@
 // gain and delay in a noisy synthetic Z(f) = R_ref g exp(j w tau) are recovered within three
 // sigma for every seed, the sigmas are honest (the spread over seeds matches them), a
 // periodic fractional delay is exact, and bad inputs give usable == false with the reason.
+#include "analysis/signal/reference_calibration.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 #include <random>
-
-#include "analysis/signal/reference_calibration.h"
 
 namespace eol::analysis {
 namespace {

@@ -1,6 +1,6 @@
 // The CAN fixture driver against the CAN fixture node (the emulator behind `eol fixture-sim
 // --can`), both in-process, over a real SocketCAN interface (EOL_CAN_INTERFACE; ctest runs
-// this under ../shared/tools/vcan/with-vcan): the clamp sequence, pressure scaling at the
+// this under tests/support/vcan/with-vcan): the clamp sequence, pressure scaling at the
 // driver edge, every output and its echo, the heartbeat and status timeouts, malformed
 // frames, bus-off through the transport seam, and the frame map's validation. The
 // independent peers (python3-can, can-utils) are in can_peers_test.cc.
@@ -14,8 +14,8 @@
 #include <string>
 #include <thread>
 
-#include "drivers/factory.h"
-#include "drivers/fixture/can_fixture_node.h"
+#include "drivers/emulators/can_fixture_node.h"
+#include "drivers/factory/factory.h"
 #include "drivers/fixture/can_link.h"
 #include "drivers/fixture/can_map.h"
 #include "drivers/sim/sim_bench.h"
@@ -351,7 +351,7 @@ TEST(CanMapTest, BadMapsAreNamed) {
   const auto error = [](const nlohmann::json& j) -> std::string {
     try {
       ParseCanMap(j, "/fixture/map");
-    } catch (const ConfigError& e) {
+    } catch (const io::ConfigError& e) {
       return e.what();
     }
     return "no error";

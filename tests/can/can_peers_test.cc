@@ -1,6 +1,6 @@
 // The CAN fixture driver and `eol fixture-sim --can` against independent peers on a real
 // SocketCAN interface (EOL_CAN_INTERFACE; ctest runs this under
-// ../shared/tools/vcan/with-vcan, whose shim every child process inherits):
+// tests/support/vcan/with-vcan, whose shim every child process inherits):
 //   - tests/peers/can_fixture_peer.py (python3-can) playing a fixture node for our driver,
 //     and as a client of our emulator; it encodes the README's frame map on its own;
 //   - can-utils' cansend and candump against the emulator.
@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/factory.h"
+#include "drivers/factory/factory.h"
 #include "drivers/fixture/can_fixture.h"
 #include "tests/support/child_process.h"
 

@@ -1,7 +1,6 @@
 // Contract tests of db::Store (db/store.h): each test opens a fresh file in its own
 // temporary directory, removed afterwards.
 #include "db/store.h"
-#include "db/schema.h"
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -16,6 +15,8 @@
 #include <regex>
 #include <string>
 #include <vector>
+
+#include "db/schema.h"
 
 namespace eol::db {
 namespace {
@@ -164,8 +165,9 @@ TEST_F(StoreTest, OpenCreatesTheSchemaWithWalAndVersion) {
   EXPECT_EQ(raw.Column("PRAGMA journal_mode"), std::vector<std::string>{"wal"});
   EXPECT_EQ(raw.Column("PRAGMA user_version"),
             std::vector<std::string>{std::to_string(Store::kSchemaVersion)});
-  EXPECT_EQ(raw.Column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
-            (std::vector<std::string>{"curves", "measurements", "recipe_audit", "self_checks", "tests"}));
+  EXPECT_EQ(
+      raw.Column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
+      (std::vector<std::string>{"curves", "measurements", "recipe_audit", "self_checks", "tests"}));
   const auto indexes = raw.Column("SELECT name FROM sqlite_schema WHERE type = 'index'");
   for (const char* name : {"tests_serial_started", "tests_started", "measurements_name"})
     EXPECT_NE(std::find(indexes.begin(), indexes.end(), name), indexes.end()) << name;
@@ -609,10 +611,11 @@ TEST_F(StoreMigrationTest, VersionOneFileMigratesToTwoKeepingItsTests) {
     raw.Exec(schema::kSchemaV1);
     raw.Exec("PRAGMA application_id = " + std::to_string(schema::kApplicationId) +
              "; PRAGMA user_version = 1");
-    raw.Exec("INSERT INTO tests (serial, station_id, recipe_id, recipe_version, recipe_hash, "
-             "software_version, started_at, finished_at, outcome, reasons) VALUES ('OLD-1', 's', "
-             "'r', 1, 'h', 'v', '2025-01-01T00:00:00.000Z', '2025-01-01T00:00:01.000Z', 'PASS', "
-             "'[]')");
+    raw.Exec(
+        "INSERT INTO tests (serial, station_id, recipe_id, recipe_version, recipe_hash, "
+        "software_version, started_at, finished_at, outcome, reasons) VALUES ('OLD-1', 's', "
+        "'r', 1, 'h', 'v', '2025-01-01T00:00:00.000Z', '2025-01-01T00:00:01.000Z', 'PASS', "
+        "'[]')");
   }
   auto store = Store::Open(path.string());
   RawDb raw(path);
@@ -624,8 +627,15 @@ TEST_F(StoreMigrationTest, VersionOneFileMigratesToTwoKeepingItsTests) {
 
 TEST_F(StoreMigrationTest, AuditLogRoundTripsNewestFirst) {
   auto store = Store::Open((dir_ / "a.sqlite").string());
-  RecipeAudit a{"2026-11-22T05:00:00.000Z", "qe-anna", "engineer", "pmsm-10pole", 1, 2,
-                std::string(64, 'a'), std::string(64, 'b'), "/etc/eol/recipe.json"};
+  RecipeAudit a{"2026-11-22T05:00:00.000Z",
+                "qe-anna",
+                "engineer",
+                "pmsm-10pole",
+                1,
+                2,
+                std::string(64, 'a'),
+                std::string(64, 'b'),
+                "/etc/eol/recipe.json"};
   RecipeAudit b = a;
   b.at = "2026-11-22T06:00:00.000Z";
   b.old_version = 2;

@@ -6,17 +6,17 @@
 #include <filesystem>
 #include <string>
 
+#include "../support/child_process.h"
 #include "db/schema.h"
 #include "db/store.h"
-#include "../support/child_process.h"
 
 namespace eol::db {
 namespace {
 
 using analysis::Outcome;
 
-TestRecord Record(const std::string& serial, const std::string& at, Outcome outcome,
-                  double f0_hz, const std::string& kind = "production") {
+TestRecord Record(const std::string& serial, const std::string& at, Outcome outcome, double f0_hz,
+                  const std::string& kind = "production") {
   TestRecord r;
   r.serial = serial;
   r.station_id = "S";
@@ -59,8 +59,9 @@ TEST(StoreV3, VersionTwoFileUpgradesAndOldTestsAreProduction) {
          "INSERT INTO tests (serial, station_id, recipe_id, recipe_version, recipe_hash, "
          "software_version, started_at, finished_at, outcome, reasons) VALUES ('OLD-2', 's', "
          "'r', 1, 'h', 'v', '2025-01-01T00:00:00.000Z', '2025-01-01T00:00:01.000Z', 'PASS', '[]')");
-    Exec(raw, "INSERT INTO measurements (test_id, name, value, unit, lo, hi, outcome, marginal) "
-              "VALUES (1, 'resonance_f_hz', 391.5, 'Hz', 370, 420, 'PASS', 0)");
+    Exec(raw,
+         "INSERT INTO measurements (test_id, name, value, unit, lo, hi, outcome, marginal) "
+         "VALUES (1, 'resonance_f_hz', 391.5, 'Hz', 370, 420, 'PASS', 0)");
     sqlite3_close(raw);
   }
   auto store = Store::Open(path);
@@ -121,7 +122,8 @@ TEST(StoreV3, SelfChecksAreWrittenWithTheirTestAndKeptApartFromProduction) {
 TEST(StoreV3, ASelfCheckRecordWithoutItsResultIsRefusedAndNotStored) {
   eol::testing::TempDir dir;
   auto store = Store::Open(dir / "s.sqlite");
-  TestRecord bad = Record("MASTER-G", "2026-01-01T01:00:00.000Z", Outcome::kPass, 391, "self_check");
+  TestRecord bad =
+      Record("MASTER-G", "2026-01-01T01:00:00.000Z", Outcome::kPass, 391, "self_check");
   try {
     store->Insert(bad);
     ADD_FAILURE() << "a self-check without master/passed was stored";

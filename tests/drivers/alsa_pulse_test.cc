@@ -19,7 +19,7 @@
 
 #include "analysis/signal/multisine.h"
 #include "drivers/daq/alsa_daq.h"
-#include "drivers/daq/daq_config.h"
+#include "drivers/factory/daq_config.h"
 #include "tests/support/child_process.h"
 
 #if EOL_WITH_ALSA  // else the driver is not built: nothing to test
@@ -264,7 +264,7 @@ TEST(AlsaConfig, ParsesGainsCalibrationAndNamesBadFields) {
       "capture": "hw:1,0", "format": "S16_LE", "period_frames": 256,
       "gains": {"output_v_per_fs": 2.5, "voltage_v_per_fs": 10, "current_v_per_fs": 1},
       "calibration": {"shunt_ohm": 0.05, "divider_ratio": 20, "channel_delay_s": 1e-5}})");
-  JsonObject o(j, "/daq");
+  io::JsonObject o(j, "/daq");
   (void)o.RequiredString("driver");
   const AlsaDaqSettings s = ParseAlsaDaqSettings(o);
   EXPECT_EQ(s.playback_device, "hw:1");
@@ -278,22 +278,22 @@ TEST(AlsaConfig, ParsesGainsCalibrationAndNamesBadFields) {
 
   nlohmann::json bad = j;
   bad["format"] = "S24_3LE";
-  JsonObject ob(bad, "/daq");
+  io::JsonObject ob(bad, "/daq");
   (void)ob.RequiredString("driver");
   try {
     ParseAlsaDaqSettings(ob);
     FAIL() << "S24_3LE accepted";
-  } catch (const ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/daq/format"), std::string::npos) << e.what();
   }
   bad = j;
   bad["gains"]["current_v_per_fs"] = 0;
-  JsonObject og(bad, "/daq");
+  io::JsonObject og(bad, "/daq");
   (void)og.RequiredString("driver");
   try {
     ParseAlsaDaqSettings(og);
     FAIL() << "zero gain accepted";
-  } catch (const ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/daq/gains/current_v_per_fs"), std::string::npos)
         << e.what();
   }

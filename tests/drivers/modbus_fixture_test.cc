@@ -15,8 +15,8 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/factory.h"
-#include "drivers/fixture/modbus_fixture_server.h"
+#include "drivers/emulators/modbus_fixture_server.h"
+#include "drivers/factory/factory.h"
 #include "drivers/fixture/modbus_map.h"
 #include "drivers/sim/sim_bench.h"
 
@@ -434,7 +434,7 @@ TEST(ModbusMapTest, DefaultMapReadsInTwoRequests) {
 std::string ParseError(const nlohmann::json& j) {
   try {
     ParseModbusMap(j, "/fixture/map");
-  } catch (const ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     return e.what();
   }
   return "no error";
@@ -499,7 +499,7 @@ TEST(ModbusFactoryTest, MakesModbusFixturesByName) {
   const auto error = [](const nlohmann::json& j) -> std::string {
     try {
       MakeDrivers(j);
-    } catch (const ConfigError& e) {
+    } catch (const io::ConfigError& e) {
       return e.what();
     }
     return "no error";

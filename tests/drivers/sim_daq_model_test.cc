@@ -1,4 +1,4 @@
-// The simulated acquisition with either motor model (drivers/daq/sim_daq.h): both record the
+// The simulated acquisition with either motor model (drivers/sim/sim_daq.h): both record the
 // motor in the fixture through the bench circuit, so U/I on the excited lines is the motor's
 // impedance; the time-domain model also shows the start transient. Config parsing names the
 // offending field.
@@ -10,7 +10,7 @@
 #include "analysis/fit/resonance_fit.h"
 #include "analysis/signal/fft.h"
 #include "analysis/signal/multisine.h"
-#include "drivers/factory.h"
+#include "drivers/factory/factory.h"
 
 namespace eol::drivers {
 namespace {
@@ -102,17 +102,17 @@ TEST(SimDaq, TimeDomainShowsTheStartTransient) {
 TEST(SimDaq, ConfigNamesTheModelField) {
   const nlohmann::json good = {
       {"driver", "sim"}, {"model", "time_domain"}, {"amplifier_output_ohm", 0.05}};
-  const JsonObject daq(good, "/daq");
+  const io::JsonObject daq(good, "/daq");
   EXPECT_EQ(daq.RequiredString("driver"), "sim");  // read by MakeDrivers before parsing
   const SimDaqSettings s = ParseSimDaqSettings(daq);
   EXPECT_EQ(s.model, SimMotorModel::kTimeDomain);
   EXPECT_DOUBLE_EQ(s.amplifier_output_ohm, 0.05);
-  EXPECT_EQ(ParseSimDaqSettings(JsonObject(nlohmann::json::object(), "/daq")).model,
+  EXPECT_EQ(ParseSimDaqSettings(io::JsonObject(nlohmann::json::object(), "/daq")).model,
             SimMotorModel::kSteadyState);
   try {
-    ParseSimDaqSettings(JsonObject(nlohmann::json{{"model", "spice"}}, "/daq"));
+    ParseSimDaqSettings(io::JsonObject(nlohmann::json{{"model", "spice"}}, "/daq"));
     FAIL() << "no error";
-  } catch (const ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/daq/model: must be \"steady_state\" or"),
               std::string::npos)
         << e.what();

@@ -2,12 +2,12 @@
 // npm): the daemon runs on its simulators, a test is run, and the page must show the stored
 // verdict, the serial and the measured curve against the recipe's mask, then follow a second
 // test live. The screenshot is kept in build/artifacts/ for CI.
-#include <httplib.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <httplib.h>
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 
 #include "../support/child_process.h"
@@ -68,8 +68,8 @@ TEST(OperatorPage, ShowsVerdictCurveAndFollowsTestsLive) {
   std::filesystem::create_directories(artifacts);
   const std::string shot = artifacts + "/operator-page.png";
   std::filesystem::remove(shot);
-  ChildProcess browser({node, kBrowserDir + "/check_page.mjs", "http://127.0.0.1:" + std::to_string(port),
-                        shot, "PAGE-0001", "PAGE-0002"},
+  ChildProcess browser({node, kBrowserDir + "/check_page.mjs",
+                        "http://127.0.0.1:" + std::to_string(port), shot, "PAGE-0001", "PAGE-0002"},
                        /*merge_stderr=*/false);
   const auto code = browser.Wait(180s);
   ASSERT_TRUE(code.has_value()) << "browser did not finish";

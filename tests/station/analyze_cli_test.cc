@@ -10,13 +10,13 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "analysis/fit_bench.h"
+#include "analysis/bench/fit_bench.h"
 #include "analysis/model/motor_model.h"
 #include "analysis/model/two_mass.h"
 #include "analysis/signal/chirp_noise.h"
 #include "analysis/sim/steady_state.h"
-#include "station/files/frf_files.h"
-#include "station/files/recording_files.h"
+#include "drivers/io/frf_files.h"
+#include "drivers/io/recording_files.h"
 #include "tests/support/child_process.h"
 #include "tests/support/eol_cli.h"
 
@@ -56,7 +56,7 @@ analysis::Frf NoisyZ(const analysis::MotionalImpedance& m, double sigma, bool ke
 
 TEST(AnalyzeCliTest, FrfCsvWithSigmaJson) {
   testing::TempDir dir;
-  station::files::WriteFrfCsv(dir / "z.csv", NoisyZ(kGood, 0.02, true, 1));
+  io::WriteFrfCsv(dir / "z.csv", NoisyZ(kGood, 0.02, true, 1));
   const CliRun r = Eol({"--measured", dir / "z.csv", "--json"});
   ASSERT_EQ(r.code, 0) << r.out;
   const nlohmann::json j = Json(r);
@@ -79,7 +79,7 @@ TEST(AnalyzeCliTest, FrfCsvWithSigmaJson) {
 
 TEST(AnalyzeCliTest, WithoutSigmaSaysNoiseIsEstimated) {
   testing::TempDir dir;
-  station::files::WriteFrfCsv(dir / "z.csv", NoisyZ(kGood, 0.02, false, 2));
+  io::WriteFrfCsv(dir / "z.csv", NoisyZ(kGood, 0.02, false, 2));
   const CliRun j = Eol({"--measured", dir / "z.csv", "--json"});
   ASSERT_EQ(j.code, 0) << j.out;
   EXPECT_EQ(Json(j)["noise_estimated"], true);
@@ -92,10 +92,10 @@ TEST(AnalyzeCliTest, WithoutSigmaSaysNoiseIsEstimated) {
 
 TEST(AnalyzeCliTest, RecipeGivesVerdictPassAndFail) {
   testing::TempDir dir;
-  station::files::WriteFrfCsv(dir / "good.csv", NoisyZ(kGood, 0.02, true, 3));
+  io::WriteFrfCsv(dir / "good.csv", NoisyZ(kGood, 0.02, true, 3));
   analysis::MotionalImpedance soft = kGood;
   soft.f0_hz = 350.0;
-  station::files::WriteZma(dir / "soft.zma", NoisyZ(soft, 0.02, false, 4));
+  io::WriteZma(dir / "soft.zma", NoisyZ(soft, 0.02, false, 4));
   const CliRun g = Eol({"--measured", dir / "good.csv", "--recipe", kRecipe, "--json"});
   ASSERT_EQ(g.code, 0) << g.out;
   const nlohmann::json jg = Json(g);
@@ -116,8 +116,8 @@ TEST(AnalyzeCliTest, RawRecordingCsvAndWav) {
   analysis::MultisineOptions o;  // the recipe's excitation
   const analysis::Excitation e = analysis::DesignMultisine(o);
   const analysis::Recording rec = analysis::SimulatePeriodicRecording(kGood, e, 5, 2e-3, 1e-3, 9);
-  station::files::WriteRecordingCsv(dir / "rec.csv", rec);
-  station::files::WriteWavRecording(dir / "rec.wav", rec, 4.0, 1.0);
+  io::WriteRecordingCsv(dir / "rec.csv", rec);
+  io::WriteWavRecording(dir / "rec.wav", rec, 4.0, 1.0);
   for (const std::vector<std::string>& extra :
        {std::vector<std::string>{"--measured", dir / "rec.csv", "--recipe", kRecipe},
         {"--measured", dir / "rec.csv", "--excitation-band", "200,800,1"},
@@ -157,7 +157,7 @@ TEST(AnalyzeCliTest, NoiseRecordingWithWelch) {
     rec.voltage_v[t] += vn(rng);
     rec.current_a[t] += in(rng);
   }
-  station::files::WriteWavRecording(dir / "noise.wav", rec, 4.0, 1.0);
+  io::WriteWavRecording(dir / "noise.wav", rec, 4.0, 1.0);
   const CliRun r = Eol({"--measured", dir / "noise.wav", "--voltage-gain", "4", "--current-gain",
                         "1", "--welch-segment", "16000", "--recipe", kRecipe, "--json"});
   ASSERT_EQ(r.code, 0) << r.out;
@@ -183,7 +183,7 @@ TEST(AnalyzeCliTest, MobilityFrfGetsTheTwoMassFit) {
     h.sigma.push_back(0.01 * std::abs(h.value[k]));
     h.value[k] += std::complex<double>(n(rng), n(rng)) * (h.sigma[k] / std::sqrt(2.0));
   }
-  station::files::WriteFrfCsv(dir / "h.csv", h);
+  io::WriteFrfCsv(dir / "h.csv", h);
   const CliRun r = Eol({"--measured", dir / "h.csv", "--json"});
   ASSERT_EQ(r.code, 0) << r.out;
   const nlohmann::json j = Json(r);
@@ -196,7 +196,7 @@ TEST(AnalyzeCliTest, DataThatCannotBeAnalysedExitsOne) {
   testing::TempDir dir;
   analysis::MotionalImpedance none = kGood;
   none.rp_ohm = 1e-9;  // T(phi) ~ 0: no coupling, no peak
-  station::files::WriteFrfCsv(dir / "flat.csv", NoisyZ(none, 0.02, true, 6));
+  io::WriteFrfCsv(dir / "flat.csv", NoisyZ(none, 0.02, true, 6));
   const CliRun j = Eol({"--measured", dir / "flat.csv", "--recipe", kRecipe, "--json"});
   EXPECT_EQ(j.code, 1) << j.out;
   const nlohmann::json js = Json(j);
@@ -223,7 +223,7 @@ TEST(AnalyzeCliTest, UsageAndFileErrorsExitTwo) {
   rec.sample_rate_hz = 8000.0;
   rec.voltage_v.assign(100, 0.1);
   rec.current_a.assign(100, 0.01);
-  station::files::WriteRecordingCsv(dir / "r.csv", rec);
+  io::WriteRecordingCsv(dir / "r.csv", rec);
   const CliRun no_excitation = Eol({"--measured", dir / "r.csv"}, true);
   EXPECT_EQ(no_excitation.code, 2);
   EXPECT_CONTAINS(no_excitation.out, "a raw recording needs its excitation");

@@ -9,11 +9,11 @@
 #include <fstream>
 
 #include "../support/child_process.h"
-#include "tests/support/eol_cli.h"
 #include "drivers/daq/calibration_file.h"
-#include "drivers/factory.h"
+#include "drivers/factory/factory.h"
 #include "station/config.h"
 #include "station/station.h"
+#include "tests/support/eol_cli.h"
 
 namespace eol {
 namespace {
@@ -53,10 +53,9 @@ TEST(CalibrateCli, RecoversInjectedGainAndDelayWithinThreeSigma) {
   const CliRun r = Calibrate({"--config", dir / "station.json", "--reference-ohm", "2.0", "--out",
                               dir / "calibration.json"});
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("calibration " + (dir / "calibration.json") + ": gain"),
-            std::string::npos)
+  EXPECT_NE(r.out.find("calibration " + (dir / "calibration.json") + ": gain"), std::string::npos)
       << r.out;
-  const nlohmann::json j = drivers::ReadJsonFile(dir / "calibration.json");
+  const nlohmann::json j = io::ReadJsonFile(dir / "calibration.json");
   const nlohmann::json& e = j["estimate"];
   const double gain = e["gain"], gain_sigma = e["gain_sigma"];
   const double delay = e["delay_s"], delay_sigma = e["delay_sigma_s"];
@@ -116,7 +115,7 @@ TEST(CalibrateCli, BadCalibrationFileIsNamed) {
   try {
     drivers::MakeDrivers(config.drivers);
     FAIL() << "a negative shunt was accepted";
-  } catch (const drivers::ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("/daq/calibration_file"), std::string::npos) << m;
     EXPECT_NE(m.find(dir / "bad.json"), std::string::npos) << m;
@@ -127,7 +126,7 @@ TEST(CalibrateCli, BadCalibrationFileIsNamed) {
   try {
     drivers::MakeDrivers(config.drivers);
     FAIL() << "a reference_resistor calibration without a date was accepted";
-  } catch (const drivers::ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/date: a reference_resistor calibration needs its date"),
               std::string::npos)
         << e.what();

@@ -6,12 +6,12 @@
 
 #include <cmath>
 
-#include "analysis/qc/measurement_names.h"
-#include "drivers/daq/sim_daq.h"
-#include "drivers/fixture/sim_fixture.h"
-#include "drivers/json_config.h"
-#include "station/sequencer.h"
 #include "../support/child_process.h"
+#include "analysis/qc/measurement_names.h"
+#include "drivers/io/json_config.h"
+#include "drivers/sim/sim_daq.h"
+#include "drivers/sim/sim_fixture.h"
+#include "station/sequencer.h"
 
 namespace eol::station {
 namespace {
@@ -19,7 +19,7 @@ namespace {
 using analysis::Outcome;
 
 nlohmann::json BaseRecipe() {
-  return drivers::ReadJsonFile(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json");
+  return io::ReadJsonFile(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json");
 }
 
 // Within 0..45 degC the simulated population (R 0.5 ohm +-2 %) reads 20 +-5 degC.
@@ -88,11 +88,11 @@ TEST_F(ConditionsTest, InWindowPassesAndRecordsEveryCondition) {
   EXPECT_NEAR(c.at("winding_temperature_c").get<double>(), truth_c, 1.0);
   // The level the motor saw: the multisine's rms is its peak over its crest factor.
   const double v_rms = c.at("excitation_v_rms").get<double>();
-  EXPECT_NEAR(v_rms, recipe_->excitation.peak_v / c.at("crest_factor").get<double>(),
-              0.02 * v_rms);
+  EXPECT_NEAR(v_rms, recipe_->excitation.peak_v / c.at("crest_factor").get<double>(), 0.02 * v_rms);
   EXPECT_GT(c.at("excitation_a_rms").get<double>(), 0.0);
   // Pressure read at confirmation and through the excitation, inside the recipe's window.
-  for (const char* key : {"clamp_pressure_bar", "clamp_pressure_min_bar", "clamp_pressure_max_bar"}) {
+  for (const char* key :
+       {"clamp_pressure_bar", "clamp_pressure_min_bar", "clamp_pressure_max_bar"}) {
     EXPECT_GE(c.at(key).get<double>(), recipe_->clamp_pressure_lo_bar) << key;
     EXPECT_LE(c.at(key).get<double>(), recipe_->clamp_pressure_hi_bar) << key;
   }
@@ -146,7 +146,7 @@ TEST(ConditionsRecipe, InvalidSectionsNameThePathAndTheRule) {
     j["conditions"] = conditions;
     try {
       ParseRecipe(j, "r.json");
-    } catch (const drivers::ConfigError& e) {
+    } catch (const io::ConfigError& e) {
       return std::string(e.what());
     }
     return std::string("(accepted)");

@@ -2,16 +2,16 @@
 // rotor with at most one false reject, stores every record, and the daemon `eol station`
 // serves those records over GET /api/units/{serial}, takes new tests over POST /api/tests
 // and stops cleanly on SIGTERM.
-#include <httplib.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <httplib.h>
 
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 
-#include "db/store.h"
 #include "../support/child_process.h"
 #include "../support/station_ready.h"
+#include "db/store.h"
 
 namespace eol {
 namespace {

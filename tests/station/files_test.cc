@@ -8,14 +8,14 @@
 #include <fstream>
 #include <numbers>
 
-#include "station/files/file_error.h"
-#include "station/files/frf_files.h"
-#include "station/files/measured_input.h"
-#include "station/files/recording_files.h"
-#include "station/files/text_table.h"
+#include "drivers/io/file_error.h"
+#include "drivers/io/frf_files.h"
+#include "drivers/io/measured_input.h"
+#include "drivers/io/recording_files.h"
+#include "drivers/io/text_table.h"
 #include "tests/support/child_process.h"
 
-namespace eol::station::files {
+namespace eol::io {
 namespace {
 
 #define EXPECT_CONTAINS(haystack, needle) \
@@ -203,4 +203,4 @@ TEST(MeasuredInputTest, TellsFilesApart) {
 }
 
 }  // namespace
-}  // namespace eol::station::files
+}  // namespace eol::io

@@ -3,13 +3,13 @@
 // with its cause in the stored record, never PASS; the excitation coil must be off at the
 // fixture; and once the fixture is healthy again the next test runs to a verdict without a
 // restart of the daemon.
-#include <httplib.h>
 #include <gtest/gtest.h>
+#include <httplib.h>
 #include <modbus/modbus.h>
-#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
 #include <thread>
@@ -82,11 +82,11 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
   // while the stator is excited.
   ChildProcess fixture({EOL_BINARY, "fixture-sim", "--port", "0", "--ready-file",
                         dir / "fixture.port", "--part", "ROTOR-ON-FIXTURE", "--fault", c.fault,
-                        "--fault-on-excitation", "--fault-after-ms", "300",
-                        "--fault-duration-ms", "2500"});
-  ASSERT_TRUE(fixture.WaitFor([&](const std::string&) {
-    return std::filesystem::exists(dir / "fixture.port");
-  }, 30s)) << fixture.output();
+                        "--fault-on-excitation", "--fault-after-ms", "300", "--fault-duration-ms",
+                        "2500"});
+  ASSERT_TRUE(fixture.WaitFor(
+      [&](const std::string&) { return std::filesystem::exists(dir / "fixture.port"); }, 30s))
+      << fixture.output();
   const int fixture_port = ReadPortFile(dir / "fixture.port");
   ASSERT_GT(fixture_port, 0);
 
@@ -104,8 +104,8 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
       << station.output();
   httplib::Client http("127.0.0.1", PortFromReadyLine(station.output()));
 
-  const auto started = http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-1"}}.dump(),
-                                 "application/json");
+  const auto started =
+      http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-1"}}.dump(), "application/json");
   ASSERT_TRUE(started && started->status == 202) << (started ? started->body : "no answer");
   const nlohmann::json faulted = WaitForFinishedTest(http, "FAULT-1", 60s);
   ASSERT_FALSE(faulted.is_null()) << station.output();
@@ -134,13 +134,14 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
 
   // Recovery without a restart: the fault has cleared, the next serial gets a verdict.
   std::this_thread::sleep_for(2500ms);
-  const auto again = http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-2"}}.dump(),
-                               "application/json");
+  const auto again =
+      http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-2"}}.dump(), "application/json");
   ASSERT_TRUE(again && again->status == 202) << (again ? again->body : "no answer");
   const nlohmann::json recovered = WaitForFinishedTest(http, "FAULT-2", 60s);
   ASSERT_FALSE(recovered.is_null()) << station.output();
   EXPECT_TRUE(recovered["outcome"] == "PASS" || recovered["outcome"] == "FAIL")
-      << recovered.dump() << "\n" << station.output();
+      << recovered.dump() << "\n"
+      << station.output();
   EXPECT_FALSE(station.Wait(0ms).has_value()) << "the daemon must not need a restart";
 }
 

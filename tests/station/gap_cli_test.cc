@@ -8,10 +8,10 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "analysis/gap/measurement_sim.h"
 #include "analysis/model/effects.h"
-#include "station/files/frf_files.h"
-#include "station/files/recording_files.h"
+#include "analysis/sim/measurement_sim.h"
+#include "drivers/io/frf_files.h"
+#include "drivers/io/recording_files.h"
 #include "tests/support/child_process.h"
 
 namespace eol {
@@ -62,14 +62,13 @@ class GapCli : public ::testing::Test {
   void SetUp() override {
     std::vector<double> f;
     for (double x = 200.0; x <= 800.0; x += 1.0) f.push_back(x);
-    station::files::WriteFrfCsv(dir_ / "sim.csv", Nominal().motional.Evaluate(f));
+    io::WriteFrfCsv(dir_ / "sim.csv", Nominal().motional.Evaluate(f));
   }
   TempDir dir_;
 };
 
 TEST_F(GapCli, JsonHasTheStableNames) {
-  station::files::WriteFrfCsv(dir_ / "meas.csv",
-                              Measured({{analysis::EffectKind::kChannelDelay, {6e-6}}}, 3));
+  io::WriteFrfCsv(dir_ / "meas.csv", Measured({{analysis::EffectKind::kChannelDelay, {6e-6}}}, 3));
   const EolRun r = Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "meas.csv", "--json",
                         dir_ / "out.json"});
   ASSERT_EQ(r.code, 0) << r.output;
@@ -98,7 +97,7 @@ TEST_F(GapCli, JsonHasTheStableNames) {
 TEST_F(GapCli, MissingSigmaIsEstimatedAndSaid) {
   analysis::Frf m = Measured({{analysis::EffectKind::kStrayCapacitance, {2e-7}}}, 5);
   m.sigma.clear();
-  station::files::WriteZma(dir_ / "meas.zma", m);
+  io::WriteZma(dir_ / "meas.zma", m);
   const EolRun r = Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "meas.zma", "--json",
                         dir_ / "out.json"});
   ASSERT_EQ(r.code, 0) << r.output;
@@ -117,7 +116,7 @@ TEST_F(GapCli, SeveralUnitsAndAPlot) {
       "gap", "--sim", dir_ / "sim.csv", "--json", dir_ / "out.json", "--plot", dir_ / "gap.svg"};
   for (int u = 0; u < 3; ++u) {
     const std::string path = dir_ / ("unit" + std::to_string(u) + ".csv");
-    station::files::WriteFrfCsv(path, Measured(truth, 10 + u));
+    io::WriteFrfCsv(path, Measured(truth, 10 + u));
     args.push_back("--measured");
     args.push_back(path);
   }
@@ -136,7 +135,7 @@ TEST_F(GapCli, SeveralUnitsAndAPlot) {
 }
 
 TEST_F(GapCli, PureNoiseIsNoneAndJsonToStdout) {
-  station::files::WriteFrfCsv(dir_ / "meas.csv", Measured({}, 8));
+  io::WriteFrfCsv(dir_ / "meas.csv", Measured({}, 8));
   const EolRun r =
       Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "meas.csv", "--json", "-"});
   ASSERT_EQ(r.code, 0) << r.output;
@@ -151,7 +150,7 @@ TEST_F(GapCli, RawRecordingPeriodAndLinesAreDetected) {
   const analysis::Excitation ex = analysis::DesignMultisine(analysis::MultisineOptions{});
   analysis::SimulatedMeasurementOptions o;
   o.seed = 12;
-  station::files::WriteRecordingCsv(
+  io::WriteRecordingCsv(
       dir_ / "rec.csv",
       analysis::SimulateImpedanceRecording(
           [&](double f) { return analysis::EvaluateNetwork(n, truth, f); }, ex, o));

@@ -20,7 +20,7 @@ namespace {
 using testing::ChildProcess;
 using testing::TempDir;
 
-const std::string kDir = std::string(EOL_SHARED_DATA_DIR) + "/motor-bench-multisine/";
+const std::string kDir = std::string(EOL_TEST_DATA_DIR) + "/motor-bench-multisine/";
 
 nlohmann::json Diagnose(const std::string& recording, const TempDir& dir, std::string* text) {
   std::ofstream(dir / "rigid.json")

@@ -16,11 +16,11 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "analysis/gap/measurement_sim.h"
+#include "analysis/sim/measurement_sim.h"
 #include "analysis/sim/population.h"
-#include "drivers/json_config.h"
-#include "station/files/frf_files.h"
-#include "station/files/motor_json.h"
+#include "drivers/io/frf_files.h"
+#include "drivers/io/json_config.h"
+#include "drivers/io/motor_json.h"
 #include "tests/support/child_process.h"
 
 namespace eol {
@@ -78,10 +78,10 @@ TEST(GapPaperCase, ClampedRotorFixtureIsFoundAndTheDefectPredicted) {
   const analysis::MotorPopulation p = Population();
   const double rigid = std::numeric_limits<double>::infinity();
   TempDir dir;
-  station::files::WriteFrfCsv(dir / "sim.csv", Motor(p, false, rigid).Evaluate(Lines()));
-  station::files::WriteFrfCsv(dir / "sim-defect.csv", Motor(p, true, rigid).Evaluate(Lines()));
+  io::WriteFrfCsv(dir / "sim.csv", Motor(p, false, rigid).Evaluate(Lines()));
+  io::WriteFrfCsv(dir / "sim-defect.csv", Motor(p, true, rigid).Evaluate(Lines()));
   const analysis::MotionalImpedance real = Motor(p, false, p.KFixtureNmPerRad());
-  station::files::WriteFrfCsv(dir / "meas.csv", Measure([&](double f) { return real.At(f); }, 4));
+  io::WriteFrfCsv(dir / "meas.csv", Measure([&](double f) { return real.At(f); }, 4));
 
   std::string text;
   const nlohmann::json j =
@@ -134,14 +134,12 @@ TEST(GapPaperCase, TorsionalChainMotorJson) {
   const std::string motors = std::string(EOL_SOURCE_DIR) + "/recipes/motors/";
   TempDir dir;
   // The simulation: the chain with a rigid fixture (706 Hz); the defect: every bond poor.
-  nlohmann::json defect = drivers::ReadJsonFile(motors + "pmsm-10pole-rigid.json");
+  nlohmann::json defect = io::ReadJsonFile(motors + "pmsm-10pole-rigid.json");
   defect["rotor"]["soft_magnets"] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
   std::ofstream(dir / "defect.json") << defect.dump(2);
   // "Reality": the same chain in the standard fixture (390 Hz), measured.
-  const analysis::ClampedMotor real =
-      station::files::LoadMotorJson(motors + "pmsm-10pole.json").Motor();
-  station::files::WriteFrfCsv(dir / "meas.csv",
-                              Measure([&](double f) { return real.Impedance(f); }, 9));
+  const analysis::ClampedMotor real = io::LoadMotorJson(motors + "pmsm-10pole.json").Motor();
+  io::WriteFrfCsv(dir / "meas.csv", Measure([&](double f) { return real.Impedance(f); }, 9));
   std::string text;
   const nlohmann::json j = RunGap({"--sim", motors + "pmsm-10pole-rigid.json", "--measured",
                                    dir / "meas.csv", "--predict-sim", dir / "defect.json"},

@@ -1,17 +1,17 @@
 // Crash safety: the daemon is killed with SIGKILL at random moments of a test, many times.
 // After every kill the database must open consistent, no unfinished test may ever read as
 // PASS, and the next start must record the interrupted test as ABORTED.
-#include <httplib.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <httplib.h>
 
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <regex>
 
-#include "db/store.h"
 #include "../support/child_process.h"
 #include "../support/station_ready.h"
+#include "db/store.h"
 
 namespace eol {
 namespace {
@@ -24,14 +24,15 @@ using eol::testing::PortFromReadyLine;
 TEST(KillAtRandom, DatabaseStaysConsistentAndInterruptedTestsBecomeAborted) {
   eol::testing::TempDir dir;
   const std::string db_path = dir / "station.sqlite";
-  std::ofstream(dir / "station.json") << nlohmann::json{
-      {"station_id", "crash"},
-      {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
-      {"db", db_path},
-      {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
-      {"fixture", {{"driver", "sim"}}},
-      {"daq", {{"driver", "sim"}, {"time_scale", 0.1}}},
-      {"sim", {{"clamp_close_s", 0.1}, {"clamp_open_s", 0.05}}}}.dump();
+  std::ofstream(dir / "station.json")
+      << nlohmann::json{{"station_id", "crash"},
+                        {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
+                        {"db", db_path},
+                        {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
+                        {"fixture", {{"driver", "sim"}}},
+                        {"daq", {{"driver", "sim"}, {"time_scale", 0.1}}},
+                        {"sim", {{"clamp_close_s", 0.1}, {"clamp_open_s", 0.05}}}}
+             .dump();
 
   std::mt19937 rng(20261122);
   std::uniform_int_distribution<int> kill_after_ms(0, 1400);
@@ -48,12 +49,13 @@ TEST(KillAtRandom, DatabaseStaysConsistentAndInterruptedTestsBecomeAborted) {
     }
     httplib::Client http("127.0.0.1", PortFromReadyLine(station.output()));
     const std::string serial = "CRASH-" + std::to_string(cycle);
-    const auto res = http.Post("/api/tests", nlohmann::json{{"serial", serial}}.dump(),
-                               "application/json");
+    const auto res =
+        http.Post("/api/tests", nlohmann::json{{"serial", serial}}.dump(), "application/json");
     ASSERT_TRUE(res && res->status == 202) << (res ? res->body : "no answer");
 
     // While the test runs, readers never see it as a verdict, let alone a PASS.
-    const auto kill_at = std::chrono::steady_clock::now() + std::chrono::milliseconds(kill_after_ms(rng));
+    const auto kill_at =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(kill_after_ms(rng));
     while (std::chrono::steady_clock::now() < kill_at) {
       const auto unit = http.Get(("/api/units/" + serial).c_str());
       if (unit && unit->status == 200) {
@@ -74,7 +76,8 @@ TEST(KillAtRandom, DatabaseStaysConsistentAndInterruptedTestsBecomeAborted) {
       EXPECT_FALSE(t.finished_at.empty());
       if (t.outcome == analysis::Outcome::kPass) {
         EXPECT_FALSE(t.measurements.empty());
-        for (const auto& m : t.measurements) EXPECT_EQ(m.outcome, analysis::MeasurementOutcome::kPass);
+        for (const auto& m : t.measurements)
+          EXPECT_EQ(m.outcome, analysis::MeasurementOutcome::kPass);
       }
     }
   }
@@ -90,7 +93,8 @@ TEST(KillAtRandom, DatabaseStaysConsistentAndInterruptedTestsBecomeAborted) {
     if (tests.empty()) continue;  // killed before the test was begun
     if (tests.front().outcome == analysis::Outcome::kAborted) {
       ++aborted;
-      EXPECT_EQ(tests.front().reasons.front(), "interrupted: station stopped before the test finished");
+      EXPECT_EQ(tests.front().reasons.front(),
+                "interrupted: station stopped before the test finished");
     } else {
       ++finished;
     }

@@ -23,21 +23,21 @@
 
 #include "analysis/model/two_mass.h"
 #include "analysis/signal/periodic_frf.h"
-#include "station/files/text_table.h"
+#include "drivers/io/text_table.h"
 
 namespace eol {
 namespace {
 
-const std::string kDir = std::string(EOL_SHARED_DATA_DIR) + "/motor-bench-multisine/";
+const std::string kDir = std::string(EOL_TEST_DATA_DIR) + "/motor-bench-multisine/";
 
 std::vector<std::size_t> ExcitedLines(const std::string& name) {
-  station::files::LineReader in(kDir + name + "-excited-lines-hz.txt");
+  io::LineReader in(kDir + name + "-excited-lines-hz.txt");
   std::vector<std::size_t> lines;
   std::string line;
   while (in.Next(&line))
     if (!line.empty())
-      lines.push_back(static_cast<std::size_t>(
-          station::files::ParseNumber(line, in.path(), in.line_number(), 1, "line")));
+      lines.push_back(
+          static_cast<std::size_t>(io::ParseNumber(line, in.path(), in.line_number(), 1, "line")));
   return lines;  // 1 Hz lines: the bin index is the frequency in Hz
 }
 
@@ -48,7 +48,7 @@ struct Bench {
 };
 
 Bench Analyse(const std::string& name) {
-  const station::files::CsvTable t = station::files::ReadCsvTable(kDir + name + ".csv.gz");
+  const io::CsvTable t = io::ReadCsvTable(kDir + name + ".csv.gz");
   const auto& ts = t.Column("t_s");
   EXPECT_EQ(t.rows(), 50000u);
   EXPECT_NEAR((ts.back() - ts.front()) / static_cast<double>(t.rows() - 1), 1.0 / 2500.0, 1e-9);

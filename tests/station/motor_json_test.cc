@@ -1,12 +1,12 @@
-// The motor file (station/files/motor_json.h): the shipped examples parse and build the
+// The motor file (drivers/io/motor_json.h): the shipped examples parse and build the
 // calibrated chain, the canonical JSON round-trips, and errors name the JSON path.
-#include "station/files/motor_json.h"
+#include "drivers/io/motor_json.h"
 
 #include <gtest/gtest.h>
 
-#include "drivers/json_config.h"
+#include "drivers/io/json_config.h"
 
-namespace eol::station::files {
+namespace eol::io {
 namespace {
 
 const std::string kMotors = std::string(EOL_SOURCE_DIR) + "/recipes/motors/";
@@ -14,7 +14,7 @@ const std::string kMotors = std::string(EOL_SOURCE_DIR) + "/recipes/motors/";
 std::string ErrorOf(const nlohmann::json& j) {
   try {
     ParseMotorJson(j, "m.json");
-  } catch (const drivers::ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     return e.what();
   }
   return "no error";
@@ -73,8 +73,8 @@ TEST(MotorJson, ErrorsNameThePath) {
   j = Minimal();
   j["transducer"] = {{"transmission_nm_per_a", 0.05}};
   const MotorSpec direct = ParseMotorJson(j, "m.json");
-  EXPECT_THROW(direct.TransmissionNmPerA(10.0), drivers::ConfigError);
+  EXPECT_THROW(direct.TransmissionNmPerA(10.0), io::ConfigError);
 }
 
 }  // namespace
-}  // namespace eol::station::files
+}  // namespace eol::io

@@ -29,7 +29,8 @@ TEST(DebianPackage, HoldsProgramUnitConfigRecipesAndPage) {
   for (const char* f : {"./usr/bin/eol", "./lib/systemd/system/eol-station.service",
                         "./etc/eol/station.json", "./usr/share/eol/recipes/pmsm-10pole.json",
                         "./usr/share/eol/web/index.html", "./usr/share/eol/web/app.js"})
-    EXPECT_NE(contents.output().find(f), std::string::npos) << f << " missing:\n" << contents.output();
+    EXPECT_NE(contents.output().find(f), std::string::npos) << f << " missing:\n"
+                                                            << contents.output();
 
   eol::testing::ChildProcess control({"/usr/bin/dpkg-deb", "-I", deb});
   ASSERT_EQ(control.Wait(60s).value_or(-1), 0);

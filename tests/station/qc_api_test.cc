@@ -2,11 +2,11 @@
 // units (POST /api/teach returns a proposed recipe, version + 1, that the station accepts when
 // it is PUT), operators may not; GET /api/detectability reports every defect class for the
 // recipe in use and the fixture stiffness given.
-#include <httplib.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <httplib.h>
 
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <thread>
 
@@ -33,23 +33,27 @@ class QcApi : public ::testing::Test {
   void SetUp() override {
     std::filesystem::copy_file(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json",
                                dir_ / "pmsm-10pole.json");
-    std::ofstream(dir_ / "station.json") << nlohmann::json{
-        {"station_id", "qc-api"},
-        {"recipe", "pmsm-10pole.json"},
-        {"db", "s.sqlite"},
-        {"http",
-         {{"listen", "127.0.0.1"},
-          {"port", 0},
-          {"tokens", {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
-                      {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
-        {"fixture", {{"driver", "sim"}}},
-        {"daq", {{"driver", "sim"}}},
-        {"sim", {{"clamp_close_s", 0.02}, {"clamp_open_s", 0.02},
-                 {"population", {{"defect_share", 0.0}, {"seed", 5}}}}}}.dump();
+    std::ofstream(dir_ / "station.json")
+        << nlohmann::json{{"station_id", "qc-api"},
+                          {"recipe", "pmsm-10pole.json"},
+                          {"db", "s.sqlite"},
+                          {"http",
+                           {{"listen", "127.0.0.1"},
+                            {"port", 0},
+                            {"tokens",
+                             {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
+                              {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
+                          {"fixture", {{"driver", "sim"}}},
+                          {"daq", {{"driver", "sim"}}},
+                          {"sim",
+                           {{"clamp_close_s", 0.02},
+                            {"clamp_open_s", 0.02},
+                            {"population", {{"defect_share", 0.0}, {"seed", 5}}}}}}
+               .dump();
     station_ = std::make_unique<ChildProcess>(
         std::vector<std::string>{EOL_BINARY, "station", "--config", dir_ / "station.json"});
-    ASSERT_TRUE(station_->WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; },
-                                  30s))
+    ASSERT_TRUE(
+        station_->WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; }, 30s))
         << station_->output();
     http_ = std::make_unique<httplib::Client>("127.0.0.1", PortFromReadyLine(station_->output()));
     http_->set_read_timeout(120, 0);

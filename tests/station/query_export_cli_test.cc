@@ -1,12 +1,12 @@
 // `eol query` and `eol export` on a real store, through the binary.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "db/store.h"
 #include "../support/child_process.h"
+#include "db/store.h"
 #include "tests/support/eol_cli.h"
 
 namespace eol {
@@ -35,15 +35,14 @@ db::TestRecord Record(const std::string& serial, const std::string& t, analysis:
   m.limit.lo = 370;
   m.outcome = f0 >= 370 ? analysis::MeasurementOutcome::kPass : analysis::MeasurementOutcome::kFail;
   r.measurements.push_back(m);
-  if (o == analysis::Outcome::kFail) r.reasons.push_back("resonance_f_hz = 352 Hz, below 370, \"low\"");
+  if (o == analysis::Outcome::kFail)
+    r.reasons.push_back("resonance_f_hz = 352 Hz, below 370, \"low\"");
   return r;
 }
 
 using eol::testing::CliRun;
 
-CliRun Eol(const std::vector<std::string>& args) {
-  return testing::RunEol(args, false, 60s);
-}
+CliRun Eol(const std::vector<std::string>& args) { return testing::RunEol(args, false, 60s); }
 
 class QueryExportTest : public ::testing::Test {
  protected:
@@ -98,7 +97,7 @@ TEST_F(QueryExportTest, ExportCsvHasOneRowPerTestAndQuotesReasons) {
 
 TEST_F(QueryExportTest, ExportJsonBySerialAndTimeRange) {
   const CliRun r = Eol({"export", "--db", db_, "--format", "json", "--from",
-                     "2026-11-21T00:00:00.000Z", "--to", "2026-11-22T00:00:00.000Z"});
+                        "2026-11-21T00:00:00.000Z", "--to", "2026-11-22T00:00:00.000Z"});
   ASSERT_EQ(r.code, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.size(), 2u);

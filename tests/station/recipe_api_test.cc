@@ -1,17 +1,17 @@
 // Recipe changes over the API: engineers only, validated, version must increase, the old
 // file kept, the audit log written, and the next test judged with the new recipe.
-#include <httplib.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <httplib.h>
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 
-#include "db/store.h"
-#include "drivers/json_config.h"
 #include "../support/child_process.h"
 #include "../support/station_ready.h"
+#include "db/store.h"
+#include "drivers/io/json_config.h"
 
 namespace eol {
 namespace {
@@ -27,7 +27,8 @@ using eol::testing::PortFromReadyLine;
 TEST(RecipeApi, EngineersChangeRecipesAuditedAndVersioned) {
   eol::testing::TempDir dir;
   const std::string recipe_path = dir / "pmsm-10pole.json";
-  std::filesystem::copy_file(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json", recipe_path);
+  std::filesystem::copy_file(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json",
+                             recipe_path);
   std::ofstream(dir / "station.json") << nlohmann::json{
       {"station_id", "recipe-api"},
       {"recipe", "pmsm-10pole.json"},
@@ -35,8 +36,9 @@ TEST(RecipeApi, EngineersChangeRecipesAuditedAndVersioned) {
       {"http",
        {{"listen", "127.0.0.1"},
         {"port", 0},
-        {"tokens", {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
-                    {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
+        {"tokens",
+         {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
+          {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
       {"fixture", {{"driver", "sim"}}},
       {"daq", {{"driver", "sim"}}}}.dump();
   ChildProcess station({EOL_BINARY, "station", "--config", dir / "station.json"});
@@ -47,7 +49,7 @@ TEST(RecipeApi, EngineersChangeRecipesAuditedAndVersioned) {
     return httplib::Headers{{"Authorization", std::string("Bearer ") + token}};
   };
 
-  nlohmann::json recipe = drivers::ReadJsonFile(recipe_path);
+  nlohmann::json recipe = io::ReadJsonFile(recipe_path);
   const std::string old_hash = nlohmann::json::parse(http.Get("/api/recipe")->body)["hash"];
   recipe["version"] = 2;
   recipe["limits"][0]["lo"] = 372;
@@ -80,7 +82,7 @@ TEST(RecipeApi, EngineersChangeRecipesAuditedAndVersioned) {
   EXPECT_EQ(changed["version"], 2);
   EXPECT_EQ(changed["previous"]["hash"], old_hash);
   EXPECT_TRUE(std::filesystem::exists(dir / "pmsm-10pole.v1.json")) << "old version not kept";
-  EXPECT_EQ(drivers::ReadJsonFile(recipe_path)["version"], 2);
+  EXPECT_EQ(io::ReadJsonFile(recipe_path)["version"], 2);
   EXPECT_EQ(nlohmann::json::parse(http.Get("/api/recipe")->body)["version"], 2);
 
   const auto audit = nlohmann::json::parse(http.Get("/api/recipe/audit")->body)["audit"];

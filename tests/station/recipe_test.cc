@@ -6,20 +6,20 @@
 
 #include <fstream>
 
-#include "drivers/json_config.h"
 #include "../support/child_process.h"
+#include "drivers/io/json_config.h"
 
 namespace eol::station {
 namespace {
 
 const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json";
 
-nlohmann::json Good() { return drivers::ReadJsonFile(kRecipe); }
+nlohmann::json Good() { return io::ReadJsonFile(kRecipe); }
 
 std::string ErrorOf(const nlohmann::json& j) {
   try {
     ParseRecipe(j, "test.json");
-  } catch (const drivers::ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     return e.what();
   }
   return "";
@@ -45,7 +45,8 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
       {[](auto& j) { j["excitation"].erase("peak_v"); }, "/excitation/peak_v: missing (required)"},
       {[](auto& j) { j["excitation"]["peak_v"] = "two"; },
        "/excitation/peak_v: must be a number (got \"two\")"},
-      {[](auto& j) { j["excitation"]["periods"] = 1; }, "/excitation/periods: must be in [2, 1000]"},
+      {[](auto& j) { j["excitation"]["periods"] = 1; },
+       "/excitation/periods: must be in [2, 1000]"},
       {[](auto& j) { j["fixture"]["clamp_pressure_bar"]["hi"] = 1.0; },
        "/fixture/clamp_pressure_bar/hi: must be greater than /fixture/clamp_pressure_bar/lo"},
       {[](auto& j) { j["limits"][0]["name"] = "resonance_hz"; },
@@ -58,7 +59,9 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
       {[](auto& j) { j["analysis"]["f0_max_hz"] = 900; },
        "/analysis/f0_max_hz: must lie inside the excited band"},
       {[](auto& j) { j["version"] = 0; }, "/version: must be a whole number >= 1"},
-      {[](auto& j) { j["excitation"]["phase_pairs"] = {0, 1}; },
+      {[](auto& j) {
+         j["excitation"]["phase_pairs"] = {0, 1};
+       },
        "/excitation/phase_pairs: give phase_pair or phase_pairs, not both"},
       {[](auto& j) {
          j["excitation"].erase("phase_pair");
@@ -80,7 +83,8 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
     nlohmann::json j = Good();
     c.edit(j);
     const std::string err = ErrorOf(j);
-    EXPECT_NE(err.find(c.expected), std::string::npos) << "got: " << err << "\nwant: " << c.expected;
+    EXPECT_NE(err.find(c.expected), std::string::npos)
+        << "got: " << err << "\nwant: " << c.expected;
   }
 }
 
@@ -103,7 +107,7 @@ TEST(Recipe, SyntaxErrorNamesTheFile) {
   try {
     LoadRecipe(path);
     FAIL() << "a broken file was accepted";
-  } catch (const drivers::ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find(path + ": not valid JSON"), std::string::npos) << e.what();
   }
 }

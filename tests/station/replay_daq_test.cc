@@ -10,8 +10,8 @@
 
 #include "../support/child_process.h"
 #include "analysis/impedance_analysis.h"
-#include "drivers/factory.h"
-#include "station/files/recording_files.h"
+#include "drivers/factory/factory.h"
+#include "drivers/io/recording_files.h"
 #include "station/recipe.h"
 
 namespace eol {
@@ -40,8 +40,7 @@ struct Fixture {
     ASSERT_EQ(p.Wait(120s).value_or(-1), 0) << p.output();
   }
   std::unique_ptr<drivers::Daq> Replay(const nlohmann::json& daq) {
-    auto set = drivers::MakeDrivers({{"fixture", {{"driver", "sim"}}}, {"daq", daq}}, nullptr,
-                                    station::files::ReadRecordingFile);
+    auto set = drivers::MakeDrivers({{"fixture", {{"driver", "sim"}}}, {"daq", daq}});
     return std::move(set.daq);
   }
   double F0(const analysis::Recording& rec) {
@@ -57,7 +56,7 @@ TEST(ReplayDaq, SimulatedRecordingRoundTripsToTheSameF0) {
   Fixture fx;
   fx.Simulate(fx.dir / "a.csv", "1");
   fx.Simulate(fx.dir / "b.csv", "2");
-  const auto direct = station::files::ReadRecordingCsv(fx.dir / "a.csv");
+  const auto direct = io::ReadRecordingCsv(fx.dir / "a.csv");
   analysis::Recording direct_periodic = direct;
   direct_periodic.period_samples = fx.ex.period_samples;
   const double f0_direct = fx.F0(direct_periodic);
@@ -82,7 +81,7 @@ TEST(ReplayDaq, SimulatedRecordingRoundTripsToTheSameF0) {
 
   // WAV (32-bit float, gains 10 V and 2 A per full scale) through a directory listing.
   std::filesystem::create_directory(fx.dir / "wav");
-  station::files::WriteWavRecording(fx.dir / "wav/run1.wav", direct, 10.0, 2.0);
+  io::WriteWavRecording(fx.dir / "wav/run1.wav", direct, 10.0, 2.0);
   auto wav = fx.Replay({{"driver", "replay"},
                         {"directory", fx.dir / "wav"},
                         {"gains", {{"voltage_v_per_fs", 10.0}, {"current_a_per_fs", 2.0}}}});
@@ -126,7 +125,7 @@ TEST(ReplayDaq, RepeatsOneFileAndRefusesMisfits) {
   try {
     fx.Replay({{"driver", "replay"}, {"file", fx.dir / "a.csv"}, {"directory", fx.dir.path()}});
     FAIL() << "two sources accepted";
-  } catch (const drivers::ConfigError& e) {
+  } catch (const io::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/daq: give exactly one of"), std::string::npos)
         << e.what();
   }

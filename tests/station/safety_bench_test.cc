@@ -1,7 +1,7 @@
-// `eol safety-bench`'s measurement (station/safety_bench.h) over both fixtures: every injected
-// fault must end its test ERROR and yield a measured reaction (relay open after the fault was
-// visible). The figures themselves are benchmark output (README), not asserted here.
-#include "station/safety_bench.h"
+// `eol safety-bench`'s measurement (station/bench/safety_bench.h) over both fixtures: every
+// injected fault must end its test ERROR and yield a measured reaction (relay open after the fault
+// was visible). The figures themselves are benchmark output (README), not asserted here.
+#include "station/bench/safety_bench.h"
 
 #include <gtest/gtest.h>
 

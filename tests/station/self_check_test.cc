@@ -2,14 +2,15 @@
 // (config, sim bench with its masters, real SQLite file, real HTTP on 127.0.0.1): production
 // is refused with ERROR and the reason until both masters check out; a limit master that
 // PASSes locks the station; the lockout survives a restart; a passing check unlocks.
+#include "station/self_check.h"
+
 #include <gtest/gtest.h>
 
 #include <thread>
 
-#include "station/self_check.h"
-#include "station/stats_report.h"
-#include "station/station.h"
 #include "../support/child_process.h"
+#include "station/station.h"
+#include "station/stats_report.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -59,8 +60,9 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
   {
     Station s(Config(true));
     ASSERT_TRUE(Lockout(s).at("locked").get<bool>());
-    EXPECT_NE(Lockout(s)["reason"].get<std::string>().find("no self-check of the good master MASTER-G"),
-              std::string::npos);
+    EXPECT_NE(
+        Lockout(s)["reason"].get<std::string>().find("no self-check of the good master MASTER-G"),
+        std::string::npos);
     // Never checked: production refused before anything moves, and nothing stored.
     const db::TestRecord refused = s.RunTest("U-1");
     EXPECT_EQ(refused.outcome, Outcome::kError);
@@ -78,8 +80,9 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
     const db::TestRecord limit = s.RunTest("MASTER-L");
     EXPECT_EQ(limit.outcome, Outcome::kFail) << Reasons(limit);
     EXPECT_TRUE(limit.self_check.at("passed").get<bool>()) << Reasons(limit);
-    EXPECT_NE(Reasons(limit).find("self-check passed: limit master MASTER-L rejected on the resonance"),
-              std::string::npos)
+    EXPECT_NE(
+        Reasons(limit).find("self-check passed: limit master MASTER-L rejected on the resonance"),
+        std::string::npos)
         << Reasons(limit);
     EXPECT_FALSE(Lockout(s).at("locked").get<bool>()) << Lockout(s).dump();
 
@@ -104,8 +107,8 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
     const db::TestRecord refused = s.RunTest("U-2");
     EXPECT_EQ(refused.outcome, Outcome::kError);
     ASSERT_FALSE(refused.reasons.empty());
-    EXPECT_EQ(refused.reasons.front().rfind("station locked out: self-check failed at " + failed_at +
-                                                ": limit master MASTER-L PASSed",
+    EXPECT_EQ(refused.reasons.front().rfind("station locked out: self-check failed at " +
+                                                failed_at + ": limit master MASTER-L PASSed",
                                             0),
               0u)
         << Reasons(refused);
@@ -173,18 +176,21 @@ TEST_F(SelfCheckTest, ACheckIsDueAfterEveryNTestsAndAfterEveryHours) {
     ASSERT_FALSE(due.reasons.empty());
     EXPECT_NE(due.reasons.front().find("self-check due: the last check"), std::string::npos)
         << Reasons(due);
-    EXPECT_NE(due.reasons.front().find("is older than 0.0001 h"), std::string::npos) << Reasons(due);
+    EXPECT_NE(due.reasons.front().find("is older than 0.0001 h"), std::string::npos)
+        << Reasons(due);
   }
 }
 
 TEST(SelfCheckConfig, InvalidSectionsNameThePath) {
   auto message = [](const nlohmann::json& self_check) {
-    const nlohmann::json j = {{"recipe", "r.json"}, {"db", "d.sqlite"},
-                              {"fixture", {{"driver", "sim"}}}, {"daq", {{"driver", "sim"}}},
+    const nlohmann::json j = {{"recipe", "r.json"},
+                              {"db", "d.sqlite"},
+                              {"fixture", {{"driver", "sim"}}},
+                              {"daq", {{"driver", "sim"}}},
                               {"self_check", self_check}};
     try {
       ParseStationConfig(j, "c.json", "");
-    } catch (const drivers::ConfigError& e) {
+    } catch (const io::ConfigError& e) {
       return std::string(e.what());
     }
     return std::string("(accepted)");
@@ -196,9 +202,9 @@ TEST(SelfCheckConfig, InvalidSectionsNameThePath) {
   EXPECT_NE(message({{"good_master", "G"}, {"limit_master", "L"}, {"every_n_tests", -1}})
                 .find("/self_check/every_n_tests: must be in [0, 100000]"),
             std::string::npos);
-  EXPECT_NE(message({{"good_master", "G"}, {"limit_master", "L"}, {"every_day", 1}})
-                .find("every_day"),
-            std::string::npos);
+  EXPECT_NE(
+      message({{"good_master", "G"}, {"limit_master", "L"}, {"every_day", 1}}).find("every_day"),
+      std::string::npos);
   EXPECT_EQ(message({{"good_master", "G"}, {"limit_master", "L"}}), "(accepted)");
 }
 

@@ -8,10 +8,10 @@
 #include <algorithm>
 #include <chrono>
 
-#include "analysis/qc/measurement_names.h"
-#include "drivers/daq/sim_daq.h"
-#include "drivers/fixture/sim_fixture.h"
 #include "../support/child_process.h"
+#include "analysis/qc/measurement_names.h"
+#include "drivers/sim/sim_daq.h"
+#include "drivers/sim/sim_fixture.h"
 
 namespace eol::station {
 namespace {
@@ -86,8 +86,8 @@ TEST_F(SequencerTest, GoodRotorPassesAndIsStoredWithEverything) {
   EXPECT_EQ(stored->curves.front().name, "impedance");
   EXPECT_EQ(stored->curves.front().freq_hz.size(), 601u);
   // The fitted resonance is close to the simulator's truth.
-  const double truth = analysis::DrawUnit(bench_->settings().population, "GOOD-1", false)
-                           .rotor.NaturalFrequencyHz();
+  const double truth =
+      analysis::DrawUnit(bench_->settings().population, "GOOD-1", false).rotor.NaturalFrequencyHz();
   double f0 = 0;
   for (const auto& m : stored->measurements)
     if (m.name == analysis::names::kResonanceFHz) f0 = m.value;
@@ -95,9 +95,9 @@ TEST_F(SequencerTest, GoodRotorPassesAndIsStoredWithEverything) {
   // The trace walks the documented states in order.
   std::vector<std::string> states;
   for (const auto& t : stored->trace) states.push_back(t.state);
-  const std::vector<std::string> expected = {"wait_serial", "check_interlocks", "clamp",
-                                             "confirm_clamp", "excite", "analyse", "judge",
-                                             "unclamp", "store"};
+  const std::vector<std::string> expected = {"wait_serial",   "check_interlocks", "clamp",
+                                             "confirm_clamp", "excite",           "analyse",
+                                             "judge",         "unclamp",          "store"};
   EXPECT_EQ(states, expected);
   EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
   EXPECT_FALSE(bench_->output(FixtureOutput::kClampCmd));
@@ -122,8 +122,7 @@ TEST_F(SequencerTest, RetestLimitRefusesASerialBeforeClamping) {
 
 TEST_F(SequencerTest, EveryPhasePairOfTheRecipeIsMeasuredInOneClamping) {
   Build(0.0);
-  recipe_.phase_pairs = {drivers::PhasePair::kUV, drivers::PhasePair::kVW,
-                         drivers::PhasePair::kWU};
+  recipe_.phase_pairs = {drivers::PhasePair::kUV, drivers::PhasePair::kVW, drivers::PhasePair::kWU};
   SequencerOptions o;
   o.station_id = "test";
   sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
@@ -165,7 +164,8 @@ TEST_F(SequencerTest, ClampLostDuringExcitationIsErrorWithExcitationCutFast) {
   bench_->InjectFault(SimFault::kClampDrops, 200ms);
   const db::TestRecord r = Test("DROP-1", false);
   EXPECT_EQ(r.outcome, Outcome::kError);
-  EXPECT_TRUE(HasReason(r, "interlock lost during excitation: clamp not confirmed")) << r.reasons.front();
+  EXPECT_TRUE(HasReason(r, "interlock lost during excitation: clamp not confirmed"))
+      << r.reasons.front();
   ExpectStored(r);
   EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
   // The watchdog, not the end of the stream, opened the relay (the 50 ms target is measured by

@@ -8,11 +8,11 @@
 #include <fstream>
 
 #include "../support/child_process.h"
-#include "tests/support/eol_cli.h"
 #include "analysis/fit/modes_fit.h"
 #include "analysis/fit/resonance_fit.h"
-#include "station/files/frf_files.h"
-#include "station/files/recording_files.h"
+#include "drivers/io/frf_files.h"
+#include "drivers/io/recording_files.h"
+#include "tests/support/eol_cli.h"
 
 namespace eol {
 namespace {
@@ -42,7 +42,7 @@ void ExpectResonance(const std::string& motor, const std::string& defect, double
   const CliRun r =
       Simulate({"--motor", kMotors + motor, "--out", dir / "z.csv", "--defect", defect});
   ASSERT_EQ(r.code, 0) << r.out;
-  const analysis::Frf z = station::files::ReadFrfCsv(dir / "z.csv");
+  const analysis::Frf z = io::ReadFrfCsv(dir / "z.csv");
   ASSERT_TRUE(z.has_sigma());
   EXPECT_EQ(z.size(), 601u);  // the recipe's 200-800 Hz at 1 Hz
   const analysis::FitSummary fit = Fit(z, lo, hi);
@@ -77,8 +77,7 @@ TEST(SimulateCli, PoorCementationInTheFixtureRingsNear366HzWithAMagnetMode) {
   analysis::ModesFitOptions o;
   o.single.f0_min_hz = 250;
   o.single.f0_max_hz = 790;
-  const analysis::ModesFitSummary s =
-      analysis::FitMotionalModes(station::files::ReadFrfCsv(dir / "z.csv"), o);
+  const analysis::ModesFitSummary s = analysis::FitMotionalModes(io::ReadFrfCsv(dir / "z.csv"), o);
   ASSERT_TRUE(s.usable) << s.message;
   ASSERT_EQ(s.mode_count, 2) << s.message;
   EXPECT_NEAR(s.fit.Find("f1_hz")->value, 366.0, 0.5) << s.message;
@@ -95,8 +94,7 @@ TEST(SimulateCli, OneSoftMagnetOnARigidFixtureShowsTwoModes) {
   analysis::ModesFitOptions o;
   o.single.f0_min_hz = 250;
   o.single.f0_max_hz = 790;
-  const analysis::ModesFitSummary s =
-      analysis::FitMotionalModes(station::files::ReadFrfCsv(dir / "z.csv"), o);
+  const analysis::ModesFitSummary s = analysis::FitMotionalModes(io::ReadFrfCsv(dir / "z.csv"), o);
   ASSERT_TRUE(s.usable) << s.message;
   EXPECT_EQ(s.mode_count, 2) << s.message;
   EXPECT_NEAR(s.fit.Find("f1_hz")->value, 567.3, 2.0) << s.message;
@@ -112,7 +110,7 @@ TEST(SimulateCli, RecordingFormatHoldsEveryPeriod) {
   std::string header;
   std::getline(in, header);
   EXPECT_EQ(header.rfind("t_s,u_v,i_a", 0), 0u) << header;
-  const analysis::Recording rec = station::files::ReadRecordingCsv(dir / "rec.csv");
+  const analysis::Recording rec = io::ReadRecordingCsv(dir / "rec.csv");
   EXPECT_EQ(rec.voltage_v.size(), 5u * 8000u);  // 1 transient + 4 averaged periods
   EXPECT_NEAR(rec.sample_rate_hz, 8000.0, 1e-6);
 }
@@ -123,7 +121,7 @@ TEST(SimulateCli, NoCouplingAtAZeroOfTheTransmission) {
   const CliRun r = Simulate({"--motor", kMotors + "pmsm-10pole.json", "--out", dir / "z.csv",
                              "--rotor-position-deg", "36"});
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_FALSE(Fit(station::files::ReadFrfCsv(dir / "z.csv"), 250, 700).usable);
+  EXPECT_FALSE(Fit(io::ReadFrfCsv(dir / "z.csv"), 250, 700).usable);
 }
 
 TEST(SimulateCli, NoiseFreeFrfIsTheExactModel) {
@@ -131,7 +129,7 @@ TEST(SimulateCli, NoiseFreeFrfIsTheExactModel) {
   const CliRun r = Simulate({"--motor", kMotors + "pmsm-10pole.json", "--out", dir / "z.csv",
                              "--noise-v", "0", "--noise-a", "0"});
   ASSERT_EQ(r.code, 0) << r.out;
-  const analysis::Frf z = station::files::ReadFrfCsv(dir / "z.csv");
+  const analysis::Frf z = io::ReadFrfCsv(dir / "z.csv");
   EXPECT_FALSE(z.has_sigma());
   const analysis::FitSummary fit = Fit(z, 250, 700);
   ASSERT_TRUE(fit.usable) << fit.message;

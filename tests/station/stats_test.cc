@@ -2,16 +2,16 @@
 // GET /api/stats on a real store, and the drift alarm on the simulated station with and
 // without fixture wear (fixed seeds).
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
+#include "../support/child_process.h"
 #include "db/store.h"
 #include "station/http_api.h"
 #include "station/station.h"
 #include "station/stats_report.h"
-#include "../support/child_process.h"
 #include "tests/support/eol_cli.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
@@ -143,9 +143,9 @@ TEST_F(StatsKnownAnswer, CliCapabilityGaugeAndDriftExitCode) {
   const nlohmann::json both = nlohmann::json::parse(all.out);
   ExpectKnownAnswers(both);
   ASSERT_EQ(both.at("alarms").size(), 1u);
-  EXPECT_NE(both["alarms"][0].get<std::string>().find(
-                "drifting v1: drift alarm: resonance_f_hz rises"),
-            std::string::npos)
+  EXPECT_NE(
+      both["alarms"][0].get<std::string>().find("drifting v1: drift alarm: resonance_f_hz rises"),
+      std::string::npos)
       << both["alarms"][0];
 
   const CliRun text = Eol({"stats", "--db", db_, "--gauge", "MASTER-G"});
@@ -154,7 +154,8 @@ TEST_F(StatsKnownAnswer, CliCapabilityGaugeAndDriftExitCode) {
             std::string::npos)
       << text.out;
   EXPECT_NE(text.out.find("ALARM drifting v1: drift alarm"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("type-1 gauge study of MASTER-G: 10 tests (K = 20 % of the tolerance, 6 sigma)"),
+  EXPECT_NE(text.out.find(
+                "type-1 gauge study of MASTER-G: 10 tests (K = 20 % of the tolerance, 6 sigma)"),
             std::string::npos)
       << text.out;
   EXPECT_NE(text.out.find("no reference value"), std::string::npos) << text.out;
@@ -191,7 +192,8 @@ TEST_F(StatsKnownAnswer, ApiServesTheSameReport) {
   const nlohmann::json window = nlohmann::json::parse(res->body);
   ASSERT_EQ(window.at("recipes").size(), 1u) << res->body;
   EXPECT_EQ(Measurement(window["recipes"][0], "resonance_f_hz").at("n"), 3);
-  EXPECT_NEAR(Measurement(window["recipes"][0], "resonance_f_hz").at("mean").get<double>(), 389.0, 1e-9);
+  EXPECT_NEAR(Measurement(window["recipes"][0], "resonance_f_hz").at("mean").get<double>(), 389.0,
+              1e-9);
 
   for (const auto& [query, message] : std::vector<std::pair<std::string, std::string>>{
            {"/api/stats?sigma_span=5", "sigma_span must be 4 or 6"},
@@ -224,7 +226,8 @@ nlohmann::json DriftRun(const eol::testing::TempDir& dir, const std::string& nam
     char serial[16];
     std::snprintf(serial, sizeof serial, "W-%03d", i);
     const db::TestRecord r = s.RunTest(serial);
-    EXPECT_NE(r.outcome, Outcome::kError) << serial << ": " << (r.reasons.empty() ? "" : r.reasons[0]);
+    EXPECT_NE(r.outcome, Outcome::kError)
+        << serial << ": " << (r.reasons.empty() ? "" : r.reasons[0]);
   }
   return station::StatsReport(s.store(), {});
 }

@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/child_process.h"
-#include "tests/support/eol_cli.h"
 #include "db/test_record.h"
 #include "station/recipe.h"
+#include "tests/support/eol_cli.h"
 
 namespace eol {
 namespace {

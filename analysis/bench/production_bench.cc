@@ -1,0 +1,196 @@
+#include "analysis/bench/production_bench.h"
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "analysis/impedance_analysis.h"
+#include "analysis/qc/line_measurement.h"
+
+namespace eol::analysis {
+namespace {
+
+constexpr std::uint64_t kGoldenIndexBase = 1000000000ULL;
+
+std::size_t ClassIndex(DefectClass c) {
+  for (std::size_t i = 0; i < kAllDefectClasses.size(); ++i)
+    if (kAllDefectClasses[i] == c) return i;
+  return 0;
+}
+
+std::uint64_t NoiseSeed(std::uint64_t seed, std::uint64_t index) {
+  std::uint64_t z = (seed + 0x9E3779B97F4A7C15ULL) ^ (index * 0xD6E8FEB86659FD93ULL);
+  z = (z ^ (z >> 32)) * 0xD6E8FEB86659FD93ULL;
+  return z ^ (z >> 32);
+}
+
+struct Measured {
+  Frf frf;
+  ImpedanceAnalysis analysis;
+};
+
+Measured MeasureUnit(const ProductionBenchOptions& o, const LineMeasurementSetup& setup,
+                     const LineUnit& unit, std::uint64_t index) {
+  Measured m;
+  m.frf =
+      MeasureLineUnit(setup, ModalImpedance(unit.motor, setup.freq_hz), NoiseSeed(o.seed, index));
+  m.analysis = AnalyzeImpedance(m.frf, o.fit);
+  return m;
+}
+
+Outcome JudgeWith(const std::vector<MeasurementSpec>& limits, const std::vector<CurveMask>& masks,
+                  const Measured& m) {
+  std::vector<MeasurementSpec> specs = limits;
+  std::map<std::string, Estimate> values = m.analysis.values;
+  for (const CurveMask& mask : masks) {
+    specs.push_back(mask.Spec());
+    if (m.analysis.usable)
+      values[mask.MeasurementName()] =
+          Estimate{static_cast<double>(CheckMask(m.frf, mask).lines_outside), 0.0};
+  }
+  return Judge(specs, values).outcome;
+}
+
+void Count(ClassCounts& c, Outcome o) {
+  ++c.units;
+  if (o == Outcome::kPass)
+    ++c.pass;
+  else if (o == Outcome::kFail)
+    ++c.fail;
+  else
+    ++c.error;
+}
+
+}  // namespace
+
+const char* ToString(BenchRule r) {
+  switch (r) {
+    case BenchRule::kTaught:
+      return "taught";
+    case BenchRule::kRecipe:
+      return "recipe";
+    case BenchRule::kNaive:
+      return "naive";
+  }
+  return "taught";
+}
+
+bool ProductionBenchOptions::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (units < 1 || units > 10000000) return fail("units must be in [1, 10000000]");
+  if (golden_units < 3 || golden_units > 100000) return fail("golden_units must be in [3, 100000]");
+  if (threads < 1 || threads > 64) return fail("threads must be in [1, 64]");
+  if (periods < 1) return fail("periods must be at least 1");
+  if (!(voltage_noise_v > 0.0 && current_noise_a > 0.0))
+    return fail("the channel noise must be positive (the sigma of every line comes from it)");
+  std::string w;
+  if (!excitation.IsValid(&w)) return fail("excitation: " + w);
+  if (!fit.IsValid(&w)) return fail("fit: " + w);
+  if (!teach.IsValid(&w)) return fail("teach: " + w);
+  if (!rotor.IsValid(&w)) return fail("rotor: " + w);
+  if (!rotor.fixture) return fail("rotor: the line clamps in a fixture (fixture must be set)");
+  if (!spread.IsValid(&w)) return fail("spread: " + w);
+  if (!rates.IsValid(&w)) return fail("rates: " + w);
+  if (!naive.IsValid(&w)) return fail(w);
+  if (declared.empty()) return fail("the recipe declares no scalar limit");
+  return true;
+}
+
+const ClassCounts& ProductionBenchSummary::Counts(BenchRule rule, DefectClass c) const {
+  return counts[static_cast<std::size_t>(rule)][ClassIndex(c)];
+}
+
+double ProductionBenchSummary::EscapeRate(BenchRule rule, DefectClass c) const {
+  const ClassCounts& k = Counts(rule, c);
+  return k.units ? static_cast<double>(k.pass) / k.units : 0.0;
+}
+
+double ProductionBenchSummary::FalseRejectRate(BenchRule rule) const {
+  const ClassCounts& k = Counts(rule, DefectClass::kGood);
+  return k.units ? static_cast<double>(k.fail + k.error) / k.units : 0.0;
+}
+
+ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ProductionBenchSummary s;
+  std::string why;
+  if (!o.IsValid(&why)) {
+    s.message = "production bench options: " + why;
+    return s;
+  }
+  const LineMeasurementSetup setup =
+      MakeLineMeasurement(o.excitation, o.periods, o.voltage_noise_v, o.current_noise_a);
+  const int threads = o.threads;
+
+  // 1. Golden units and teaching.
+  std::vector<GoldenUnit> golden(static_cast<std::size_t>(o.golden_units));
+  std::vector<int> golden_ok(golden.size(), 0);
+  {
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+      for (std::size_t i = next++; i < golden.size(); i = next++) {
+        const std::uint64_t index = kGoldenIndexBase + i;
+        const LineUnit unit = DrawLineUnit(o.rotor, o.spread, DefectClass::kGood, o.seed, index);
+        Measured m = MeasureUnit(o, setup, unit, index);
+        golden[i].label = "golden-" + std::to_string(i);
+        if (!m.analysis.usable) continue;
+        for (const auto& [name, e] : m.analysis.values) golden[i].values[name] = e.value;
+        golden[i].curve = std::move(m.frf);
+        golden_ok[i] = 1;
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(work);
+    for (auto& t : pool) t.join();
+  }
+  std::vector<GoldenUnit> usable_golden;
+  for (std::size_t i = 0; i < golden.size(); ++i)
+    if (golden_ok[i]) usable_golden.push_back(std::move(golden[i]));
+  s.teach = TeachLimits(o.declared, usable_golden, o.teach);
+  s.golden_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!s.teach.usable) {
+    s.message = "teaching failed: " + s.teach.message;
+    return s;
+  }
+
+  // 2. Production units, judged three ways.
+  std::mutex merge;
+  std::atomic<int> next{0};
+  auto work = [&] {
+    ProductionBenchSummary local;
+    for (int i = next++; i < o.units; i = next++) {
+      const auto index = static_cast<std::uint64_t>(i);
+      const LineUnit unit = DrawLineUnit(o.rotor, o.spread, o.rates, o.seed, index);
+      const Measured m = MeasureUnit(o, setup, unit, index);
+      const std::size_t c = ClassIndex(unit.defect);
+      Count(local.counts[0][c], JudgeWith(s.teach.limits, s.teach.masks, m));
+      Count(local.counts[1][c], JudgeWith(o.declared, o.recipe_masks, m));
+      Count(local.counts[2][c], NaivePass(m.frf, o.naive) ? Outcome::kPass : Outcome::kFail);
+    }
+    const std::lock_guard<std::mutex> lock(merge);
+    for (std::size_t r = 0; r < kBenchRules.size(); ++r)
+      for (std::size_t c = 0; c < kAllDefectClasses.size(); ++c) {
+        s.counts[r][c].units += local.counts[r][c].units;
+        s.counts[r][c].pass += local.counts[r][c].pass;
+        s.counts[r][c].fail += local.counts[r][c].fail;
+        s.counts[r][c].error += local.counts[r][c].error;
+      }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) pool.emplace_back(work);
+  for (auto& t : pool) t.join();
+
+  s.units = o.units;
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.usable = true;
+  s.message = std::to_string(o.units) + " units judged after teaching from " +
+              std::to_string(s.teach.units_used) + " golden units";
+  return s;
+}
+
+}  // namespace eol::analysis

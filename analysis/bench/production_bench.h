@@ -1,0 +1,82 @@
+// Production benchmark of learned limits (`eol production-bench`).
+//
+// 1. Draw golden_units good units of the line (line_population.h), measure each with the
+//    recipe's excitation (line_measurement.h: the periodic estimate's statistics drawn in the
+//    frequency domain), analyse it as the station does (AnalyzeImpedance: weighted ML fit of
+//    the clamped motor) and teach limits and a Re Z mask from them (teach.h).
+// 2. Draw `units` units at the defect rates, measure and analyse each the same way, and judge
+//    it three ways:
+//      taught  the recipe's declared measurements with the taught limits and mask (Judge);
+//      recipe  the recipe's own limits and masks as given (hand-set);
+//      naive   |Z| peak in a fixed window (naive_rule.h).
+//    A unit counts as rejected when the verdict is FAIL or ERROR (ERROR is a retest, not a
+//    ship). An escape is a defective unit that PASSes; a false reject a good unit that does not.
+// Each unit is drawn from (seed, index) alone, so the figures do not depend on the number of
+// threads. Golden units use indices from 1e9 up, disjoint from the production units.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "analysis/bench/naive_rule.h"
+#include "analysis/fit/resonance_fit.h"
+#include "analysis/qc/line_population.h"
+#include "analysis/qc/teach.h"
+#include "analysis/signal/multisine.h"
+
+namespace eol::analysis {
+
+struct ProductionBenchOptions {
+  int units = 10000;
+  int golden_units = 50;
+  std::uint64_t seed = 1;
+  int threads = 2;
+  MultisineOptions excitation;  // the recipe's
+  std::size_t periods = 4;
+  double voltage_noise_v = 2.0e-3;  // the simulated DAQ's, rms per sample
+  double current_noise_a = 1.0e-3;
+  ResonanceFitOptions fit;                // the recipe's analysis options
+  std::vector<MeasurementSpec> declared;  // the recipe's scalar limits
+  std::vector<CurveMask> recipe_masks;    // the recipe's masks (the "recipe" rule)
+  TeachOptions teach;
+  RotorChainParams rotor;  // nominal geometry, default fixture
+  LineSpread spread;
+  DefectRates rates;
+  NaivePeakRule naive;
+
+  bool IsValid(std::string* why) const;
+};
+
+struct ClassCounts {
+  int units = 0;
+  int pass = 0;
+  int fail = 0;
+  int error = 0;
+};
+
+enum class BenchRule { kTaught, kRecipe, kNaive };
+inline constexpr std::array<BenchRule, 3> kBenchRules = {BenchRule::kTaught, BenchRule::kRecipe,
+                                                         BenchRule::kNaive};
+const char* ToString(BenchRule r);
+
+struct ProductionBenchSummary {
+  bool usable = false;
+  std::string message;
+  TeachSummary teach;
+  // counts[rule][class], class in kAllDefectClasses order.
+  std::array<std::array<ClassCounts, kAllDefectClasses.size()>, kBenchRules.size()> counts{};
+  int units = 0;
+  double seconds = 0.0;  // wall time of the whole benchmark
+  double golden_seconds = 0.0;
+
+  const ClassCounts& Counts(BenchRule rule, DefectClass c) const;
+  // Escapes of a defect class (PASS / units), false rejects of good units ((FAIL+ERROR)/units).
+  double EscapeRate(BenchRule rule, DefectClass c) const;
+  double FalseRejectRate(BenchRule rule) const;
+};
+
+ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& options);
+
+}  // namespace eol::analysis

@@ -1,0 +1,158 @@
+#include "drivers/factory/factory.h"
+
+#include "drivers/daq/calibration_file.h"
+#include "drivers/factory/daq_config.h"
+#include "drivers/fixture/modbus_fixture.h"
+#include "drivers/sim/sim_fixture.h"
+#if EOL_WITH_SOCKETCAN
+#include "drivers/fixture/can_fixture.h"
+#endif
+
+namespace eol::drivers {
+
+analysis::MotorPopulation ParsePopulation(const io::JsonObject& o) {
+  analysis::MotorPopulation p;
+  p.inertia_kg_m2 = o.Number("inertia_kg_m2", p.inertia_kg_m2);
+  p.f_rigid_hz = o.Number("f_rigid_hz", p.f_rigid_hz);
+  p.f_rigid_defect_hz = o.Number("f_rigid_defect_hz", p.f_rigid_defect_hz);
+  p.f_fixture_hz = o.Number("f_fixture_hz", p.f_fixture_hz);
+  p.q_good = o.Number("q_good", p.q_good);
+  p.q_defect = o.Number("q_defect", p.q_defect);
+  p.r_ohm = o.Number("r_ohm", p.r_ohm);
+  p.l_h = o.Number("l_h", p.l_h);
+  p.transmission_nm_per_a = o.Number("transmission_nm_per_a", p.transmission_nm_per_a);
+  p.spread_inertia = o.Number("spread_inertia", p.spread_inertia);
+  p.spread_k_rotor = o.Number("spread_k_rotor", p.spread_k_rotor);
+  p.spread_k_fixture = o.Number("spread_k_fixture", p.spread_k_fixture);
+  p.spread_q = o.Number("spread_q", p.spread_q);
+  p.spread_r = o.Number("spread_r", p.spread_r);
+  p.spread_l = o.Number("spread_l", p.spread_l);
+  p.spread_transmission = o.Number("spread_transmission", p.spread_transmission);
+  p.defect_share = o.Number("defect_share", p.defect_share);
+  p.seed = static_cast<std::uint64_t>(o.Integer("seed", static_cast<int>(p.seed)));
+  o.RejectUnknown();
+  std::string why;
+  if (!p.IsValid(&why)) throw io::ConfigError(o.path() + ": " + why);
+  return p;
+}
+
+SimBenchSettings ParseSimBenchSettings(const io::JsonObject& o) {
+  SimBenchSettings s;
+  if (auto pop = o.OptionalObject("population")) s.population = ParsePopulation(*pop);
+  s.clamp_close_s = o.Number("clamp_close_s", s.clamp_close_s);
+  s.clamp_open_s = o.Number("clamp_open_s", s.clamp_open_s);
+  s.clamp_pressure_bar = o.Number("clamp_pressure_bar", s.clamp_pressure_bar);
+  s.heartbeat_period_s = o.Number("heartbeat_period_s", s.heartbeat_period_s);
+  s.load_part_on_serial = o.Bool("load_part_on_serial", s.load_part_on_serial);
+  s.fixture_wear_per_test = o.Number("fixture_wear_per_test", s.fixture_wear_per_test);
+  o.Require(s.fixture_wear_per_test >= 0 && s.fixture_wear_per_test <= 0.01,
+            "fixture_wear_per_test", "must be in [0, 0.01] (share of the stiffness per part)");
+  if (o.Has("masters")) {
+    const nlohmann::json& list = o.Raw("masters");
+    if (!list.is_array()) throw io::ConfigError(o.PathOf("masters") + ": must be an array");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const io::JsonObject m(list[i], o.PathOf("masters") + "/" + std::to_string(i));
+      SimMaster master{m.RequiredString("serial"), m.Bool("defective", false)};
+      m.Require(!master.serial.empty(), "serial", "must not be empty");
+      m.RejectUnknown();
+      s.masters.push_back(master);
+    }
+  }
+  o.Require(s.clamp_close_s > 0 && s.clamp_close_s < 10, "clamp_close_s", "must be in (0, 10) s");
+  o.Require(s.clamp_open_s > 0 && s.clamp_open_s < 10, "clamp_open_s", "must be in (0, 10) s");
+  o.Require(s.heartbeat_period_s > 0 && s.heartbeat_period_s <= 0.5, "heartbeat_period_s",
+            "must be in (0, 0.5] s");
+  o.RejectUnknown();
+  return s;
+}
+
+SimDaqSettings ParseSimDaqSettings(const io::JsonObject& o) {
+  SimDaqSettings s;
+  const std::string model = o.String("model", ToString(s.model));
+  if (model == ToString(SimMotorModel::kSteadyState)) {
+    s.model = SimMotorModel::kSteadyState;
+  } else if (model == ToString(SimMotorModel::kTimeDomain)) {
+    s.model = SimMotorModel::kTimeDomain;
+  } else {
+    o.Require(false, "model", "must be \"steady_state\" or \"time_domain\"");
+  }
+  s.amplifier_output_ohm = o.Number("amplifier_output_ohm", s.amplifier_output_ohm);
+  o.Require(s.amplifier_output_ohm >= 0.0, "amplifier_output_ohm", "must not be negative");
+  s.time_scale = o.Number("time_scale", s.time_scale);
+  s.voltage_noise_v = o.Number("voltage_noise_v", s.voltage_noise_v);
+  s.current_noise_a = o.Number("current_noise_a", s.current_noise_a);
+  s.voltage_full_scale_v = o.Number("voltage_full_scale_v", s.voltage_full_scale_v);
+  s.current_full_scale_a = o.Number("current_full_scale_a", s.current_full_scale_a);
+  s.seed = static_cast<std::uint64_t>(o.Integer("seed", static_cast<int>(s.seed)));
+  const std::string relay = o.String("relay", "bench");
+  o.Require(relay == "bench" || relay == "external", "relay", "must be \"bench\" or \"external\"");
+  s.relay_external = relay == "external";
+  ParseSimCalibrationLoad(o, s);
+  o.Require(s.time_scale >= 0.0, "time_scale", "must not be negative");
+  o.Require(s.voltage_noise_v >= 0.0, "voltage_noise_v", "must not be negative");
+  o.Require(s.current_noise_a >= 0.0, "current_noise_a", "must not be negative");
+  o.Require(s.voltage_full_scale_v > 0.0, "voltage_full_scale_v", "must be positive");
+  o.Require(s.current_full_scale_a > 0.0, "current_full_scale_a", "must be positive");
+  o.RejectUnknown();
+  return s;
+}
+
+DriverSet MakeDrivers(const nlohmann::json& station_config, std::shared_ptr<SimBench> bench) {
+  const io::JsonObject root(station_config, "");
+  const io::JsonObject fixture = root.Object("fixture");
+  const io::JsonObject daq = root.Object("daq");
+  const std::string fixture_driver = fixture.RequiredString("driver");
+  const std::string daq_driver = daq.RequiredString("driver");
+
+  DriverSet set;
+  if (bench) {
+    (void)root.OptionalObject("sim");  // the caller built the bench from it
+    set.bench = std::move(bench);
+  } else if (fixture_driver == "sim" || daq_driver == "sim") {
+    const auto sim = root.OptionalObject("sim");
+    set.bench = std::make_shared<SimBench>(sim ? ParseSimBenchSettings(*sim) : SimBenchSettings{});
+  }
+
+  if (fixture_driver == "sim") {
+    fixture.RejectUnknown();
+    set.fixture = std::make_unique<SimFixture>(set.bench);
+  } else if (fixture_driver == "modbus-tcp") {
+    set.fixture = std::make_unique<ModbusFixture>(
+        ParseModbusFixtureSettings(fixture, ModbusLink::Transport::kTcp));
+  } else if (fixture_driver == "modbus-rtu") {
+    set.fixture = std::make_unique<ModbusFixture>(
+        ParseModbusFixtureSettings(fixture, ModbusLink::Transport::kRtu));
+  } else if (fixture_driver == "socketcan") {
+#if EOL_WITH_SOCKETCAN
+    set.fixture = std::make_unique<CanFixture>(ParseCanFixtureSettings(fixture));
+#else
+    throw io::ConfigError(fixture.PathOf("driver") +
+                          ": the socketcan fixture driver was not compiled in (build with "
+                          "-DEOL_WITH_SOCKETCAN=ON)");
+#endif
+  } else {
+    throw io::ConfigError(fixture.PathOf("driver") + ": unknown fixture driver '" + fixture_driver +
+                          "' (known: sim, modbus-tcp, modbus-rtu, socketcan)");
+  }
+
+  if (daq_driver == "sim") {
+    set.daq = std::make_unique<SimDaq>(set.bench, ParseSimDaqSettings(daq));
+  } else if (daq_driver == "alsa") {
+    const AlsaDaqSettings alsa = ParseAlsaDaqSettings(daq);
+#if EOL_WITH_ALSA
+    set.daq = std::make_unique<AlsaDaq>(alsa);
+#else
+    throw io::ConfigError(
+        daq.PathOf("driver") +
+        ": the alsa driver was not compiled in (configure with -DEOL_WITH_ALSA=ON)");
+#endif
+  } else if (daq_driver == "replay") {
+    set.daq = std::make_unique<ReplayDaq>(ParseReplayDaqSettings(daq));
+  } else {
+    throw io::ConfigError(daq.PathOf("driver") + ": unknown daq driver '" + daq_driver +
+                          "' (known: sim, alsa, replay)");
+  }
+  return set;
+}
+
+}  // namespace eol::drivers

@@ -1,0 +1,52 @@
+// The one place that lists the drivers and makes them from configuration (STYLE.md 1).
+//
+//   "fixture": {"driver": "sim"}                    in-process simulated bench
+//   "fixture": {"driver": "modbus-tcp", "host": "10.0.0.20", "port": 502, "unit_id": 1, ...}
+//   "fixture": {"driver": "modbus-rtu", "device": "/dev/ttyUSB0", "baud": 19200, ...}
+//                                                   a Modbus controller (modbus_fixture.h;
+//                                                   `eol fixture-sim` emulates one)
+//   "daq":     {"driver": "sim", "model": "steady_state" | "time_domain",
+//               "amplifier_output_ohm": 0, "time_scale": 0, "voltage_noise_v": 0.002, ...}
+//                                                   the simulated acquisition (sim_daq.h)
+//   "daq":     {"driver": "alsa", "playback": "default", "capture": "default", ...}
+//                                                   a sound interface (alsa_daq.h)
+//   "daq":     {"driver": "replay", "files": [...] | "directory": "..." | "file": "..."}
+//                                                   recordings from files (replay_daq.h)
+//              keys of these and the calibration: daq/daq_config.h
+//   "sim":     {"population": {...}, "clamp_close_s": 0.15, ...,   the simulated bench
+//               "masters": [{"serial": "MASTER-G"}, {"serial": "MASTER-L", "defective": true}],
+//               "fixture_wear_per_test": 0.001}                    (sim_bench.h)
+//
+// A simulator is chosen exactly as real hardware is. A driver that was not compiled in, or
+// an unknown name, fails with a io::ConfigError naming the path and the known drivers.
+#pragma once
+
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "drivers/daq/daq.h"
+#include "drivers/daq/replay_daq.h"
+#include "drivers/fixture/fixture.h"
+#include "drivers/io/json_config.h"
+#include "drivers/sim/sim_bench.h"
+#include "drivers/sim/sim_daq.h"
+
+namespace eol::drivers {
+
+struct DriverSet {
+  std::shared_ptr<SimBench> bench;  // set when any driver is simulated
+  std::unique_ptr<Fixture> fixture;
+  std::unique_ptr<Daq> daq;
+};
+
+// `station_config` is the whole station config; its "fixture", "daq" and optional "sim"
+// objects are read. Throws io::ConfigError. A given `bench` is used by the sim drivers instead of
+// a new one: the demo shares one bench between the sim DAQ and the Modbus fixture emulator.
+DriverSet MakeDrivers(const nlohmann::json& station_config,
+                      std::shared_ptr<SimBench> bench = nullptr);
+
+SimBenchSettings ParseSimBenchSettings(const io::JsonObject& sim);
+analysis::MotorPopulation ParsePopulation(const io::JsonObject& population);
+SimDaqSettings ParseSimDaqSettings(const io::JsonObject& daq);
+
+}  // namespace eol::drivers

@@ -1,0 +1,47 @@
+// eol: the end-of-line test station for permanent-magnet motors.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <clocale>
+#include <string>
+
+#include "station/cli/commands.h"
+#include "station/data_files.h"
+#include "station/version.h"
+
+int main(int argc, char** argv) {
+  std::setlocale(LC_ALL, "C");  // numbers in files and JSON never depend on the locale
+  // Logs go to stderr: stdout carries results (unit lines, JSON summaries).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("eol"));
+  CLI::App app{
+      "eol - end-of-line test station for permanent-magnet motors.\n"
+      "Clamps the shaft, excites a stator phase pair with a multisine, estimates the impedance\n"
+      "Z(f), fits the clamped rotor's torsional resonance and judges it against the recipe."};
+  app.set_version_flag("--version", eol::station::SoftwareVersion());
+  app.require_subcommand(1);
+  eol::station::cli::AddDemoCommand(app);
+  eol::station::cli::AddStationCommand(app);
+  eol::station::cli::AddFixtureSimCommand(app);
+  eol::station::cli::AddAnalyzeCommand(app);
+  eol::station::cli::AddSimulateCommand(app);
+  eol::station::cli::AddFitBenchCommand(app);
+  eol::station::cli::AddGapCommand(app);
+  eol::station::cli::AddGapBenchCommand(app);
+  eol::station::cli::AddQueryCommand(app);
+  eol::station::cli::AddExportCommand(app);
+  eol::station::cli::AddSafetyBenchCommand(app);
+  eol::station::cli::AddStatsCommand(app);
+  eol::station::cli::AddCalibrateCommand(app);
+  eol::station::cli::AddTeachCommand(app);
+  eol::station::cli::AddDetectabilityCommand(app);
+  eol::station::cli::AddProductionBenchCommand(app);
+  // Default files (recipe, operator page, SciPy peer) come from the working directory or the
+  // installed program's prefix, never from the machine the program was built on.
+  const std::string defaults =
+      std::string("Default files: ") + eol::station::kDefaultsSearchHelp + ".";
+  app.footer(defaults);
+  for (CLI::App* sub : app.get_subcommands({})) sub->footer(defaults);
+  CLI11_PARSE(app, argc, argv);
+  return 0;
+}
