@@ -1,5 +1,7 @@
 #include "station/qc_service.h"
 
+#include "station/serial_number.h"
+
 namespace eol::station {
 
 using nlohmann::json;
@@ -84,6 +86,58 @@ analysis::GoldenUnit GoldenFromRecord(const db::TestRecord& r, const std::string
     u.curve.method = "record";
   }
   return u;
+}
+
+TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe& recipe,
+                           const std::vector<std::string>& serials,
+                           const analysis::TeachOptions& options) {
+  TeachResult result;
+  for (const std::string& serial : serials) {
+    std::string why;
+    if (!ValidSerial(serial, &why)) {
+      result.kind = TeachResult::Kind::kBadSerial;
+      result.message = "serials: " + json(serial).dump() + ": " + why;
+      return result;
+    }
+  }
+  std::vector<analysis::GoldenUnit> golden;
+  json skipped = json::array();
+  {
+    std::lock_guard<std::mutex> lock(store_mu);
+    for (const std::string& serial : serials) {
+      const auto latest = store.LatestOfSerial(serial);
+      if (!latest || latest->outcome == analysis::Outcome::kError ||
+          latest->outcome == analysis::Outcome::kAborted) {
+        skipped.push_back(serial + (latest ? ": latest test is " +
+                                                 std::string(analysis::ToString(latest->outcome))
+                                           : ": no test stored"));
+        continue;
+      }
+      const auto full = store.Test(latest->id, true);
+      if (full) golden.push_back(GoldenFromRecord(*full, serial));
+    }
+  }
+  const analysis::TeachSummary summary = analysis::TeachLimits(recipe.limits, golden, options);
+  result.report = TeachSummaryJson(summary, options);
+  result.report["skipped"] = skipped;
+  result.report["previous"] = {
+      {"id", recipe.id}, {"version", recipe.version}, {"hash", recipe.hash}};
+  if (!summary.usable) {
+    result.kind = TeachResult::Kind::kNotUsable;
+    result.message = summary.message;
+    return result;
+  }
+  const json proposed = TaughtRecipeJson(recipe, summary, options);
+  try {
+    const Recipe checked = ParseRecipe(proposed, "taught recipe");
+    result.report["recipe"] = proposed;
+    result.report["recipe_hash"] = checked.hash;
+  } catch (const std::exception& e) {
+    result.kind = TeachResult::Kind::kInvalidRecipe;
+    result.message = e.what();
+    result.report = json();
+  }
+  return result;
 }
 
 analysis::DetectabilityOptions DetectabilityOptionsFor(const Recipe& r, double k_fixture_nm_per_rad,
