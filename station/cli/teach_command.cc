@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "station/cli/commands.h"
@@ -123,9 +124,10 @@ void AddTeachCommand(CLI::App& app) {
   cmd->add_option("--coverage", args->options.coverage,
                   "Share of good units that pass every taught bound together")
       ->capture_default_str();
-  cmd->add_option("--method", args->options.method, "tolerance_interval or mad")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"tolerance_interval", "mad"}));
+  std::map<std::string, analysis::TeachMethod> methods;  // the names of analysis/qc/teach.h
+  for (analysis::TeachMethod m : analysis::kAllTeachMethods) methods[analysis::ToString(m)] = m;
+  cmd->add_option("--method", args->options.method, "tolerance_interval (default) or mad")
+      ->transform(CLI::CheckedTransformer(methods));
   cmd->add_option("--mask-segments", args->options.mask_segments,
                   "Segments of the taught Re Z mask (0: keep the recipe's masks)")
       ->capture_default_str();

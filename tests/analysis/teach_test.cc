@@ -146,7 +146,7 @@ TEST(Teach, MadIsWiderThanTheIntervalForTheSameUnits) {
   o.mask_segments = 0;
   const auto units = NormalUnits(40, 21, 390.0, 4.0);
   const TeachSummary t = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
-  o.method = "mad";
+  o.method = TeachMethod::kMad;
   const TeachSummary m = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
   ASSERT_TRUE(t.usable && m.usable) << t.message << m.message;
   EXPECT_GT(m.k_factor, t.k_factor);
