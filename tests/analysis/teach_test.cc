@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include "analysis/qc/tolerance.h"
 
@@ -221,6 +222,22 @@ TEST(Teach, MaskFromCurvesPassesGoodAndCatchesAShiftedPeak) {
   ASSERT_TRUE(t.usable);
   EXPECT_TRUE(t.masks.empty());
   EXPECT_NE(t.message.find("unit-5"), std::string::npos) << t.message;
+}
+
+TEST(Teach, MethodNamesAreTheApiStringsAndAnUnknownOneIsRefusedByName) {
+  for (TeachMethod m : kAllTeachMethods)
+    EXPECT_EQ(nlohmann::json(ToString(m)).get<TeachMethod>(), m);
+  EXPECT_STREQ(ToString(TeachMethod::kToleranceInterval), "tolerance_interval");
+  EXPECT_STREQ(ToString(TeachMethod::kMad), "mad");
+  // As POST /api/teach reads it: body.value("method", default).
+  const nlohmann::json body = {{"method", "robust"}};
+  try {
+    (void)body.value("method", TeachMethod::kToleranceInterval);
+    FAIL() << "method 'robust' was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "method: unknown value 'robust' (accepted: tolerance_interval, mad)");
+  }
+  EXPECT_THROW((void)nlohmann::json(1).get<TeachMethod>(), std::invalid_argument);
 }
 
 }  // namespace
