@@ -69,7 +69,7 @@ TEST(FitJson, KeepsTheStringsAndKeysThatRecordsAndThePageRead) {
   EXPECT_EQ(j.at("termination"), "converged");
   EXPECT_EQ(j.at("model"), "R+sL+parallel-RLC");
   EXPECT_TRUE(j.at("params").at("f0_hz").contains("sigma"));
-  EXPECT_EQ(j.at("params").at("Q").at("unit"), "");
+  EXPECT_EQ(j.at("params").at("Q").at("unit"), "1");
   for (const char* key :
        {"usable", "message", "chi2", "dof", "chi2_per_dof", "iterations", "sigma_estimated"})
     EXPECT_TRUE(j.contains(key)) << key;
