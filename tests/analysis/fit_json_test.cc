@@ -15,7 +15,7 @@ namespace eol::analysis {
 namespace {
 
 // The paper's case (NOTES.md 2) with circular noise, sigma 0.02 ohm, fixed seed.
-FitSummary ReferenceFit() {
+FitSummary ReferenceFit(bool with_sigma = true) {
   MotionalImpedance m;
   m.r_ohm = 0.5;
   m.l_h = 2e-3;
@@ -28,15 +28,14 @@ FitSummary ReferenceFit() {
   std::mt19937_64 rng(7);
   std::normal_distribution<double> n(0.0, 0.02 / std::sqrt(2.0));
   for (auto& v : z.value) v += std::complex<double>(n(rng), n(rng));
-  z.sigma.assign(f.size(), 0.02);
+  if (with_sigma) z.sigma.assign(f.size(), 0.02);
   ResonanceFitOptions o;
   o.f0_min_hz = 250.0;
   o.f0_max_hz = 700.0;
   return FitMotionalResonance(z, o);
 }
 
-TEST(FitJson, ARealFitSurvivesTheRoundTripFieldByField) {
-  const FitSummary s = ReferenceFit();
+void ExpectRoundTrip(const FitSummary& s) {
   ASSERT_TRUE(s.usable) << s.message;
   ASSERT_EQ(s.covariance.rows(), 5);
   // Through text, as the store and the API carry it.
@@ -62,6 +61,15 @@ TEST(FitJson, ARealFitSurvivesTheRoundTripFieldByField) {
   EXPECT_DOUBLE_EQ(back.estimated_sigma, s.estimated_sigma);
   // And the model the page draws is the same.
   EXPECT_DOUBLE_EQ(back.Model().f0_hz, s.Model().f0_hz);
+}
+
+TEST(FitJson, ARealFitSurvivesTheRoundTripFieldByField) {
+  ExpectRoundTrip(ReferenceFit());
+  // Without sigma the noise is estimated: sigma_estimated and estimated_sigma are set.
+  const FitSummary estimated = ReferenceFit(false);
+  ASSERT_TRUE(estimated.sigma_estimated);
+  ASSERT_GT(estimated.estimated_sigma, 0.0);
+  ExpectRoundTrip(estimated);
 }
 
 TEST(FitJson, KeepsTheStringsAndKeysThatRecordsAndThePageRead) {
