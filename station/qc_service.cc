@@ -37,10 +37,10 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
     j["masks"] = json::array();
     for (const analysis::CurveMask& m : s.masks) j["masks"].push_back(MaskJson(m));
   }
-  const std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
-                           std::to_string(s.units_used) + " golden units (" + o.method +
-                           ", coverage " + json(o.coverage).dump() + ", confidence " +
-                           json(o.confidence).dump() + ", k " + json(s.k_factor).dump() + ").";
+  const std::string note =
+      " Limits v" + std::to_string(r.version + 1) + " taught from " + std::to_string(s.units_used) +
+      " golden units (" + analysis::ToString(o.method) + ", coverage " + json(o.coverage).dump() +
+      ", confidence " + json(o.confidence).dump() + ", k " + json(s.k_factor).dump() + ").";
   j["description"] = j.value("description", std::string()) + note;
   return j;
 }

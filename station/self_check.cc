@@ -103,7 +103,7 @@ LockoutState EvaluateLockout(const SelfCheckConfig& c, db::Store& store,
     }
   }
   const std::string since = std::min(s.good->at, s.limit->at);
-  s.tests_since_check = store.CountTestsSince("production", since);
+  s.tests_since_check = store.CountTestsSince(db::RecordKind::kProduction, since);
   if (c.every_hours > 0) {
     const auto valid = std::chrono::duration_cast<std::chrono::system_clock::duration>(
         std::chrono::duration<double, std::ratio<3600>>(c.every_hours));

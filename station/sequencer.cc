@@ -7,6 +7,7 @@
 #include <sstream>
 #include <thread>
 
+#include "analysis/fit/fit_json.h"
 #include "analysis/impedance_analysis.h"
 #include "analysis/qc/measurement_names.h"
 #include "analysis/text.h"
@@ -34,22 +35,6 @@ db::Curve ToCurve(const analysis::Frf& z, const std::string& name) {
   }
   c.sigma = z.sigma;
   return c;
-}
-
-nlohmann::json FitJson(const analysis::FitSummary& fit) {
-  nlohmann::json params = nlohmann::json::object();
-  for (const auto& p : fit.params)
-    params[p.name] = {{"value", p.value}, {"sigma", p.sigma}, {"unit", p.unit}};
-  return {{"model", fit.model},
-          {"usable", fit.usable},
-          {"termination", fit.termination},
-          {"message", fit.message},
-          {"params", params},
-          {"chi2", fit.chi2},
-          {"dof", fit.dof},
-          {"chi2_per_dof", fit.chi2_per_dof},
-          {"iterations", fit.iterations},
-          {"sigma_estimated", fit.sigma_estimated}};
 }
 
 }  // namespace
@@ -218,7 +203,7 @@ void Sequencer::Enter(db::TestRecord& record, SeqState s, const std::string& det
   const double t_ms = std::chrono::duration<double, std::milli>(Clock::now() - test_start_).count();
   record.trace.push_back({ToString(s), t_ms, detail});
   spdlog::info("[{}] {}{}{}", record.serial, ToString(s), detail.empty() ? "" : ": ", detail);
-  board_.OnState(record.serial, ToString(s), detail);
+  board_.OnState(record.serial, s, detail);
 }
 
 drivers::FixtureInputs Sequencer::ReadInputs(const char* purpose) {
@@ -334,7 +319,7 @@ void Sequencer::AnalyseAndJudge(db::TestRecord& record, const analysis::Recordin
   if (a.frf.frf.size() > 0) record.curves.push_back(ToCurve(a.frf.frf, "impedance"));
   record.conditions["periods_used"] = a.frf.periods_used;
   if (!a.fit.params.empty()) {
-    record.fit = FitJson(a.fit);
+    record.fit = a.fit;  // analysis/fit/fit_json.h
     record.curves.push_back(ToCurve(a.fit.Model().Evaluate(a.frf.frf.freq_hz), "model"));
   }
   if (!a.usable) throw Fault{analysis::Outcome::kError, a.message};
@@ -481,7 +466,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
   record.outcome = analysis::Outcome::kError;
   Enter(record, SeqState::kWaitSerial, "serial " + serial + " received");
   const std::optional<std::string> master = MasterRole(options_.self_check, serial);
-  if (master) record.kind = "self_check";
+  if (master) record.kind = db::RecordKind::kSelfCheck;
 
   try {
     if (options_.self_check.enabled() && !master) {

@@ -5,6 +5,7 @@
 // station failed: it says nothing about the motor), ABORTED (the test was interrupted).
 #pragma once
 
+#include <array>
 #include <map>
 #include <optional>
 #include <string>
@@ -13,7 +14,9 @@
 namespace eol::analysis {
 
 enum class Outcome { kPass, kFail, kError, kAborted };
-const char* ToString(Outcome o);
+inline constexpr std::array kAllOutcomes = {Outcome::kPass, Outcome::kFail, Outcome::kError,
+                                            Outcome::kAborted};
+const char* ToString(Outcome o);  // "PASS", "FAIL", "ERROR", "ABORTED"
 std::optional<Outcome> ParseOutcome(const std::string& s);
 
 // Closed interval [lo, hi]; an absent bound is open. A value inside the limits but within
@@ -38,7 +41,9 @@ struct Estimate {
 };
 
 enum class MeasurementOutcome { kPass, kFail, kUnset };
-const char* ToString(MeasurementOutcome o);
+inline constexpr std::array kAllMeasurementOutcomes = {
+    MeasurementOutcome::kPass, MeasurementOutcome::kFail, MeasurementOutcome::kUnset};
+const char* ToString(MeasurementOutcome o);  // "PASS", "FAIL", "UNSET"
 
 struct Measurement {
   std::string name;

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <set>
+#include <stdexcept>
 
+#include "analysis/enum_names.h"
 #include "analysis/qc/tolerance.h"
 
 namespace eol::analysis {
@@ -94,13 +96,34 @@ bool CommonGrid(const std::vector<const GoldenUnit*>& units, std::string* why) {
 
 }  // namespace
 
+const char* ToString(TeachMethod m) {
+  switch (m) {
+    case TeachMethod::kToleranceInterval:
+      return "tolerance_interval";
+    case TeachMethod::kMad:
+      return "mad";
+  }
+  return "tolerance_interval";
+}
+
+TeachMethod ParseTeachMethod(std::string_view name) {
+  return ParseEnumOrThrow("method", name, kAllTeachMethods);
+}
+
+void to_json(nlohmann::json& j, const TeachMethod& m) { j = ToString(m); }
+
+void from_json(const nlohmann::json& j, TeachMethod& m) {
+  if (!j.is_string())
+    throw std::invalid_argument(
+        "method: must be a string (accepted: " + AcceptedNames(kAllTeachMethods) + ")");
+  m = ParseTeachMethod(j.get<std::string>());
+}
+
 bool TeachOptions::IsValid(std::string* why) const {
   auto fail = [&](const std::string& m) {
     if (why) *why = m;
     return false;
   };
-  if (method != "tolerance_interval" && method != "mad")
-    return fail("method must be tolerance_interval or mad (got " + method + ")");
   if (!(confidence > 0.5 && confidence < 1.0)) return fail("confidence must be in (0.5, 1)");
   if (!(coverage > 0.5 && coverage < 1.0)) return fail("coverage must be in (0.5, 1)");
   if (!(outlier_z >= 2.0)) return fail("outlier_z must be at least 2");
@@ -118,7 +141,7 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
   std::string why;
   if (!o.IsValid(&why)) return Fail(s, "teach options: " + why);
   if (declared.empty()) return Fail(s, "the recipe declares no scalar limit to teach");
-  const bool robust = o.method == "mad";
+  const bool robust = o.method == TeachMethod::kMad;
 
   // Every golden unit must carry every declared measurement, finite.
   for (const GoldenUnit& u : golden)
@@ -286,7 +309,7 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
 
   s.usable = true;
   s.message =
-      std::string("method ") + o.method + ", " + std::to_string(s.units_used) + " of " +
+      std::string("method ") + ToString(o.method) + ", " + std::to_string(s.units_used) + " of " +
       std::to_string(s.units_given) + " golden units used (" + std::to_string(s.rejected.size()) +
       " rejected as outliers), coverage " + Num(o.coverage) + " of good units over " +
       std::to_string(s.bounds) + " bounds (" + Num(s.p_bound) + " each) at confidence " +

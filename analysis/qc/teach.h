@@ -37,8 +37,11 @@
 // doubt.
 #pragma once
 
+#include <array>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "analysis/frf.h"
@@ -53,9 +56,19 @@ struct GoldenUnit {
   Frf curve;                             // measured impedance; may be empty (then no mask)
 };
 
+// Named "tolerance_interval" and "mad" (ToString) in POST /api/teach, `eol teach --method` and
+// the taught recipe's description.
+enum class TeachMethod { kToleranceInterval, kMad };
+inline constexpr std::array kAllTeachMethods = {TeachMethod::kToleranceInterval, TeachMethod::kMad};
+const char* ToString(TeachMethod m);
+// The method named `name`; std::invalid_argument "method: unknown value 'x' (accepted: ...)".
+TeachMethod ParseTeachMethod(std::string_view name);
+void to_json(nlohmann::json& j, const TeachMethod& m);
+void from_json(const nlohmann::json& j, TeachMethod& m);
+
 struct TeachOptions {
-  std::string method = "tolerance_interval";  // or "mad"
-  double confidence = 0.95;                   // gamma of the tolerance interval
+  TeachMethod method = TeachMethod::kToleranceInterval;
+  double confidence = 0.95;  // gamma of the tolerance interval
   double coverage = 0.9973;  // share of good units passing every taught bound together
   double outlier_z = 5.0;
   double width_margin = 0.2;  // for units_needed

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "analysis/fit/fit_json.h"
 #include "analysis/impedance_analysis.h"
 #include "analysis/model/two_mass.h"
 #include "analysis/signal/waveform.h"
@@ -290,13 +291,7 @@ int RunAnalyze(const AnalyzeArgs& a) {
   const bool noise_estimated = !z.has_sigma();
   out["noise_estimated"] = noise_estimated;
   const analysis::FitSummary& fit = result.fit;
-  out["fit"] = {{"model", fit.model},
-                {"chi2", fit.chi2},
-                {"dof", fit.dof},
-                {"chi2_per_dof", fit.chi2_per_dof},
-                {"iterations", fit.iterations},
-                {"termination", fit.termination},
-                {"message", fit.message}};
+  out["fit"] = fit;  // analysis/fit/fit_json.h
   if (noise_estimated) out["estimated_sigma_ohm"] = fit.estimated_sigma;
   if (!result.usable) {
     if (recipe) {
@@ -338,7 +333,8 @@ int RunAnalyze(const AnalyzeArgs& a) {
     std::cout << "  " << p.name << " = " << Sci(p.value) << " +- " << Sci(p.sigma) << " " << p.unit
               << "\n";
   std::cout << "fit: " << fit.model << ", chi2/dof = " << Fixed(fit.chi2_per_dof, 3) << " (dof "
-            << fit.dof << "), " << fit.termination << " in " << fit.iterations << " iterations\n";
+            << fit.dof << "), " << analysis::ToString(fit.termination) << " in " << fit.iterations
+            << " iterations\n";
   if (recipe) {
     std::cout << "verdict (" << recipe->id << " v" << recipe->version
               << "): " << analysis::ToString(verdict.outcome) << "\n";

@@ -123,9 +123,16 @@ void AddTeachCommand(CLI::App& app) {
   cmd->add_option("--coverage", args->options.coverage,
                   "Share of good units that pass every taught bound together")
       ->capture_default_str();
-  cmd->add_option("--method", args->options.method, "tolerance_interval or mad")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"tolerance_interval", "mad"}));
+  std::vector<std::string> methods;  // the names of analysis/qc/teach.h
+  for (analysis::TeachMethod m : analysis::kAllTeachMethods)
+    methods.push_back(analysis::ToString(m));
+  cmd->add_option_function<std::string>(
+         "--method",
+         [args](const std::string& name) {
+           args->options.method = analysis::ParseTeachMethod(name);
+         },
+         "tolerance_interval (default) or mad")
+      ->check(CLI::IsMember(methods));
   cmd->add_option("--mask-segments", args->options.mask_segments,
                   "Segments of the taught Re Z mask (0: keep the recipe's masks)")
       ->capture_default_str();

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include "analysis/qc/tolerance.h"
 
@@ -146,7 +147,7 @@ TEST(Teach, MadIsWiderThanTheIntervalForTheSameUnits) {
   o.mask_segments = 0;
   const auto units = NormalUnits(40, 21, 390.0, 4.0);
   const TeachSummary t = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
-  o.method = "mad";
+  o.method = TeachMethod::kMad;
   const TeachSummary m = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
   ASSERT_TRUE(t.usable && m.usable) << t.message << m.message;
   EXPECT_GT(m.k_factor, t.k_factor);
@@ -221,6 +222,22 @@ TEST(Teach, MaskFromCurvesPassesGoodAndCatchesAShiftedPeak) {
   ASSERT_TRUE(t.usable);
   EXPECT_TRUE(t.masks.empty());
   EXPECT_NE(t.message.find("unit-5"), std::string::npos) << t.message;
+}
+
+TEST(Teach, MethodNamesAreTheApiStringsAndAnUnknownOneIsRefusedByName) {
+  for (TeachMethod m : kAllTeachMethods)
+    EXPECT_EQ(nlohmann::json(ToString(m)).get<TeachMethod>(), m);
+  EXPECT_STREQ(ToString(TeachMethod::kToleranceInterval), "tolerance_interval");
+  EXPECT_STREQ(ToString(TeachMethod::kMad), "mad");
+  // As POST /api/teach reads it: body.value("method", default).
+  const nlohmann::json body = {{"method", "robust"}};
+  try {
+    (void)body.value("method", TeachMethod::kToleranceInterval);
+    FAIL() << "method 'robust' was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "method: unknown value 'robust' (accepted: tolerance_interval, mad)");
+  }
+  EXPECT_THROW((void)nlohmann::json(1).get<TeachMethod>(), std::invalid_argument);
 }
 
 }  // namespace

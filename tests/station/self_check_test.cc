@@ -74,7 +74,7 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
 
     const db::TestRecord good = s.RunTest("MASTER-G");
     EXPECT_EQ(good.outcome, Outcome::kPass) << Reasons(good);
-    EXPECT_EQ(good.kind, "self_check");
+    EXPECT_EQ(good.kind, db::RecordKind::kSelfCheck);
     EXPECT_TRUE(good.self_check.at("passed").get<bool>()) << Reasons(good);
     EXPECT_TRUE(Lockout(s).at("locked").get<bool>());  // the limit master is still due
     const db::TestRecord limit = s.RunTest("MASTER-L");
@@ -88,7 +88,7 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
 
     const db::TestRecord unit = s.RunTest("U-1");
     EXPECT_EQ(unit.outcome, Outcome::kPass) << Reasons(unit);
-    EXPECT_EQ(s.store().Test(unit.id)->kind, "production");
+    EXPECT_EQ(s.store().Test(unit.id)->kind, db::RecordKind::kProduction);
   }
   std::string failed_at;
   {
