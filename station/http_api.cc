@@ -282,6 +282,7 @@ void HttpApi::Routes() {
       options.method = body.value("method", options.method);
       options.confidence = body.value("confidence", options.confidence);
       options.coverage = body.value("coverage", options.coverage);
+      options.allow_few_units = body.value("allow_few_units", options.allow_few_units);
     } catch (const std::exception& e) {
       return SendError(res, 400, "bad_request", std::string("options: ") + e.what());
     }
