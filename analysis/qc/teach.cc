@@ -151,6 +151,11 @@ void ExpectedFalseReject(TeachSummary& s, std::size_t n_units, double confidence
     shares.push_back(reject_share([&](const TaughtStatistic& t) { return drawn[t.name].first; },
                                   [&](const TaughtStatistic& t) { return drawn[t.name].second; }));
   }
+  // The expected share of new good units rejected, given the golden ones: the mean over the
+  // draws (the plug-in value sits low in the tail when the scale is uncertain).
+  double sum = 0.0;
+  for (double v : shares) sum += v;
+  s.expected_false_reject = sum / static_cast<double>(shares.size());
   std::sort(shares.begin(), shares.end());
   auto at = [&](double q) {
     return shares[std::min(shares.size() - 1, static_cast<std::size_t>(q * shares.size()))];

@@ -29,8 +29,8 @@
 // for n_eff = 0.37 n, the asymptotic efficiency of the MAD for normal data.
 // Marginal band: marginal_scales x scale inside each limit.
 //
-// Expected false-reject rate of the taught recipe: per bound the normal tail beyond it from
-// the golden centre and scale, combined as 1 - prod(1 - tail_b) (bounds independent); its
+// Expected false-reject rate of the taught recipe: per bound the normal tail beyond it,
+// combined as 1 - prod(1 - tail_b) (bounds independent), averaged over the draws below; its
 // interval at `confidence` from the distribution of the true centre and scale given the golden
 // ones (fiducial, the same as Jeffreys' posterior for normal data): per statistic sigma =
 // s sqrt(nu / chi2_nu), mu = m + sigma N(0, 1) / sqrt(n), limits held fixed (fixed seed, 4000
