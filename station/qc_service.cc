@@ -37,10 +37,16 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
     j["masks"] = json::array();
     for (const analysis::CurveMask& m : s.masks) j["masks"].push_back(MaskJson(m));
   }
-  const std::string note =
-      " Limits v" + std::to_string(r.version + 1) + " taught from " + std::to_string(s.units_used) +
-      " golden units (" + analysis::ToString(o.method) + ", coverage " + json(o.coverage).dump() +
-      ", confidence " + json(o.confidence).dump() + ", k " + json(s.k_factor).dump() + ").";
+  std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
+                     std::to_string(s.units_used) + " golden units (" +
+                     analysis::ToString(o.method) + ", allocation " + o.allocation +
+                     ", false-reject target " + json(1.0 - o.coverage).dump() + ", confidence " +
+                     json(o.confidence).dump() + ", expected false rejects " +
+                     json(s.expected_false_reject).dump() + " [" + json(s.false_reject_lo).dump() +
+                     ", " + json(s.false_reject_hi).dump() + "]).";
+  if (s.few_units_forced)
+    note += " FORCED: " + std::to_string(s.units_used) + " golden units where " +
+            std::to_string(s.units_needed) + " are needed.";
   j["description"] = j.value("description", std::string()) + note;
   return j;
 }
@@ -55,8 +61,25 @@ json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOpti
   for (const auto& t : s.statistics)
     stats.push_back({{"name", t.name}, {"centre", t.centre}, {"scale", t.scale}});
   for (const auto& m : s.masks) masks.push_back(MaskJson(m));
+  json bounds = json::array();
+  for (const auto& b : s.taught_bounds)
+    bounds.push_back({{"statistic", b.statistic},
+                      {"side", b.lo ? "lo" : "hi"},
+                      {"role", b.defect_side ? "defect" : "plausibility"},
+                      {"share", b.share},
+                      {"k", b.k},
+                      {"limit", b.limit}});
   return {{"usable", s.usable},
           {"method", o.method},
+          {"allocation", o.allocation},
+          {"false_reject_target", 1.0 - o.coverage},
+          {"expected_false_reject",
+           {{"value", s.expected_false_reject},
+            {"lo", s.false_reject_lo},
+            {"hi", s.false_reject_hi},
+            {"confidence", o.confidence}}},
+          {"few_units_forced", s.few_units_forced},
+          {"taught_bounds", bounds},
           {"confidence", o.confidence},
           {"coverage", o.coverage},
           {"bounds", s.bounds},

@@ -84,6 +84,7 @@ void PostTeach(ApiContext& c, const httplib::Request& req, httplib::Response& re
     options.method = body.value("method", options.method);
     options.confidence = body.value("confidence", options.confidence);
     options.coverage = body.value("coverage", options.coverage);
+    options.allow_few_units = body.value("allow_few_units", options.allow_few_units);
   } catch (const std::exception& e) {
     return Send(res, BadRequest("bad_request", std::string("options: ") + e.what()));
   }
