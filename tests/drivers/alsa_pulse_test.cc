@@ -5,12 +5,12 @@
 // back on both input channels after the server's latency. Contracts: the played multisine
 // comes back (delay found, correlation and amplitude sane); a stalled reader is reported as
 // an xrun naming the device and the frame; an excitation beyond the output's full scale is
-// refused before anything is played.
+// refused before anything is played. Lifecycle, sample count, abort, calibration and errors
+// naming the device are the DAQ contract's (tests/support/daq_contract.h, daq_contract_test).
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cmath>
-#include <thread>
 
 #include "analysis/signal/multisine.h"
 #include "drivers/daq/alsa_daq.h"
@@ -180,28 +180,6 @@ TEST(AlsaPulse, ExcitationBeyondFullScaleIsRefusedBeforePlaying) {
   ASSERT_FALSE(result.ok());
   EXPECT_NE(result.status().message().find("exceeds the line output's full scale 0.4"),
             std::string::npos)
-      << result.status().message();
-}
-
-TEST(AlsaPulse, AbortStopsTheAcquisition) {
-  PulseServer server;
-  if (!server.ready()) GTEST_SKIP() << server.why_not();
-  AlsaDaq daq(PulseSettings());
-  ASSERT_TRUE(daq.Connect().ok());
-  const analysis::Excitation ex = Multisine();
-  AcquisitionRequest req;
-  req.sample_rate_hz = kRateHz;
-  req.period_samples = ex.period_samples;
-  req.excitation_v = ex.Repeat(100);  // 10 s unless aborted
-  std::atomic<bool> abort{false};
-  std::thread stopper([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    abort = true;
-  });
-  const auto result = daq.Acquire(req, abort);
-  stopper.join();
-  ASSERT_FALSE(result.ok());
-  EXPECT_NE(result.status().message().find("aborted"), std::string::npos)
       << result.status().message();
 }
 
