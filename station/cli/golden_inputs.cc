@@ -101,8 +101,8 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
           if (r.outcome != analysis::Outcome::kPass)
             throw std::runtime_error("record " + label + " is " + analysis::ToString(r.outcome) +
                                      ": only PASS records are golden units");
-          if (r.kind != "production")
-            throw std::runtime_error("record " + label + " is a " + r.kind +
+          if (r.kind != db::RecordKind::kProduction)
+            throw std::runtime_error("record " + label + " is a " + db::ToString(r.kind) +
                                      " test (a master part), not a production unit");
           if (r.recipe_hash != recipe.hash)
             throw std::runtime_error("record " + label + " was tested with recipe hash " +
