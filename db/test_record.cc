@@ -52,6 +52,22 @@ void from_json(const nlohmann::json& j, Measurement& m) {
                             : MeasurementOutcome::kUnset;
   m.marginal = j.value("marginal", false);
 }
+
+void to_json(nlohmann::json& j, const Reason& r) {
+  j = {{"code", ToString(r.code)}, {"text", r.text}};
+}
+
+void from_json(const nlohmann::json& j, Reason& r) {
+  if (j.is_string()) {  // stored before reasons had codes (schema v3 and earlier writers)
+    r = {ReasonCode::kLegacy, j.get<std::string>()};
+    return;
+  }
+  const std::string code = j.at("code").get<std::string>();
+  const auto parsed = ParseReasonCode(code);
+  if (!parsed)
+    throw nlohmann::json::other_error::create(501, "reasons: unknown code '" + code + "'", &j);
+  r = {*parsed, j.at("text").get<std::string>()};
+}
 }  // namespace eol::analysis
 
 namespace eol::db {
@@ -134,7 +150,7 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   if (!parsed)
     throw nlohmann::json::other_error::create(501, "outcome: unknown value '" + outcome + "'", &j);
   r.outcome = *parsed;
-  r.reasons = j.value("reasons", std::vector<std::string>{});
+  r.reasons = j.value("reasons", std::vector<analysis::Reason>{});
   r.measurements = j.value("measurements", std::vector<analysis::Measurement>{});
   r.conditions = j.value("conditions", nlohmann::json::object());
   r.calibration = j.value("calibration", nlohmann::json::object());

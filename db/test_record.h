@@ -44,7 +44,10 @@ struct TestRecord {
   std::optional<std::int64_t> retest_of;  // id of the first test of this serial, if any
 
   analysis::Outcome outcome = analysis::Outcome::kError;
-  std::vector<std::string> reasons;
+  // Why the outcome is what it is, the decisive first: [{"code", "text"}] in JSON
+  // (analysis/qc/measurement.h lists the codes). Old records whose reasons are plain strings
+  // read back with the code "legacy".
+  std::vector<analysis::Reason> reasons;
   std::vector<analysis::Measurement> measurements;
 
   // Conditions and context, free-form but with unit-carrying keys:
@@ -78,4 +81,7 @@ void to_json(nlohmann::json& j, const Limit& l);
 void from_json(const nlohmann::json& j, Limit& l);
 void to_json(nlohmann::json& j, const Measurement& m);
 void from_json(const nlohmann::json& j, Measurement& m);
+// {"code": "limit", "text": "..."}; a plain string reads as code kLegacy.
+void to_json(nlohmann::json& j, const Reason& r);
+void from_json(const nlohmann::json& j, Reason& r);
 }  // namespace eol::analysis
