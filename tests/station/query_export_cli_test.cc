@@ -36,7 +36,8 @@ db::TestRecord Record(const std::string& serial, const std::string& t, analysis:
   m.outcome = f0 >= 370 ? analysis::MeasurementOutcome::kPass : analysis::MeasurementOutcome::kFail;
   r.measurements.push_back(m);
   if (o == analysis::Outcome::kFail)
-    r.reasons.push_back("resonance_f_hz = 352 Hz, below 370, \"low\"");
+    r.reasons.push_back(
+        {analysis::ReasonCode::kLimit, "resonance_f_hz = 352 Hz, below 370, \"low\""});
   return r;
 }
 
