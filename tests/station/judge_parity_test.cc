@@ -32,11 +32,11 @@ class JudgeParityTest : public ::testing::Test {
   // One simulated recording shared by every case (`eol simulate` takes a while).
   static void SetUpTestSuite() {
     dir_ = new TempDir();
-    const auto r =
-        RunEol({"simulate", "--motor",
-                std::string(EOL_SOURCE_DIR) + "/recipes/motors/pmsm-10pole.json", "--format",
-                "recording", "--model", "steady_state", "--seed", "7", "--out", *dir_ / "unit.csv"},
-               true, 120s);
+    const auto r = RunEol(
+        {"simulate", "--motor", std::string(EOL_SOURCE_DIR) + "/recipes/motors/pmsm-10pole.json",
+         "--recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json", "--format",
+         "recording", "--model", "steady_state", "--seed", "7", "--out", *dir_ / "unit.csv"},
+        true, 120s);
     ASSERT_EQ(r.code, 0) << r.out;
   }
   static void TearDownTestSuite() {
@@ -92,13 +92,15 @@ class JudgeParityTest : public ::testing::Test {
       EXPECT_EQ(ms[i].at("name").get<std::string>(), m.name) << name;
       EXPECT_EQ(ms[i].at("outcome").get<std::string>(), analysis::ToString(m.outcome))
           << name << " " << m.name;
-      if (std::isfinite(m.value))
+      if (std::isfinite(m.value)) {
         EXPECT_EQ(ms[i].at("value").get<double>(), m.value) << name << " " << m.name;
+      }
     }
     // The conditions the judge computed from the recording agree too.
     for (const char* key : {"excitation_v_rms", "excitation_a_rms", "winding_temperature_c"})
-      if (station.conditions.contains(key))
+      if (station.conditions.contains(key)) {
         EXPECT_EQ(offline.at("conditions").at(key), station.conditions.at(key)) << key;
+      }
     return station;
   }
 
