@@ -21,9 +21,10 @@
 // with "phase pair V-W: ". Reasons are ordered: first pair (conditions, limits, masks), then
 // each further pair.
 //
-// Without a recording (an FRF file judged offline) the excitation-level conditions cannot be
-// evaluated: they are listed in Judgement::conditions_not_evaluated and do not change the
-// outcome (the winding temperature, estimated from the fitted R, is still judged).
+// Without a recording of the recipe's excitation (an FRF file judged offline, or a noise
+// recording analysed with Welch) the excitation-level conditions cannot be evaluated: they are
+// listed in Judgement::conditions_not_evaluated and do not change the outcome (the winding
+// temperature, estimated from the fitted R, is still judged).
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -3,7 +3,8 @@
 // periodic recording, fits the clamped motor (analysis::AnalyzeImpedance / AnalyzeRecording)
 // and, with --recipe, judges the unit with the station's own judge (station/judge.h: limits,
 // masks, conditions), so a recording gets the verdict and reasons the station gives it. An FRF
-// file has no recording: the excitation-level conditions are listed under
+// file has no recording, and a noise recording (Welch) was not excited with the recipe's
+// multisine: for both the excitation-level conditions are listed under
 // verdict.conditions_not_evaluated instead of being judged.
 // A mobility FRF (f_hz,re,im[,sigma]) is fitted with the two-mass model instead (no verdict).
 // Exit codes: 0 a usable analysis (whatever the verdict), 1 the data cannot be analysed
@@ -289,7 +290,7 @@ int RunAnalyze(const AnalyzeArgs& a) {
       if (recipe) {
         analysis::ImpedanceAnalysis unusable;
         unusable.message = w.message;
-        out["verdict"] = JudgeJson(*recipe, unusable, &in.recording, out);
+        out["verdict"] = JudgeJson(*recipe, unusable, nullptr, out);
       }
       return Fail(a, out, 1, "invalid measurement: " + w.message);
     }
@@ -318,8 +319,10 @@ int RunAnalyze(const AnalyzeArgs& a) {
                 {"termination", fit.termination},
                 {"message", fit.message}};
   if (noise_estimated) out["estimated_sigma_ohm"] = fit.estimated_sigma;
+  // A noise recording (Welch) was not excited with the recipe's multisine: the recipe's
+  // excitation-level windows do not apply to it, so it is judged like an FRF file.
   const analysis::Recording* recording =
-      in.kind == io::MeasuredKind::kRecording ? &in.recording : nullptr;
+      in.kind == io::MeasuredKind::kRecording && a.welch_segment == 0 ? &in.recording : nullptr;
   if (!result.usable) {
     if (recipe) out["verdict"] = JudgeJson(*recipe, result, recording, out);
     return Fail(a, out, 1, result.message);
@@ -359,7 +362,8 @@ int RunAnalyze(const AnalyzeArgs& a) {
     for (const analysis::Reason& r : verdict.reasons)
       std::cout << "  " << r.text << " [" << analysis::ToString(r.code) << "]\n";
     for (const std::string& c : verdict.conditions_not_evaluated)
-      std::cout << "  condition " << c << " not evaluated: an FRF file has no recording\n";
+      std::cout << "  condition " << c
+                << " not evaluated: no recording of the recipe's excitation\n";
   }
   return 0;
 }
