@@ -73,7 +73,8 @@ TEST_F(QueryExportTest, QueryShowsHistoryNewestFirstWithRetestLink) {
   const CliRun text = Eol({"query", "--db", db_, "--serial", "SN-1"});
   EXPECT_EQ(text.code, 0);
   EXPECT_NE(text.out.find("SN-1: 2 test(s), latest PASS"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("reason: resonance_f_hz = 352 Hz"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("reason (limit): resonance_f_hz = 352 Hz"), std::string::npos)
+      << text.out;
 }
 
 TEST_F(QueryExportTest, UnknownSerialExitsOneAndBadSerialIsRefused) {
