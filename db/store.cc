@@ -247,7 +247,9 @@ int AbortUnfinished(sqlite3* db, const std::string& path) {
               "WHERE outcome = 'RUNNING'",
               "open (mark unfinished tests ABORTED)");
   s.BindText(1, UtcNowIso8601());
-  s.BindText(2, nlohmann::json::array({kInterruptedReason}).dump());
+  s.BindText(2, nlohmann::json::array(
+                    {analysis::Reason{analysis::ReasonCode::kAborted, kInterruptedReason}})
+                    .dump());
   s.Run();
   return sqlite3_changes(db);
 }
@@ -393,7 +395,7 @@ TestRecord RowToRecord(const Statement& s, const std::string& path) {
   try {
     // An aborted test has no record JSON: its columns are all there is.
     if (!s.IsNull(12)) r = nlohmann::json::parse(s.Text(12)).get<TestRecord>();
-    r.reasons = nlohmann::json::parse(s.Text(11)).get<std::vector<std::string>>();
+    r.reasons = nlohmann::json::parse(s.Text(11)).get<std::vector<analysis::Reason>>();
   } catch (const nlohmann::json::exception& e) {
     throw StoreError(Message(path, op, std::string("stored JSON is not a record: ") + e.what()));
   } catch (const std::invalid_argument& e) {  // an unknown enum string (test_record.h)

@@ -101,7 +101,7 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   if (j.contains("retest_of") && !j.at("retest_of").is_null())
     r.retest_of = j.at("retest_of").get<std::int64_t>();
   r.outcome = j.at("outcome").get<analysis::Outcome>();
-  r.reasons = j.value("reasons", std::vector<std::string>{});
+  r.reasons = j.value("reasons", std::vector<analysis::Reason>{});
   r.measurements = j.value("measurements", std::vector<analysis::Measurement>{});
   r.conditions = j.value("conditions", nlohmann::json::object());
   r.calibration = j.value("calibration", nlohmann::json::object());

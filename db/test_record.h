@@ -58,7 +58,10 @@ struct TestRecord {
   std::optional<std::int64_t> retest_of;  // id of the first test of this serial, if any
 
   analysis::Outcome outcome = analysis::Outcome::kError;
-  std::vector<std::string> reasons;
+  // Why the outcome is what it is, the decisive first: [{"code", "text"}] in JSON
+  // (analysis/qc/measurement.h lists the codes). Old records whose reasons are plain strings
+  // read back with the code "legacy".
+  std::vector<analysis::Reason> reasons;
   std::vector<analysis::Measurement> measurements;
 
   // Conditions and context, free-form but with unit-carrying keys:

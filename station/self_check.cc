@@ -43,7 +43,7 @@ std::optional<std::string> MasterRole(const SelfCheckConfig& c, const std::strin
 nlohmann::json JudgeMasterTest(const std::string& master, const db::TestRecord& r) {
   const std::string who = master + " master " + r.serial;
   const std::string outcome = analysis::ToString(r.outcome);
-  const std::string first = r.reasons.empty() ? "" : ": " + r.reasons.front();
+  const std::string first = r.reasons.empty() ? "" : ": " + r.reasons.front().text;
   const analysis::Measurement* f0 = FindMeasurement(r, analysis::names::kResonanceFHz);
   const std::string f0_text =
       f0 && std::isfinite(f0->value)

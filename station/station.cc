@@ -192,7 +192,7 @@ void Station::Serve() {
     }
     const db::TestRecord r = sequencer_->RunTest(serial);
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),
-                 r.reasons.empty() ? "" : r.reasons.front());
+                 r.reasons.empty() ? "" : r.reasons.front().text);
     std::lock_guard<std::mutex> lock(queue_mu_);
     running_test_ = false;
   }

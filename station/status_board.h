@@ -39,7 +39,7 @@ class StatusBoard {
   void SetLockout(const nlohmann::json& lockout);
 
   // {"station_id", "state", "serial", "detail", "message", "recipe": {...}, "counts": {...},
-  //  "last": {serial, outcome, reasons, measurements, finished_at, id} | null,
+  //  "last": {serial, outcome, reasons [{code, text}], measurements, finished_at, id} | null,
   //  "recent": [...], "lockout": {...} | null}
   nlohmann::json Snapshot() const;
 

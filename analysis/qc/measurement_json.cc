@@ -55,13 +55,29 @@ void from_json(const nlohmann::json& j, Measurement& m) {
   m.marginal = j.value("marginal", false);
 }
 
+void to_json(nlohmann::json& j, const Reason& r) {
+  j = {{"code", ToString(r.code)}, {"text", r.text}};
+}
+
+void from_json(const nlohmann::json& j, Reason& r) {
+  if (j.is_string()) {  // stored before reasons had codes
+    r = {ReasonCode::kLegacy, j.get<std::string>()};
+    return;
+  }
+  const std::string code = j.at("code").get<std::string>();
+  const auto parsed = ParseReasonCode(code);
+  if (!parsed)
+    throw nlohmann::json::other_error::create(501, "reasons: unknown code '" + code + "'", &j);
+  r = {*parsed, j.at("text").get<std::string>()};
+}
+
 void to_json(nlohmann::json& j, const Verdict& v) {
   j = {{"outcome", v.outcome}, {"reasons", v.reasons}, {"measurements", v.measurements}};
 }
 
 void from_json(const nlohmann::json& j, Verdict& v) {
   v.outcome = j.at("outcome").get<Outcome>();
-  v.reasons = j.value("reasons", std::vector<std::string>{});
+  v.reasons = j.value("reasons", std::vector<Reason>{});
   v.measurements = j.value("measurements", std::vector<Measurement>{});
 }
 

@@ -229,7 +229,7 @@ nlohmann::json DriftRun(const eol::testing::TempDir& dir, const std::string& nam
     std::snprintf(serial, sizeof serial, "W-%03d", i);
     const db::TestRecord r = s.RunTest(serial);
     EXPECT_NE(r.outcome, Outcome::kError)
-        << serial << ": " << (r.reasons.empty() ? "" : r.reasons[0]);
+        << serial << ": " << (r.reasons.empty() ? "" : r.reasons[0].text);
   }
   return station::StatsReport(s.store(), {});
 }
