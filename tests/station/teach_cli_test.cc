@@ -179,7 +179,7 @@ TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
               std::string::npos)
         << r.out;
   }
-  path = records([](db::TestRecord& rec) { rec.kind = "self_check"; });
+  path = records([](db::TestRecord& rec) { rec.kind = db::RecordKind::kSelfCheck; });
   r = teach(path);
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("SN4 is a self_check test (a master part)"), std::string::npos) << r.out;
