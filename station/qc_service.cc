@@ -6,37 +6,19 @@ namespace eol::station {
 
 using nlohmann::json;
 
-json MaskJson(const analysis::CurveMask& m) {
-  json points = json::array();
-  for (const analysis::MaskPoint& p : m.points) {
-    json pt = {{"f_hz", p.f_hz}};
-    if (p.lo) pt["lo"] = *p.lo;
-    if (p.hi) pt["hi"] = *p.hi;
-    points.push_back(pt);
-  }
-  return {{"name", m.name},
-          {"quantity", m.quantity == analysis::MaskQuantity::kReOhm ? "re_ohm" : "abs_ohm"},
-          {"max_lines_outside", m.max_lines_outside},
-          {"guard_sigma", m.guard_sigma},
-          {"points", points}};
-}
-
 json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
                       const analysis::TeachOptions& o) {
-  json j = r.source;
-  j["version"] = r.version + 1;
-  for (json& l : j["limits"]) {
+  Recipe taught = r;
+  taught.version = r.version + 1;
+  for (analysis::MeasurementSpec& l : taught.limits) {
     for (const analysis::MeasurementSpec& spec : s.limits) {
-      if (l.at("name") != spec.name) continue;
-      if (spec.limit.lo) l["lo"] = *spec.limit.lo;
-      if (spec.limit.hi) l["hi"] = *spec.limit.hi;
-      l["marginal"] = spec.limit.marginal;
+      if (l.name != spec.name) continue;
+      if (spec.limit.lo) l.limit.lo = spec.limit.lo;
+      if (spec.limit.hi) l.limit.hi = spec.limit.hi;
+      l.limit.marginal = spec.limit.marginal;
     }
   }
-  if (!s.masks.empty()) {
-    j["masks"] = json::array();
-    for (const analysis::CurveMask& m : s.masks) j["masks"].push_back(MaskJson(m));
-  }
+  if (!s.masks.empty()) taught.masks = s.masks;
   std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
                      std::to_string(s.units_used) + " golden units (" +
                      analysis::ToString(o.method) + ", allocation " + o.allocation +
@@ -47,8 +29,8 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
   if (s.few_units_forced)
     note += " FORCED: " + std::to_string(s.units_used) + " golden units where " +
             std::to_string(s.units_needed) + " are needed.";
-  j["description"] = j.value("description", std::string()) + note;
-  return j;
+  taught.description += note;
+  return RecipeToJson(taught);
 }
 
 json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOptions& o) {

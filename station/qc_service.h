@@ -16,8 +16,6 @@
 
 namespace eol::station {
 
-nlohmann::json MaskJson(const analysis::CurveMask& mask);
-
 // The recipe's JSON with the taught limits and masks, version + 1, a note in the description.
 nlohmann::json TaughtRecipeJson(const Recipe& recipe, const analysis::TeachSummary& summary,
                                 const analysis::TeachOptions& options);
