@@ -38,6 +38,20 @@
 
 namespace eol::station {
 
+// Bounds every recipe must respect, physical and of resources: ParseRecipe refuses a recipe
+// outside them, naming the field, so a recipe can neither exhaust the station's memory or
+// time nor switch off a safety interlock by a window that passes everything.
+inline constexpr double kMaxSampleRateHz = 1.0e6;      // the fastest supported DAQ
+inline constexpr double kMinLineSpacingHz = 0.05;      // a period of at most 20 s
+inline constexpr double kMaxPeriodSamples = 1 << 21;   // samples per period (16 MiB a channel)
+inline constexpr int kMaxCrestIterations = 2000;       // crest-factor optimisation (~0.3 s)
+inline constexpr double kMaxExcitationS = 60.0;        // excitation per phase pair
+inline constexpr double kMinClampPressureBar = 0.5;    // below it the clamp does not hold
+inline constexpr double kMaxClampPressureBar = 300.0;  // hydraulic clamps included
+inline constexpr double kMaxClampPressureRatio = 2.0;  // hi / lo of the interlock window
+inline constexpr std::size_t kMaxMasks = 64;
+inline constexpr std::size_t kMaxMaskPoints = 512;
+
 struct Recipe {
   std::string id;
   int version = 0;
@@ -88,6 +102,9 @@ Recipe LoadRecipe(const std::string& path);
 nlohmann::json RecipeToJson(const Recipe& r);
 // One curve mask in the recipe's "masks" schema.
 nlohmann::json MaskJson(const analysis::CurveMask& mask);
+// One limit in the recipe's "limits" schema ({"name", "unit", "doc", "lo"?, "hi"?, "marginal"};
+// an open side is left out). Also how a taught or benched limit is reported.
+nlohmann::json LimitJson(const analysis::MeasurementSpec& spec);
 
 std::string Sha256Hex(const std::string& data);
 std::string CanonicalHash(const nlohmann::json& j);

@@ -19,6 +19,7 @@
 #include "analysis/fit/fit_json.h"
 #include "analysis/impedance_analysis.h"
 #include "analysis/model/two_mass.h"
+#include "analysis/qc/measurement_json.h"
 #include "analysis/signal/waveform.h"
 #include "analysis/signal/welch.h"
 #include "analysis/text.h"
@@ -172,20 +173,12 @@ std::string Sci(double v) {
   return os.str();
 }
 
+// The verdict in the measurement field list (analysis/qc/measurement_json.h), plus the
+// conditions the judge could not evaluate for a file.
 json VerdictJson(const Judgement& v) {
-  json ms = json::array();
-  for (const analysis::Measurement& m : v.measurements)
-    ms.push_back({{"name", m.name},
-                  {"unit", m.unit},
-                  {"value", m.value},
-                  {"sigma", m.sigma},
-                  {"lo", m.limit.lo ? json(*m.limit.lo) : json(nullptr)},
-                  {"hi", m.limit.hi ? json(*m.limit.hi) : json(nullptr)},
-                  {"outcome", analysis::ToString(m.outcome)},
-                  {"marginal", m.marginal}});
-  return {{"outcome", analysis::ToString(v.outcome)},
+  return {{"outcome", v.outcome},
           {"reasons", v.reasons},
-          {"measurements", ms},
+          {"measurements", v.measurements},
           {"conditions_not_evaluated", v.conditions_not_evaluated}};
 }
 

@@ -51,10 +51,7 @@ json SummaryJson(const analysis::ProductionBenchSummary& s, const BenchArgs& a) 
                                     {"escape_rate", esc}};
   }
   json limits = json::array();
-  for (const auto& l : s.teach.limits)
-    limits.push_back({{"name", l.name},
-                      {"lo", l.limit.lo ? json(*l.limit.lo) : json(nullptr)},
-                      {"hi", l.limit.hi ? json(*l.limit.hi) : json(nullptr)}});
+  for (const auto& l : s.teach.limits) limits.push_back(LimitJson(l));
   return {{"usable", s.usable},
           {"message", s.message},
           {"units", s.units},

@@ -49,6 +49,30 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
        "/excitation/periods: must be in [2, 1000]"},
       {[](auto& j) { j["fixture"]["clamp_pressure_bar"]["hi"] = 1.0; },
        "/fixture/clamp_pressure_bar/hi: must be greater than /fixture/clamp_pressure_bar/lo"},
+      // Issue 14: physical and resource bounds (a recipe cannot exhaust the station or switch
+      // off an interlock).
+      {[](auto& j) { j["excitation"]["sample_rate_hz"] = 1e10; },
+       "/excitation/sample_rate_hz: must be at most 1000000 Hz"},
+      {[](auto& j) { j["excitation"]["crest_iterations"] = 600000; },
+       "/excitation/crest_iterations: must be in [0, 2000]"},
+      {[](auto& j) {
+         j["excitation"]["line_spacing_hz"] = 0.1;
+         j["excitation"]["periods"] = 10;
+       },
+       "/excitation/periods: (periods + transient_periods) / line_spacing_hz is 110.0 s"},
+      {[](auto& j) {
+         j["excitation"]["sample_rate_hz"] = 900000;
+         j["excitation"]["line_spacing_hz"] = 0.25;
+       },
+       "/excitation/sample_rate_hz: gives more than 2097152 samples per period"},
+      {[](auto& j) {
+         j["fixture"]["clamp_pressure_bar"] = {{"lo", 0.001}, {"hi", 1e6}};
+       },
+       "/fixture/clamp_pressure_bar/lo: must be at least 0.5 bar"},
+      {[](auto& j) {
+         j["fixture"]["clamp_pressure_bar"] = {{"lo", 1.0}, {"hi", 9.0}};
+       },
+       "/fixture/clamp_pressure_bar/hi: must be at most 2 x /fixture/clamp_pressure_bar/lo"},
       {[](auto& j) { j["limits"][0]["name"] = "resonance_hz"; },
        "/limits/0/name: is not a measurement the analysis produces"},
       {[](auto& j) { j["limits"][1]["lo"] = 500; }, "/limits/1/hi: must be greater than lo"},
