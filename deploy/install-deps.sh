@@ -13,7 +13,7 @@ build_pkgs=(
 test_pkgs=(
   python3 python3-numpy python3-scipy python3-pymodbus python3-serial-asyncio python3-can
   can-utils socat sqlite3
-  chromium dpkg-dev pulseaudio libasound2-plugins clang-format
+  chromium dpkg-dev pulseaudio libasound2-plugins clang-format systemd
 )
 
 pkgs=("${build_pkgs[@]}")
