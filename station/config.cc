@@ -31,6 +31,17 @@ std::optional<Role> ParseRole(std::string_view text) {
   return std::nullopt;
 }
 
+std::string SimulationReason(const StationConfig& config) {
+  std::string why;
+  for (const char* part : {"fixture", "daq"}) {
+    if (!config.drivers.contains(part) || !config.drivers.at(part).is_object()) continue;
+    const std::string driver = config.drivers.at(part).value("driver", "");
+    if (driver == "sim" || driver == "replay")
+      why += (why.empty() ? "" : ", ") + std::string(part) + " driver '" + driver + "'";
+  }
+  return why;
+}
+
 StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,
                                  const std::string& base_dir) {
   using io::JsonObject;
@@ -69,12 +80,15 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       c.safety.heartbeat_timeout_ms =
           s->Number("heartbeat_timeout_ms", c.safety.heartbeat_timeout_ms);
       c.safety.poll_period_ms = s->Number("poll_period_ms", c.safety.poll_period_ms);
+      c.safety.safe_state_retry_s = s->Number("safe_state_retry_s", c.safety.safe_state_retry_s);
       s->Require(c.safety.watchdog_period_ms >= 1 && c.safety.watchdog_period_ms <= 50,
                  "watchdog_period_ms", "must be in [1, 50] ms (the reaction target is 50 ms)");
       s->Require(c.safety.heartbeat_timeout_ms >= 600, "heartbeat_timeout_ms",
                  "must be at least 600 ms (the heartbeat increments every 500 ms)");
       s->Require(c.safety.poll_period_ms >= 1 && c.safety.poll_period_ms <= 500, "poll_period_ms",
                  "must be in [1, 500] ms");
+      s->Require(c.safety.safe_state_retry_s >= 0 && c.safety.safe_state_retry_s <= 60,
+                 "safe_state_retry_s", "must be in [0, 60] s");
       s->RejectUnknown();
     }
     c.serial_from_stdin = root.Bool("serial_from_stdin", false);

@@ -12,7 +12,8 @@
 //   "fixture": {"driver": "sim" | ...},              see drivers/factory/factory.h
 //   "daq": {"driver": "sim" | ...},
 //   "sim": {...},                                    the simulated bench, when a driver is sim
-//   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500},
+//   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500, "poll_period_ms": 10,
+//              "safe_state_retry_s": 3},
 //   "serial_from_stdin": false,                      a scanner typing serials into stdin
 //   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
 //                  "every_n_tests": 50, "every_hours": 8}       optional, station/self_check.h
@@ -31,6 +32,7 @@ struct SafetyOptions {
   double watchdog_period_ms = 5.0;     // interlock poll period during excitation
   double heartbeat_timeout_ms = 1500;  // controller heartbeat must change within this
   double poll_period_ms = 10.0;        // clamp/release confirmation polling
+  double safe_state_retry_s = 3.0;     // on a fault, excitation off and unclamp retried this long
 };
 
 // What a token may do. Operators start tests; engineers also change and teach recipes.
@@ -70,6 +72,11 @@ struct StationConfig {
   SelfCheckConfig self_check;
   nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}
 };
+
+// Non-empty when the station runs on simulators or recorded data rather than a real fixture
+// and DAQ ("fixture driver 'sim'", "daq driver 'replay'"): its records are no production
+// results, and the page and every record say SIMULATION.
+std::string SimulationReason(const StationConfig& config);
 
 // Throws io::ConfigError naming the file and the JSON path.
 StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,

@@ -229,15 +229,20 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
   // A fixture that failed earlier gets a fresh connection: the station recovers by itself.
   if (fixture_.lifecycle() != drivers::Lifecycle::kInactive &&
       fixture_.lifecycle() != drivers::Lifecycle::kActive) {
-    if (const drivers::Status s = fixture_.Connect(); !s.ok())
+    if (const drivers::Status s = fixture_.Connect(); !s.ok()) {
+      board_.SetReadiness(false, "fixture unavailable: " + s.message());
       throw Fault{Outcome::kError, {ReasonCode::kFixture, "fixture unavailable: " + s.message()}};
+    }
   }
   if (daq_.lifecycle() != drivers::Lifecycle::kInactive) {
-    if (const drivers::Status s = daq_.Connect(); !s.ok())
+    if (const drivers::Status s = daq_.Connect(); !s.ok()) {
+      board_.SetReadiness(false, "acquisition unavailable: " + s.message());
       throw Fault{Outcome::kError,
                   {ReasonCode::kAcquisition, "acquisition unavailable: " + s.message()}};
+    }
   }
   const drivers::FixtureInputs in = ReadInputs("check interlocks");
+  board_.SetReadiness(true, "");
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
     throw Fault{Outcome::kError,
                 {ReasonCode::kInterlock, "fixture heartbeat frozen for " +
@@ -321,6 +326,18 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
   record.calibration["daq"] = daq_.name();
   if (watchdog_fault) throw Fault{Outcome::kError, {ReasonCode::kInterlock, *watchdog_fault}};
   ThrowIfAborted();
+  // The interlocks must still hold now that the relay is open: one that broke between the
+  // watchdog's last read and the end of the record makes the recording worthless. The
+  // heartbeat is confirmed alive by a fresh beat before the verdict (Unclamp).
+  const drivers::FixtureInputs after = ReadInputs("interlocks after excitation");
+  if (const std::string why = InterlockFault(after, *recipe_, true); !why.empty())
+    throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock after excitation: " + why}};
+  if (!heartbeat_.Update(after.heartbeat, Clock::now()))
+    throw Fault{Outcome::kError,
+                {ReasonCode::kInterlock, "fixture heartbeat frozen for " +
+                                             Fixed(heartbeat_.stale_ms(Clock::now()), 0) +
+                                             " ms at the end of excitation"}};
+  beat_after_excitation_ = after.heartbeat;
   if (!result->ok())
     throw Fault{Outcome::kError,
                 {ReasonCode::kAcquisition, "acquisition failed: " + result->status().message()}};
@@ -372,8 +389,24 @@ void Sequencer::Unclamp(db::TestRecord& record) {
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(recipe_->release_timeout_s));
-  while (!ReadInputs("confirm release").released) {
-    if (Clock::now() > deadline)
+  // Before the verdict is published the controller must prove it was alive at the end of
+  // excitation: a heartbeat newer than the one read when the relay opened (a freeze near the
+  // end of excitation is shorter than the watchdog's timeout and would pass unseen).
+  bool released = false;
+  bool fresh_beat = !beat_after_excitation_;
+  for (;;) {
+    const drivers::FixtureInputs in = ReadInputs("confirm release");
+    const auto now = Clock::now();
+    released = released || in.released;
+    fresh_beat = fresh_beat || in.heartbeat != *beat_after_excitation_;
+    if (!fresh_beat && !heartbeat_.Update(in.heartbeat, now))
+      throw Fault{Outcome::kError,
+                  {ReasonCode::kInterlock, "fixture heartbeat frozen for " +
+                                               Fixed(heartbeat_.stale_ms(now), 0) +
+                                               " ms after excitation: its inputs during the "
+                                               "test cannot be trusted"}};
+    if (released && fresh_beat) break;
+    if (!released && now > deadline)
       throw Fault{Outcome::kError,
                   {ReasonCode::kFixture,
                    "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s"}};
@@ -383,33 +416,64 @@ void Sequencer::Unclamp(db::TestRecord& record) {
   (void)fixture_.Deactivate();
 }
 
+// Excitation off, then the clamp released when that is safe. On a communication loss both
+// are retried (reconnecting; a fresh connection drives excitation off first) until they are
+// confirmed or safety.safe_state_retry_s has passed; what could not be confirmed is named.
 void Sequencer::SafeState(db::TestRecord& record) {
   Enter(record, SeqState::kSafeState, record.reasons.empty() ? "" : record.reasons.front().text);
+  const auto give_up =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(options_.safety.safe_state_retry_s));
+  const auto pause =
+      std::chrono::duration<double, std::milli>(std::max(options_.safety.poll_period_ms, 50.0));
   // 1. Excitation off, always first, whatever state the fixture is in.
-  if (const drivers::Status s = fixture_.Write(FixtureOutput::kExcitationEnable, false); !s.ok())
+  int attempts = 0;
+  drivers::Status off = drivers::Status::Ok();
+  for (;;) {
+    ++attempts;
+    off = fixture_.lifecycle() == drivers::Lifecycle::kError
+              ? fixture_.Connect()  // a fresh connection drives excitation off first
+              : fixture_.Write(FixtureOutput::kExcitationEnable, false);
+    if (off.ok() || Clock::now() >= give_up) break;
+    std::this_thread::sleep_for(pause);
+  }
+  if (!off.ok())
     record.reasons.push_back(
-        {ReasonCode::kFixture, "excitation-off command failed: " + s.message() +
+        {ReasonCode::kFixture, "excitation off not confirmed after " + std::to_string(attempts) +
+                                   " attempts: " + off.message() +
                                    " (the relay is wired to drop on controller loss)"});
   // 2. Unclamp only when it is safe: the controller answers, nobody is at the door, the
   //    emergency-stop chain is healthy. Otherwise leave the part clamped and say so.
-  auto in = fixture_.ReadInputs();
   std::string unsafe;
   ReasonCode code = ReasonCode::kInterlock;
-  if (!in.ok()) {
-    unsafe = "fixture not answering";
-    code = ReasonCode::kFixture;
-  } else if (!in.value().estop_ok) {
-    unsafe = "emergency stop open";
-  } else if (!in.value().door_closed) {
-    unsafe = "door open";
+  for (;;) {
+    if (fixture_.lifecycle() == drivers::Lifecycle::kError) (void)fixture_.Connect();
+    auto in = fixture_.ReadInputs();
+    if (!in.ok()) {
+      unsafe = "fixture not answering (" + in.status().message() + ")";
+      code = ReasonCode::kFixture;
+      if (Clock::now() < give_up) {
+        std::this_thread::sleep_for(pause);
+        continue;
+      }
+    } else if (!in.value().estop_ok) {
+      unsafe = "emergency stop open";
+    } else if (!in.value().door_closed) {
+      unsafe = "door open";
+    } else {
+      unsafe.clear();
+      (void)fixture_.Activate();
+      const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false);
+      if (!s.ok() && Clock::now() < give_up) {
+        std::this_thread::sleep_for(pause);
+        continue;
+      }
+      if (!s.ok())
+        record.reasons.push_back({ReasonCode::kFixture, "unclamp not confirmed: " + s.message()});
+    }
+    break;
   }
-  if (!unsafe.empty()) {
-    record.reasons.push_back({code, "clamp left as it is: " + unsafe});
-  } else {
-    (void)fixture_.Activate();
-    const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false);
-    if (!s.ok()) record.reasons.push_back({ReasonCode::kFixture, "unclamp failed: " + s.message()});
-  }
+  if (!unsafe.empty()) record.reasons.push_back({code, "clamp left as it is: " + unsafe});
   (void)fixture_.Deactivate();
 }
 
@@ -435,6 +499,7 @@ void Sequencer::StoreAndPublish(db::TestRecord& record) {
 db::TestRecord Sequencer::RunTest(const std::string& serial) {
   test_start_ = Clock::now();
   abort_.store(stop_requested_.load());
+  beat_after_excitation_.reset();
   db::TestRecord record;
   record.serial = serial;
   record.station_id = options_.station_id;
@@ -444,6 +509,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
   record.software_version = SoftwareVersion();
   record.started_at = db::UtcNowIso8601();
   record.outcome = analysis::Outcome::kError;
+  if (!options_.simulation.empty()) record.conditions["simulation"] = options_.simulation;
   Enter(record, SeqState::kWaitSerial, "serial " + serial + " received");
   const std::optional<std::string> master = MasterRole(options_.self_check, serial);
   if (master) record.kind = db::RecordKind::kSelfCheck;

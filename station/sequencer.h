@@ -68,6 +68,9 @@ std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& recip
 
 struct SequencerOptions {
   std::string station_id = "eol-1";
+  // Non-empty on simulators (station/config.h SimulationReason): every record carries
+  // conditions.simulation with this text.
+  std::string simulation;
   SafetyOptions safety;
   // Called with the serial before the interlock check (the simulated operator loads a part).
   std::function<void(const std::string& serial)> on_serial;
@@ -125,6 +128,8 @@ class Sequencer {
   SequencerOptions options_;
   analysis::Excitation excitation_;  // designed from the recipe
   HeartbeatMonitor heartbeat_;
+  // The heartbeat read right after the last excitation ended; Unclamp waits for a newer one.
+  std::optional<std::uint32_t> beat_after_excitation_;
 
   std::atomic<SeqState> state_{SeqState::kWaitSerial};
   std::atomic<bool> stop_requested_{false};  // sticky: RequestAbort() was called

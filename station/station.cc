@@ -4,15 +4,53 @@
 
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
+#include "analysis/text.h"
 #include "db/clock.h"
 #include "station/systemd_notify.h"
 
 namespace eol::station {
 
+namespace {
+
+// The configured recipe; when it does not load, the newest kept version beside it that does
+// (<stem>.v<N>.json, kept by ChangeRecipe), with `problem` saying so. Throws the configured
+// file's ConfigError when no kept version loads either.
+Recipe LoadRecipeOrLastGood(const std::string& path, std::string* problem) {
+  namespace fs = std::filesystem;
+  try {
+    return LoadRecipe(path);
+  } catch (const io::ConfigError& e) {
+    const fs::path p(path);
+    const std::string prefix = p.stem().string() + ".v";
+    std::optional<std::pair<int, fs::path>> newest;
+    std::error_code ec;
+    for (const auto& entry :
+         fs::directory_iterator(p.parent_path().empty() ? "." : p.parent_path(), ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind(prefix, 0) != 0 || entry.path().extension() != ".json") continue;
+      const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - 5);
+      if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      const int v = std::stoi(digits);
+      if (!newest || v > newest->first) newest = {v, entry.path()};
+    }
+    if (!newest) throw;
+    Recipe last = LoadRecipe(newest->second.string());
+    *problem = std::string(e.what()) + "; tests are refused until a valid recipe is installed " +
+               "(PUT /api/recipe or a fixed file and a restart); the last good version v" +
+               std::to_string(last.version) + " (" + newest->second.string() + ") is shown";
+    return last;
+  }
+}
+
+}  // namespace
+
 Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
     : config_(std::move(config)) {
-  recipe_ = std::make_shared<const Recipe>(LoadRecipe(config_.recipe_path));
+  recipe_ =
+      std::make_shared<const Recipe>(LoadRecipeOrLastGood(config_.recipe_path, &recipe_problem_));
+  if (!recipe_problem_.empty()) spdlog::error("{}", recipe_problem_);
   spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_->id, recipe_->version, config_.recipe_path,
                recipe_->hash.substr(0, 12));
   store_ = db::Store::Open(config_.db_path);
@@ -21,16 +59,30 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
                  config_.db_path, store_->aborted_on_open());
   drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench));
   board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_->id, recipe_->hash);
+  std::string not_ready;
   if (const drivers::Status s = drivers_.fixture->Connect(); !s.ok()) {
     spdlog::error("{} (will retry at the next test)", s.message());
     board_->SetMessage(s.message());
+    not_ready = s.message();
   }
   if (const drivers::Status s = drivers_.daq->Connect(); !s.ok()) {
     spdlog::error("{} (will retry at the next test)", s.message());
     board_->SetMessage(s.message());
+    not_ready += (not_ready.empty() ? "" : "; ") + s.message();
+  }
+  if (!recipe_problem_.empty()) {
+    board_->SetMessage(recipe_problem_);
+    not_ready += (not_ready.empty() ? "" : "; ") + std::string("recipe does not load");
+  }
+  board_->SetReadiness(not_ready.empty(), not_ready);
+  const std::string simulation = SimulationReason(config_);
+  if (!simulation.empty()) {
+    spdlog::warn("SIMULATION ({}): records are marked and are no production results", simulation);
+    board_->SetSimulation(simulation);
   }
   SequencerOptions opts;
   opts.station_id = config_.station_id;
+  opts.simulation = simulation;
   opts.safety = config_.safety;
   opts.self_check = config_.self_check;
   if (drivers_.bench && drivers_.bench->settings().load_part_on_serial) {
@@ -89,6 +141,14 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   } catch (const io::ConfigError& e) {
     return refused(RecipeChange::Kind::kInvalid, e.what());
   }
+  // Everything the new recipe needs is built before anything is renamed, audited or swapped:
+  // a recipe whose excitation cannot be designed leaves the station as it was.
+  try {
+    (void)analysis::DesignMultisine(next->excitation);
+  } catch (const std::exception& e) {
+    return refused(RecipeChange::Kind::kInvalid,
+                   std::string("PUT /api/recipe: /excitation: cannot be designed: ") + e.what());
+  }
   // Holding the queue lock keeps the sequencer idle until the new recipe is in place.
   std::lock_guard<std::mutex> queue_lock(queue_mu_);
   if (running_test_ || !queue_.empty())
@@ -135,6 +195,11 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
     std::lock_guard<std::mutex> lock(recipe_mu_);
     recipe_ = next;
   }
+  if (!recipe_problem_.empty()) {  // under queue_mu_, as Enqueue reads it
+    recipe_problem_.clear();
+    board_->SetMessage("");
+    board_->SetReadiness(true, "");
+  }
   sequencer_->SetRecipe(next);
   board_->SetRecipe(next->id, next->hash);
   spdlog::warn("recipe {} changed by {} ({}): v{} {} -> v{} {}", next->id, who.name,
@@ -152,6 +217,8 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   return changed;
 }
 
+bool Station::ready() const { return board_->Snapshot().value("ready", false); }
+
 int Station::http_port() const { return http_ ? http_->port() : 0; }
 
 db::TestRecord Station::RunTest(const std::string& serial) { return sequencer_->RunTest(serial); }
@@ -160,6 +227,10 @@ bool Station::Enqueue(const std::string& serial, std::string* why) {
   std::lock_guard<std::mutex> lock(queue_mu_);
   if (stop_) {
     *why = "station is stopping";
+    return false;
+  }
+  if (!recipe_problem_.empty()) {
+    *why = recipe_problem_;
     return false;
   }
   if (running_test_ || !queue_.empty()) {
@@ -171,24 +242,75 @@ bool Station::Enqueue(const std::string& serial, std::string* why) {
   return true;
 }
 
+// A deadline no healthy test reaches: the excitation of every phase pair, the clamp and
+// release timeouts, the safe state's retries, and a generous allowance for analysis and I/O.
+double TestDeadlineS(const Recipe& r, const SafetyOptions& safety) {
+  const double excite_s =
+      static_cast<double>(r.transient_periods + r.periods) / r.excitation.line_spacing_hz;
+  const double per_pair_s = excite_s + 10.0;
+  return static_cast<double>(r.phase_pairs.size()) * per_pair_s + r.clamp_timeout_s +
+         r.release_timeout_s + safety.safe_state_retry_s + 30.0;
+}
+
 void Station::Serve() {
+  std::atomic<bool> serving{true};
+  std::thread health([&] { HealthLoop(serving); });
+  ServeQueue();
+  serving = false;
+  health.join();
+}
+
+// systemd's watchdog is fed from the daemon's health, not from the serial loop: the station
+// is healthy while it waits for a serial, and while the test in flight is within its own
+// deadline (TestDeadlineS). A test past its deadline is stuck: excitation off, the operator
+// told, and the pings stop so systemd restarts the daemon (the store records the test as
+// ABORTED when it reopens).
+void Station::HealthLoop(const std::atomic<bool>& serving) {
+  bool reported = false;
+  while (serving) {
+    std::string stuck;
+    {
+      std::lock_guard<std::mutex> lock(queue_mu_);
+      if (running_test_) {
+        const double running_s =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - test_started_).count();
+        if (running_s > test_deadline_s_)
+          stuck = "test of " + running_serial_ + " running for " + analysis::Fixed(running_s, 0) +
+                  " s, beyond its deadline of " + analysis::Fixed(test_deadline_s_, 0) + " s";
+      }
+    }
+    if (stuck.empty()) {
+      NotifyWatchdog();
+      reported = false;
+    } else if (!reported) {
+      (void)drivers_.fixture->Write(drivers::FixtureOutput::kExcitationEnable, false);
+      spdlog::error("{}: excitation off, watchdog pings stopped (systemd restarts the daemon)",
+                    stuck);
+      board_->SetMessage(stuck + "; call maintenance");
+      reported = true;
+    }
+    for (int i = 0; i < 10 && serving; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+}
+
+void Station::ServeQueue() {
   while (true) {
     std::string serial;
     {
       std::unique_lock<std::mutex> lock(queue_mu_);
-      // Wakes at least every second to tell systemd's watchdog the loop is alive; a test that
-      // hangs stops the pings and gets the daemon restarted.
       int idle_s = 0;
       while (!queue_cv_.wait_for(lock, std::chrono::seconds(1),
                                  [&] { return stop_ || !queue_.empty(); })) {
-        NotifyWatchdog();
         if (++idle_s % 60 == 0) sequencer_->PublishLockout();  // a check falls due with time
       }
-      NotifyWatchdog();
       if (stop_) return;
       serial = queue_.front();
       queue_.pop_front();
       running_test_ = true;
+      running_serial_ = serial;
+      test_started_ = std::chrono::steady_clock::now();
+      test_deadline_s_ = TestDeadlineS(*recipe(), config_.safety);
     }
     const db::TestRecord r = sequencer_->RunTest(serial);
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),

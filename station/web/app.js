@@ -169,9 +169,25 @@ function renderLockout(lockout) {
   el.textContent = el.hidden ? "" : "LOCKED OUT: " + lockout.reason;
 }
 
+// A station on simulators or recorded data: nothing it shows is a production result.
+function renderSimulation(why) {
+  const el = $("simulation");
+  el.hidden = !why;
+  el.textContent = why ? "SIMULATION: " + why + ", not production results" : "";
+}
+
+// Ready: the fixture and the DAQ answered.
+function renderReadiness(ready, why) {
+  const el = $("not-ready");
+  el.hidden = ready !== false;
+  el.textContent = el.hidden ? "" : "NOT READY: " + why;
+}
+
 async function refreshStatus() {
   const s = await getJson("/api/status");
   renderLockout(s.lockout);
+  renderSimulation(s.simulation);
+  renderReadiness(s.ready, s.not_ready_reason);
   $("station").textContent = "EOL station " + s.station_id;
   $("message").textContent = s.message || "";
   renderHistory(s);
@@ -208,6 +224,10 @@ async function main() {
     refreshStatus().catch(() => {});
   });
   events.addEventListener("lockout", ev => { renderLockout(JSON.parse(ev.data).lockout); });
+  events.addEventListener("readiness", ev => {
+    const e = JSON.parse(ev.data);
+    renderReadiness(e.ready, e.not_ready_reason);
+  });
   events.addEventListener("message", ev => { $("message").textContent = JSON.parse(ev.data).message; });
 }
 

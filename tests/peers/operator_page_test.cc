@@ -81,6 +81,9 @@ TEST(OperatorPage, ShowsVerdictCurveAndFollowsTestsLive) {
   EXPECT_EQ(j["first"]["model"], 1);
   EXPECT_GE(j["first"]["masks"].get<int>(), 1) << "the recipe's mask is not drawn";
   EXPECT_EQ(j["first"]["measurements"], 6);
+  // The station runs on its simulators: the page says so, unmissably (issue 14).
+  EXPECT_NE(j["first"]["simulation"].get<std::string>().find("SIMULATION"), std::string::npos)
+      << j["first"];
   EXPECT_EQ(j["second"]["serial"], "PAGE-0002");
   EXPECT_EQ(j["second"]["connection"], "live");
   EXPECT_TRUE(j["page_errors"].empty()) << j["page_errors"];
