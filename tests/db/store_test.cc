@@ -696,5 +696,31 @@ TEST_F(StoreMigrationTest, AuditLogRoundTripsNewestFirst) {
   EXPECT_EQ(log[1].old_hash, std::string(64, 'a'));
 }
 
+// One station per database: a second writer is refused before it recovers (aborts) the
+// first one's running test; readers are not affected.
+TEST_F(StoreTest, ASecondWriterIsRefusedWhileTheFirstIsOpen) {
+  auto first = Open();
+  TestRecord running;
+  running.serial = "RUN-1";
+  running.station_id = "s1";
+  running.recipe_id = "r";
+  running.recipe_hash = std::string(64, 'a');
+  running.software_version = "t";
+  running.started_at = "2026-11-20T08:00:00.000Z";
+  first->BeginTest(running);
+  try {
+    Store::Open(path_.string());
+    ADD_FAILURE() << "a second writer opened the store";
+  } catch (const StoreError& e) {
+    EXPECT_EQ(std::string(e.what()), "store '" + path_.string() +
+                                         "': lock: another station holds " + path_.string() +
+                                         ".lock (one station per database; stop the other first)");
+  }
+  EXPECT_NO_THROW(Store::Open(path_.string(), Store::Role::kReader));
+  first.reset();
+  auto second = Open();
+  EXPECT_EQ(second->aborted_on_open(), 1) << "the lock is released with the first store";
+}
+
 }  // namespace
 }  // namespace eol::db
