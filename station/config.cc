@@ -1,5 +1,7 @@
 #include "station/config.h"
 
+#include <arpa/inet.h>
+
 #include <filesystem>
 
 #include "drivers/io/json_config.h"
@@ -7,6 +9,15 @@
 
 namespace eol::station {
 namespace {
+
+// 127.0.0.0/8, ::1 and "localhost": addresses only this host can reach.
+bool IsLoopback(const std::string& host) {
+  if (host == "localhost") return true;
+  in_addr v4{};
+  if (inet_pton(AF_INET, host.c_str(), &v4) == 1) return (ntohl(v4.s_addr) >> 24) == 127;
+  in6_addr v6{};
+  return inet_pton(AF_INET6, host.c_str(), &v6) == 1 && IN6_IS_ADDR_LOOPBACK(&v6);
+}
 
 std::string Resolve(const std::string& base_dir, const std::string& p) {
   if (p.empty() || std::filesystem::path(p).is_absolute() || base_dir.empty()) return p;
@@ -74,6 +85,11 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
         }
       }
       http->RejectUnknown();
+      // Without tokens anyone who reaches the port may start tests: only this host may.
+      if (c.tokens.empty() && !IsLoopback(c.http_listen))
+        throw io::ConfigError(http->PathOf("listen") + ": \"" + c.http_listen +
+                              "\" listens beyond this host, which needs \"tokens\" (none are "
+                              "configured); listen on 127.0.0.1 or configure tokens");
     }
     if (auto s = root.OptionalObject("safety")) {
       c.safety.watchdog_period_ms = s->Number("watchdog_period_ms", c.safety.watchdog_period_ms);

@@ -8,7 +8,8 @@
 //            "tokens": [{"name": "line1-operator", "role": "operator", "token": "..."},
 //                       {"name": "qe-anna", "role": "engineer", "token": "..."}]},
 //     Reads need no token. With tokens configured, starting a test needs an operator or
-//     engineer token; changing the recipe always needs an engineer token.
+//     engineer token; changing the recipe always needs an engineer token. Listening beyond
+//     loopback (anything but 127.0.0.0/8, ::1, localhost) needs tokens: refused otherwise.
 //   "fixture": {"driver": "sim" | ...},              see drivers/factory/factory.h
 //   "daq": {"driver": "sim" | ...},
 //   "sim": {...},                                    the simulated bench, when a driver is sim

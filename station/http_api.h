@@ -37,19 +37,17 @@
 #include <vector>
 
 #include "station/config.h"
+#include "station/http/limits.h"
 #include "station/recipe.h"
 #include "station/recipe_change.h"
 #include "station/status_board.h"
-
-namespace httplib {
-class Server;
-}
 
 namespace eol::station {
 
 namespace http {
 struct ApiContext;
-}
+class ApiServer;
+}  // namespace http
 
 struct HttpOptions {
   std::string listen = "127.0.0.1";
@@ -57,7 +55,8 @@ struct HttpOptions {
   std::string db_path;
   // Empty: starting tests needs no token. Recipe changes always need an engineer token.
   std::vector<ApiToken> tokens;
-  std::string web_root;  // folder of the operator page; empty: built-in fallback page
+  std::string web_root;       // folder of the operator page; empty: built-in fallback page
+  http::ServerLimits limits;  // workers, streams, deadlines (station/http/server.h)
 };
 
 // What the API asks of the station.
@@ -86,7 +85,7 @@ class HttpApi {
 
  private:
   std::unique_ptr<http::ApiContext> context_;
-  std::unique_ptr<httplib::Server> server_;
+  std::unique_ptr<http::ApiServer> server_;
   std::thread thread_;
   int port_ = 0;
 };

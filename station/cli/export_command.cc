@@ -64,11 +64,11 @@ void WriteCsv(std::ostream& out, const std::vector<db::TestRecord>& tests) {
 }
 
 int RunExport(const ExportArgs& a) {
-  auto store = db::Store::Open(a.db, db::Store::Role::kReader);
+  auto store = db::Store::Open(a.db, db::Store::Role::kReadOnly);
   db::TestQuery q;
   if (!a.serial.empty()) q.serial = a.serial;
-  if (!a.from.empty()) q.from = a.from;
-  if (!a.to.empty()) q.to = a.to;
+  if (!a.from.empty()) q.from = IsoOption("--from", a.from);
+  if (!a.to.empty()) q.to = IsoOption("--to", a.to);
   q.limit = a.limit;
   q.with_curves = a.format == "json";
   const std::vector<db::TestRecord> tests = store->Tests(q);
@@ -104,8 +104,10 @@ void AddExportCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--serial", args->serial, "Only this serial");
-  cmd->add_option("--from", args->from, "Started at or after (ISO 8601 UTC)");
-  cmd->add_option("--to", args->to, "Started before (ISO 8601 UTC)");
+  cmd->add_option("--from", args->from,
+                  "Started at or after (ISO 8601: a date, or a time with Z or an offset)");
+  cmd->add_option("--to", args->to,
+                  "Started before (ISO 8601: a date, or a time with Z or an offset)");
   cmd->add_option("--format", args->format, "csv or json")
       ->capture_default_str()
       ->check(CLI::IsMember({"csv", "json"}));

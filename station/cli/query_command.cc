@@ -21,7 +21,7 @@ struct QueryArgs {
 int RunQuery(const QueryArgs& a) {
   std::string why;
   if (!ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
-  auto store = db::Store::Open(a.db, db::Store::Role::kReader);
+  auto store = db::Store::Open(a.db, db::Store::Role::kReadOnly);
   const std::vector<db::TestRecord> tests = store->TestsOfSerial(a.serial, a.curves);
   if (a.json) {
     nlohmann::json list = nlohmann::json::array();

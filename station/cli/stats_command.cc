@@ -64,8 +64,8 @@ void PrintText(const nlohmann::json& r) {
 int RunStats(const StatsArgs& a) {
   StatsRequest req;
   if (!a.recipe_hash.empty()) req.recipe_hash = a.recipe_hash;
-  if (!a.from.empty()) req.from = a.from;
-  if (!a.to.empty()) req.to = a.to;
+  if (!a.from.empty()) req.from = IsoOption("--from", a.from);
+  if (!a.to.empty()) req.to = IsoOption("--to", a.to);
   if (!a.gauge.empty()) req.gauge_serial = a.gauge;
   req.gauge.sigma_span = a.sigma_span;
   req.drift.alarm_t = a.drift_t;
@@ -74,7 +74,7 @@ int RunStats(const StatsArgs& a) {
     if (!ParseReference(r, req.reference, &why)) throw std::runtime_error("--reference: " + why);
   if (const std::string bad = ValidateStatsRequest(req); !bad.empty())
     throw std::runtime_error(bad);
-  auto store = db::Store::Open(a.db, db::Store::Role::kReader);
+  auto store = db::Store::Open(a.db, db::Store::Role::kReadOnly);
   const nlohmann::json report = StatsReport(*store, req);
   if (a.json)
     std::cout << report.dump(2) << std::endl;

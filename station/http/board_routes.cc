@@ -5,7 +5,7 @@
 #include "station/http/routes.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
-#include <httplib.h>
+#include "station/http/server.h"
 
 namespace eol::station::http {
 namespace {
@@ -15,6 +15,13 @@ void GetStatus(ApiContext& c, const httplib::Request&, httplib::Response& res) {
 }
 
 void GetEvents(ApiContext& c, const httplib::Request&, httplib::Response& res) {
+  // A stream holds its connection for as long as the page is open: its thread leaves the
+  // request workers (station/http/server.h), up to a maximum of streams.
+  if (!BecomeStream())
+    return Send(
+        res, ApiError{ApiErrorKind::kUnavailable, "too_many_streams",
+                      "the station serves at most " + std::to_string(c.options.limits.max_streams) +
+                          " event streams at once; close one (another tab?)"});
   auto last = std::make_shared<std::uint64_t>(c.board.last_event());
   res.set_header("Cache-Control", "no-cache");
   res.set_chunked_content_provider(
@@ -77,10 +84,10 @@ void GetOperatorPage(ApiContext& c, const httplib::Request&, httplib::Response& 
 }  // namespace
 
 void AddBoardRoutes(httplib::Server& s, ApiContext& c) {
-  s.Get("/api/status", Bind(c, GetStatus));
-  s.Get("/api/events", Bind(c, GetEvents));
-  s.Get("/metrics", Bind(c, GetMetrics));
-  s.Get("/", Bind(c, GetOperatorPage));
+  Route(s, c, "GET", "/api/status", GetStatus);
+  Route(s, c, "GET", "/api/events", GetEvents);
+  Route(s, c, "GET", "/metrics", GetMetrics);
+  Route(s, c, "GET", "/", GetOperatorPage);
   if (!c.options.web_root.empty()) s.set_mount_point("/static", c.options.web_root);
 }
 

@@ -1,8 +1,5 @@
 // Quality engineering: capability and gauge statistics, detectability of defect classes, and
 // limits taught from stored good units.
-#include <cmath>
-#include <cstdlib>
-
 #include "station/http/request.h"
 #include "station/http/routes.h"
 #include "station/stats_report.h"
@@ -19,8 +16,8 @@ ApiError BadRequest(std::string code, std::string message) {
 
 void GetStats(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   StatsRequest q;
-  if (req.has_param("from")) q.from = req.get_param_value("from");
-  if (req.has_param("to")) q.to = req.get_param_value("to");
+  for (const auto& e : {TimeParam(req, "from", &q.from), TimeParam(req, "to", &q.to)})
+    if (e) return Send(res, *e);
   if (req.has_param("recipe_hash")) q.recipe_hash = req.get_param_value("recipe_hash");
   if (req.has_param("gauge")) q.gauge_serial = req.get_param_value("gauge");
   std::string why;
@@ -44,20 +41,13 @@ void GetStats(ApiContext& c, const httplib::Request& req, httplib::Response& res
 }
 
 void GetDetectability(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
+  // Fixtures measured so far are near 1e3 N m/rad; the range allows four decades each way
+  // and keeps the model's arithmetic finite (k_fixture=1e308 used to give a 500).
   double k_fixture = 0.0, limit_sigmas = 3.0, required_sigmas = 3.0;
-  for (auto [name, target] : {std::pair<const char*, double*>{"k_fixture", &k_fixture},
-                              {"limit_sigmas", &limit_sigmas},
-                              {"required_sigmas", &required_sigmas}}) {
-    if (!req.has_param(name)) continue;
-    const std::string v = req.get_param_value(name);
-    char* end = nullptr;
-    const double x = std::strtod(v.c_str(), &end);
-    if (v.empty() || *end != '\0' || !(x > 0.0) || !std::isfinite(x))
-      return Send(res,
-                  BadRequest("bad_parameter",
-                             std::string(name) + " must be a positive number, got '" + v + "'"));
-    *target = x;
-  }
+  for (const auto& e : {NumberParam(req, "k_fixture", 0.1, 1e7, &k_fixture),
+                        NumberParam(req, "limit_sigmas", 0.5, 20.0, &limit_sigmas),
+                        NumberParam(req, "required_sigmas", 0.5, 20.0, &required_sigmas)})
+    if (e) return Send(res, *e);
   const auto recipe = c.handlers.current_recipe();
   const analysis::DetectabilitySummary summary = analysis::PredictDetectability(
       DetectabilityOptionsFor(*recipe, k_fixture, limit_sigmas, required_sigmas));
@@ -118,9 +108,9 @@ HttpReply TeachReply(const TeachResult& result) {
 }
 
 void AddQcRoutes(httplib::Server& s, ApiContext& c) {
-  s.Get("/api/stats", Bind(c, GetStats));
-  s.Get("/api/detectability", Bind(c, GetDetectability));
-  s.Post("/api/teach", Bind(c, PostTeach));
+  Route(s, c, "GET", "/api/stats", GetStats);
+  Route(s, c, "GET", "/api/detectability", GetDetectability);
+  Route(s, c, "POST", "/api/teach", PostTeach);
 }
 
 }  // namespace eol::station::http

@@ -1,7 +1,9 @@
 // `eol query` and `eol export` on a real store, through the binary.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -111,6 +113,55 @@ TEST_F(QueryExportTest, ExportJsonBySerialAndTimeRange) {
 TEST_F(QueryExportTest, MissingDatabaseNamesThePath) {
   const CliRun r = Eol({"export", "--db", dir_ / "missing.sqlite"});
   EXPECT_NE(r.code, 0);
+}
+
+// Everything in `dir`: names, sizes and contents, to see that a command changed nothing.
+std::map<std::string, std::string> Snapshot(const std::string& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    std::ifstream in(e.path(), std::ios::binary);
+    files[e.path().filename().string()] =
+        std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  return files;
+}
+
+TEST_F(QueryExportTest, ReadOnlyCommandsNeverModifyTheDatabase) {
+  const auto before = Snapshot(dir_.path());
+  EXPECT_EQ(Eol({"query", "--db", db_, "--serial", "SN-1", "--json"}).code, 0);
+  EXPECT_EQ(Eol({"export", "--db", db_, "--format", "csv"}).code, 0);
+  EXPECT_EQ(Eol({"stats", "--db", db_}).code, 0);
+  EXPECT_TRUE(Snapshot(dir_.path()) == before) << "a read-only command changed " << dir_.path();
+}
+
+TEST(ReadOnlyCommands, AFileThatIsNotAStoreIsRefusedAndLeftAlone) {
+  eol::testing::TempDir dir;
+  std::ofstream(dir / "empty.sqlite").close();
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"query", "--db", dir / "empty.sqlite", "--serial", "A-1"},
+        std::vector<std::string>{"export", "--db", dir / "empty.sqlite"},
+        std::vector<std::string>{"stats", "--db", dir / "empty.sqlite"}}) {
+    const CliRun r = testing::RunEol(args, true, 60s);
+    EXPECT_EQ(r.code, 2) << args[0] << ": " << r.out;
+    EXPECT_NE(r.out.find("not an EOL test store"), std::string::npos) << args[0] << ": " << r.out;
+  }
+  EXPECT_EQ(std::filesystem::file_size(dir / "empty.sqlite"), 0u) << "a schema was written";
+  EXPECT_EQ(Snapshot(dir.path()).size(), 1u) << "journal files were created";
+}
+
+TEST(CliExitCodes, UsageErrorsExitTwo) {
+  eol::testing::TempDir dir;
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{}, std::vector<std::string>{"query", "--no-such-option"},
+        std::vector<std::string>{"query", "--serial", "A-1"},
+        std::vector<std::string>{"query", "--db", dir / "missing.sqlite", "--serial", "A-1"},
+        std::vector<std::string>{"export", "--db", dir / "missing.sqlite", "--limit", "10abc"},
+        std::vector<std::string>{"no-such-command"}}) {
+    const CliRun r = testing::RunEol(args, true, 60s);
+    EXPECT_EQ(r.code, 2) << (args.empty() ? "(none)" : args[0]) << ": " << r.out;
+  }
+  EXPECT_EQ(testing::RunEol({"query", "--help"}, true, 60s).code, 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "missing.sqlite"));
 }
 
 }  // namespace
