@@ -533,12 +533,11 @@ std::unique_ptr<Store> Store::Open(const std::string& path, Role role) {
                                          " (one station per database; stop the other first)"
                                    : "cannot lock " + lock_path + ": " + std::strerror(errno)));
   }
-  const int rc =
-      role == Role::kReadOnly
-          ? sqlite3_open_v2(ReadOnlyUri(path).c_str(), &store->db_,
-                            SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr)
-          : sqlite3_open_v2(path.c_str(), &store->db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
-                            nullptr);
+  const int rc = role == Role::kReadOnly
+                     ? sqlite3_open_v2(ReadOnlyUri(path).c_str(), &store->db_,
+                                       SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr)
+                     : sqlite3_open_v2(path.c_str(), &store->db_,
+                                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
   if (rc != SQLITE_OK) {
     const std::string detail =
         store->db_ != nullptr ? sqlite3_errmsg(store->db_) : sqlite3_errstr(rc);

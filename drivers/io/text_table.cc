@@ -145,7 +145,6 @@ std::vector<std::string> ReadCsvHeader(const std::string& path) {
   throw FileError(path, 0, 0, "file is empty (no header line)");
 }
 
-
 CsvTable ReadCsvTable(const std::string& path) {
   LineReader in(path);
   CsvTable t;
