@@ -120,6 +120,8 @@ bool DetectabilityOptions::IsValid(std::string* why) const {
     if (!(s >= 0.0 && std::isfinite(s))) return fail("unit spread of " + name + " must be >= 0");
   for (double f : bond_fractions)
     if (!(f > 0.0 && f <= 1.0)) return fail("bond fractions must be in (0, 1]");
+  for (double a : pod_losses)
+    if (!(a > 0.0 && a < 1.0)) return fail("pod losses must be in (0, 1)");
   if (!(required_sigmas > 0.0)) return fail("required_sigmas must be positive");
   return true;
 }
@@ -251,6 +253,44 @@ DetectabilitySummary PredictDetectability(const DetectabilityOptions& o) {
     }
     s.classes.push_back(p);
   }
+  for (const char* which : {"one_magnet", "all_magnets"}) {
+    ModelPod pod;
+    pod.name = which;
+    pod.a90 = std::nan("");
+    for (double a : o.pod_losses) {
+      RotorChainParams p = o.rotor;
+      p.bond_poor = {o.rotor.bond.stiffness_nm_per_rad * (1.0 - a),
+                     o.rotor.bond.damping_nms_per_rad * (1.0 - a)};
+      p.soft_magnets.clear();
+      const int soft = std::string(which) == "one_magnet" ? 1 : p.magnets;
+      for (int i = 0; i < soft; ++i) p.soft_magnets.push_back(i);
+      const Expected d = ctx.Evaluate(p);
+      ModelPodPoint pt;
+      pt.loss = a;
+      if (!d.analysis.usable) {
+        pt.pod = 1.0;
+        pt.best = "fit (ERROR)";
+      } else {
+        pt.f0_hz = d.analysis.fit.Find("f0_hz")->value;
+        for (const auto& m : Separate(o, good, d, 1.0, 1.0))
+          if (1.0 - m.miss_probability > pt.pod) {
+            pt.pod = 1.0 - m.miss_probability;
+            pt.best = m.name;
+          }
+      }
+      if (std::isnan(pod.a90) && pt.pod >= 0.9) {
+        if (pod.points.empty()) {
+          pod.a90 = a;
+        } else {
+          const ModelPodPoint& q = pod.points.back();
+          pod.a90 = q.loss + (0.9 - q.pod) / (pt.pod - q.pod) * (a - q.loss);
+        }
+      }
+      pod.points.push_back(pt);
+    }
+    s.pod.push_back(pod);
+  }
+
   s.usable = true;
   int separable = 0;
   for (const auto& c : s.classes) separable += c.separable ? 1 : 0;

@@ -21,6 +21,14 @@
 // periods that would (noise-limited measurements only: sigma^2 ~ 1/P, chi2_0 ~ P), and the
 // equivalent phase-pair coupling gain (Rp ~ T^2: a pair with r x the coupling acts as r^2 x
 // the periods).
+// Model POD against the defect size (MIL-HDBK-1823A's POD(a), here from the model rather than
+// from hit/miss units): for "one_magnet" (one soft bond) and "all_magnets" (every bond soft)
+// at each stiffness loss a of pod_losses (stiffness and damping of the good bond times 1 - a),
+// POD(a) = 1 - miss of the best measurement at its recommended limit (the largest of the
+// measurements' detection probabilities: a lower bound for the OR of all limits); a fit that
+// finds no resonance is an ERROR, never a PASS: POD 1. a90 is interpolated between the grid
+// points. The model has no sampling error, so no a90/95: that needs units (hit/miss data from
+// `eol production-bench` or `eol pod`).
 #pragma once
 
 #include <map>
@@ -50,6 +58,8 @@ struct DetectabilityOptions {
   std::map<std::string, double> unit_spread;
   std::vector<double> bond_fractions = {0.1, 0.3, 0.5, 0.7, 0.9};
   double required_sigmas = 3.0;
+  std::vector<double> pod_losses = {0.2,  0.4,  0.6,  0.7,  0.8,  0.85, 0.9,
+                                    0.92, 0.94, 0.95, 0.96, 0.97, 0.98, 0.99};
 
   bool IsValid(std::string* why) const;
 };
@@ -79,6 +89,19 @@ struct DefectPrediction {
   std::vector<std::string> remedies;
 };
 
+struct ModelPodPoint {
+  double loss = 0.0;  // a
+  double pod = 0.0;
+  double f0_hz = 0.0;  // predicted fitted f0 (0 when the fit finds none)
+  std::string best;    // measurement that gives the POD
+};
+
+struct ModelPod {
+  std::string name;  // "one_magnet", "all_magnets"
+  std::vector<ModelPodPoint> points;
+  double a90 = 0.0;  // NaN when POD stays below 0.9 on the grid
+};
+
 struct DetectabilitySummary {
   bool usable = false;
   std::string message;
@@ -86,6 +109,7 @@ struct DetectabilitySummary {
   double f0_good_hz = 0.0, q_good = 0.0, chi2_good = 0.0;
   int dof = 0;
   std::vector<DefectPrediction> classes;
+  std::vector<ModelPod> pod;
 };
 
 DetectabilitySummary PredictDetectability(const DetectabilityOptions& options);

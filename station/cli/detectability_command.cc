@@ -106,7 +106,19 @@ int RunDetect(const DetectArgs& a) {
     return 1;
   }
   if (a.json) {
-    std::cout << DetectabilityJson(s, source, spread_source, a.required_sigmas).dump() << std::endl;
+    json j = DetectabilityJson(s, source, spread_source, a.required_sigmas);
+    json pod = json::array();
+    for (const auto& p : s.pod) {
+      json points = json::array();
+      for (const auto& pt : p.points)
+        points.push_back(
+            {{"loss", pt.loss}, {"pod", pt.pod}, {"f0_hz", pt.f0_hz}, {"best", pt.best}});
+      pod.push_back({{"name", p.name},
+                     {"a90", std::isnan(p.a90) ? json(nullptr) : json(p.a90)},
+                     {"points", points}});
+    }
+    j["pod"] = pod;
+    std::cout << j.dump() << std::endl;
     return 0;
   }
   std::cout << "detectability (" << r.id << " v" << r.version << "): " << s.message << "\n"
@@ -121,6 +133,15 @@ int RunDetect(const DetectArgs& a) {
               G(100.0 * m.miss_probability) + " % pass)";
     std::printf("%-18s %8.2f %6.1f %8.3f %9.1f  %-16s %6.1f  %s\n", c.defect.c_str(), c.f0_hz, c.q,
                 c.chi2_per_dof, c.curve_separation, c.best.c_str(), c.best_separation, rec.c_str());
+  }
+  std::cout << "model POD against the bond stiffness loss a (best measurement at its "
+               "recommended limit; no a90/95 from a model: see eol production-bench / eol pod):\n";
+  for (const auto& p : s.pod) {
+    std::cout << "  " << p.name << ": a90 "
+              << (std::isnan(p.a90) ? std::string("not reached") : G(p.a90)) << ";";
+    for (const auto& pt : p.points)
+      std::cout << " " << G(pt.loss) << ":" << G(pt.pod) << (pt.best == "fit (ERROR)" ? "E" : "");
+    std::cout << "\n";
   }
   for (const auto& c : s.classes) {
     if (c.separable) continue;
