@@ -26,15 +26,24 @@ double Density(PodLink link, double eta) {
   }
   return std::exp(-0.5 * eta * eta) / std::sqrt(2.0 * kPi);
 }
-// ln F(eta) and ln(1 - F(eta)), kept finite in the far tails.
+// The probit's inverse Mills ratio phi(t) / Phi(t), finite where Phi(t) underflows (t < -30:
+// the asymptotic series Phi(t) / phi(t) = (1 - 1/t^2 + 3/t^4 - ...) / |t|).
+double InverseMills(double t) {
+  if (t > -30.0) return Density(PodLink::kProbit, t) / NormalCdf(t);
+  const double u = 1.0 / (t * t);
+  return -t / (1.0 - u + 3.0 * u * u);
+}
+// ln F(eta) and ln(1 - F(eta)), finite in the far tails: a fit far from the data (the
+// likelihood-ratio profile) must still see a slope there.
 double LogCdf(PodLink link, double eta) {
-  if (link == PodLink::kLogit) return -std::log1p(std::exp(-eta));
-  return std::log(std::max(NormalCdf(eta), 1e-300));
+  if (link == PodLink::kLogit)
+    return eta > 0.0 ? -std::log1p(std::exp(-eta)) : eta - std::log1p(std::exp(eta));
+  if (eta > -30.0) return std::log(NormalCdf(eta));
+  const double u = 1.0 / (eta * eta);
+  return -0.5 * eta * eta - std::log(-eta) - 0.5 * std::log(2.0 * kPi) +
+         std::log(1.0 - u + 3.0 * u * u);
 }
-double LogSurvival(PodLink link, double eta) {
-  if (link == PodLink::kLogit) return -std::log1p(std::exp(eta));
-  return std::log(std::max(NormalCdf(-eta), 1e-300));
-}
+double LogSurvival(PodLink link, double eta) { return LogCdf(link, -eta); }
 
 double ToX(PodScale scale, double a) { return scale == PodScale::kLog ? std::log(a) : a; }
 double ToA(PodScale scale, double x) { return scale == PodScale::kLog ? std::exp(x) : x; }
@@ -53,13 +62,19 @@ double LogLik(PodLink link, const std::vector<Obs>& d, double b0, double b1) {
   return l;
 }
 
-// Score of eta_i and Fisher weight of one observation.
+// Score d l_i / d eta_i and Fisher weight E[-d2 l_i / d eta_i^2] = f^2 / (F (1 - F)) of one
+// observation, in forms that stay exact in the tails (logit: h - F and F (1 - F); probit:
+// through the inverse Mills ratio, f^2 / (F (1 - F)) = lambda(eta) lambda(-eta)).
 void ScoreWeight(PodLink link, double eta, double h, double* score, double* weight) {
-  const double p = std::clamp(Cdf(link, eta), 1e-15, 1.0 - 1e-15);
-  const double f = Density(link, eta);
-  const double v = p * (1.0 - p);
-  *score = (h - p) * f / v;
-  *weight = f * f / v;
+  if (link == PodLink::kLogit) {
+    const double p = Cdf(link, eta);
+    *score = h - p;
+    *weight = Density(link, eta);  // = F (1 - F) for the logistic
+    return;
+  }
+  const double up = InverseMills(eta), down = InverseMills(-eta);
+  *score = h * up - (1.0 - h) * down;
+  *weight = up * down;
 }
 
 // Maximises the profile likelihood over b1 > 0 with eta = q + b1 (x - x_p); returns l.
@@ -75,17 +90,16 @@ double ProfileLogLik(PodLink link, const std::vector<Obs>& d, double q, double x
       g += s * dx;
       w += wt * dx * dx;
     }
-    if (w <= 0.0) break;
-    double step = g / w;
-    double next = b1 + step;
-    double l_next = -kInf;
-    for (int half = 0; half < 60; ++half) {
-      if (next > 0.0) {
-        l_next = l_of(next);
-        if (l_next >= l) break;
-      }
-      step *= 0.5;
-      next = b1 + step;
+    if (g == 0.0) break;
+    // Far from the data the weights vanish (or underflow) and the Newton step is huge: it is
+    // kept within a factor of 10 of b1 (b1 stays > 0), then halved towards b1 until l does not
+    // fall.
+    double next =
+        w > 0.0 ? std::clamp(b1 + g / w, 0.1 * b1, 10.0 * b1) : (g < 0.0 ? 0.1 * b1 : 10.0 * b1);
+    double l_next = l_of(next);
+    for (int half = 0; half < 60 && !(l_next >= l); ++half) {
+      next = 0.5 * (b1 + next);
+      l_next = l_of(next);
     }
     if (!(l_next >= l)) break;
     const bool done = std::abs(next - b1) <= 1e-12 * std::max(1.0, std::abs(b1));
@@ -263,9 +277,16 @@ PodSummary FitPod(const std::vector<HitMiss>& data, const PodOptions& options) {
       },
       x90, span);
   s.a90_95_wald = std::isfinite(x_w) ? ToA(scale, x_w) : kInf;
-  // Likelihood ratio: the profile deviance reaches z^2 (chi2_1 at 2 gamma - 1).
-  const double x_lr = FirstCrossing(
-      [&](double x) { return 2.0 * (l - ProfileLogLik(link, d, q, x, b1)) - z * z; }, x90, span);
+  // Likelihood ratio: the profile deviance reaches z^2 (chi2_1 at 2 gamma - 1). As a90' -> inf
+  // the best curve through (a90', pod_level) flattens (b1 -> 0) and its likelihood tends to
+  // that of one POD for every size, l_0; when 2 (l - l_0) stays within z^2 no a90' is excluded
+  // (the data do not show at this confidence that POD rises with a) and the bound is +inf.
+  const double share = static_cast<double>(s.hits) / s.units;
+  const double l0 = s.hits * std::log(share) + (s.units - s.hits) * std::log1p(-share);
+  double x_lr = kInf;
+  if (2.0 * (l - l0) > z * z)
+    x_lr = FirstCrossing(
+        [&](double x) { return 2.0 * (l - ProfileLogLik(link, d, q, x, b1)) - z * z; }, x90, span);
   s.a90_95_lr = std::isfinite(x_lr) ? ToA(scale, x_lr) : kInf;
   s.usable = true;
   m << ToString(link) << " POD on " << (scale == PodScale::kLog ? "ln a" : "a") << " from "

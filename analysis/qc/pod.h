@@ -8,8 +8,8 @@
 //   F the logistic 1 / (1 + e^-eta) ("logit" link) or the normal CDF Phi ("probit").
 // Estimator: maximum likelihood,
 //   l(b) = sum_i h_i ln F(eta_i) + (1 - h_i) ln(1 - F(eta_i)),  eta_i = b0 + b1 x_i,
-// by Fisher scoring (Newton for the logit) with step halving, from the least-squares line of
-// the empirical logits. Its covariance is the inverse Fisher information
+// by Fisher scoring (Newton for the logit) with step halving, from the flat curve at the hit
+// share (b1 = 0). Its covariance is the inverse Fisher information
 //   I = sum_i w_i [1 x_i; x_i x_i^2],  w_i = f(eta_i)^2 / (F (1 - F)),  f = F'.
 // The maximum likelihood estimate exists only when hits and misses overlap in size: when
 // every miss is smaller than every hit (or the reverse) the likelihood grows without bound
@@ -23,7 +23,9 @@
 //   Wald: the lower confidence bound of the POD curve, F(eta(x) - z_gamma se(eta(x))),
 //     se^2 = [1 x] I^-1 [1 x]^T, reaches 0.9 at a90/95 (the delta-method band).
 // Either bound may not exist (the data do not bound a90 from above): then it is +inf and the
-// summary says so; it stays usable for POD(a) and a90.
+// summary says so; it stays usable for POD(a) and a90. For the LR bound that is the case when
+// the deviance of the flat curve, 2 (l_max - l_0) with l_0 the likelihood of one POD for every
+// size, stays within z_gamma^2: a90' -> inf tends to that curve, so no a90' is excluded.
 #pragma once
 
 #include <limits>

@@ -25,10 +25,10 @@ io::SvgSeries Series(const std::string& label, const std::string& colour,
   return s;
 }
 
-std::string Fixed(double v) {
+std::string Fixed(double v, int digits = 3) {
   if (!std::isfinite(v)) return "none";
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f", v);
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
   return buf;
 }
 
@@ -105,8 +105,8 @@ io::SvgFigure F0Figure(const std::vector<F0Group>& groups, const std::vector<F0L
     p.series.push_back(s);
   }
   for (const F0Limit& l : limits) {
-    io::SvgSeries s =
-        Series(l.label + " " + Fixed(l.f0_hz) + " Hz", "#000000", {l.f0_hz, l.f0_hz}, {0.0, top});
+    io::SvgSeries s = Series(l.label + " " + Fixed(l.f0_hz, 2) + " Hz", "#000000",
+                             {l.f0_hz, l.f0_hz}, {0.0, top});
     s.width = 2.5;
     p.series.push_back(s);
   }

@@ -123,6 +123,15 @@ TEST(Pod, UnboundedA9095IsSaid) {
   EXPECT_FALSE(std::isfinite(s.a90_95_wald));
   EXPECT_FALSE(std::isfinite(s.a90_95_lr));
   EXPECT_NE(s.message.find("do not bound"), std::string::npos) << s.message;
+  // Why: far out the profile flattens towards one POD for every size, whose deviance is
+  // 2 (l_max - l_0) = 0.540 < z^2 = 2.706 (l_max: each size at its share; l_0: 3 of 8).
+  const double l_max =
+      4 * (0.25 * std::log(0.25) + 0.75 * std::log(0.75)) + 8 * 0.5 * std::log(0.5);
+  const double l_0 = 3 * std::log(3.0 / 8) + 5 * std::log(5.0 / 8);
+  EXPECT_NEAR(s.log_likelihood, l_max, 1e-9);
+  const double far = PodProfileDeviance(TwoSizes(0.4, 4, 1, 0.8, 4, 2), s, 1e4);
+  EXPECT_NEAR(far, 2 * (l_max - l_0), 1e-3);
+  EXPECT_LT(far, 2 * (l_max - l_0));  // the profile rises towards it
 }
 
 }  // namespace

@@ -23,7 +23,7 @@
 namespace eol::testing {
 namespace {
 
-std::string Run(const std::vector<std::string>& argv, int* code) {
+std::string RunChild(const std::vector<std::string>& argv, int* code) {
   ChildProcess p(argv, false);
   *code = p.Wait(std::chrono::seconds(120)).value_or(-1);
   return p.output();
@@ -69,9 +69,9 @@ TEST(PodScipyPeer, AgreesWithScipy) {
       eol.insert(eol.end(), {"--scale", "log"});
       peer.push_back("--log");
     }
-    const std::string ours_text = Run(eol, &code);
+    const std::string ours_text = RunChild(eol, &code);
     ASSERT_EQ(code, 0) << ours_text;
-    const std::string peer_text = Run(peer, &code);
+    const std::string peer_text = RunChild(peer, &code);
     ASSERT_EQ(code, 0) << peer_text;
     const auto ours = nlohmann::json::parse(ours_text).at("pod");
     const auto theirs = nlohmann::json::parse(peer_text);
@@ -95,7 +95,7 @@ TEST(PodScipyPeer, AgreesWithScipy) {
   // The figure: POD panel and f0 panel with the limit drawn.
   int code = 0;
   const std::string svg = (dir / "pod.svg").string();
-  Run({EOL_BINARY, "pod", "--hits", hits, "--pod-svg", svg, "--f0-limit", "380"}, &code);
+  RunChild({EOL_BINARY, "pod", "--hits", hits, "--pod-svg", svg, "--f0-limit", "380"}, &code);
   EXPECT_EQ(code, 0);
   std::ifstream in(svg);
   const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
