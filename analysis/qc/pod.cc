@@ -297,6 +297,11 @@ PodSummary FitPod(const std::vector<HitMiss>& data, const PodOptions& options) {
   if (!std::isfinite(s.a90_95_lr) || !std::isfinite(s.a90_95_wald))
     m << "; inf: the data do not bound a" << std::lround(100 * options.pod_level)
       << " from above at this confidence";
+  else if (s.a90_95_lr > s.size_max)
+    m << "; a" << std::lround(100 * options.pod_level) << "/"
+      << std::lround(100 * options.confidence)
+      << " lies beyond the largest size tested (extrapolated; for a stiffness loss, beyond 1 "
+         "no size reaches it)";
   s.message = m.str();
   return s;
 }

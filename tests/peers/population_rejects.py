@@ -47,6 +47,8 @@ def run_population(a, seed, workdir):
     counts = ["--good", str(a.golden + a.good), "--one-soft", str(a.one_soft),
               "--three-soft", str(a.three_soft), "--all-soft", str(a.all_soft),
               "--loss-lo", str(a.loss_lo), "--loss-hi", str(a.loss_hi)]
+    if a.poor_loss_factor is not None:
+        counts += ["--poor-loss-factor", str(a.poor_loss_factor)]
     subprocess.run([sys.executable, os.path.join(HERE, "independent_population.py"),
                     "--out", pop, "--seed", str(seed)] + counts, check=True)
     with open(os.path.join(pop, "truth.csv")) as f:
@@ -83,6 +85,8 @@ def main():
                     help="smallest bond stiffness loss of a soft magnet (generator)")
     ap.add_argument("--loss-hi", type=float, default=0.99,
                     help="largest bond stiffness loss of a soft magnet (generator)")
+    ap.add_argument("--poor-loss-factor", type=float,
+                    help="loss factor of a soft bond (generator; default: the generator's)")
     ap.add_argument("--hits", help="write the per-unit hit/miss CSV here and fit POD with eol pod")
     ap.add_argument("--pod-svg", help="with --hits: the POD figure (eol pod --pod-svg)")
     ap.add_argument("--jobs", type=int, default=1)
