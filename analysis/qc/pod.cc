@@ -300,8 +300,7 @@ PodSummary FitPod(const std::vector<HitMiss>& data, const PodOptions& options) {
   else if (s.a90_95_lr > s.size_max)
     m << "; a" << std::lround(100 * options.pod_level) << "/"
       << std::lround(100 * options.confidence)
-      << " lies beyond the largest size tested (extrapolated; for a stiffness loss, beyond 1 "
-         "no size reaches it)";
+      << " lies beyond the largest size tested (extrapolated)";
   s.message = m.str();
   return s;
 }
