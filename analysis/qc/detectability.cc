@@ -278,15 +278,20 @@ DetectabilitySummary PredictDetectability(const DetectabilityOptions& o) {
             pt.best = m.name;
           }
       }
-      if (std::isnan(pod.a90) && pt.pod >= 0.9) {
-        if (pod.points.empty()) {
-          pod.a90 = a;
-        } else {
-          const ModelPodPoint& q = pod.points.back();
-          pod.a90 = q.loss + (0.9 - q.pod) / (pt.pod - q.pod) * (a - q.loss);
-        }
-      }
       pod.points.push_back(pt);
+    }
+    // a90: POD stays >= 0.9 from there on (MIL-HDBK-1823A's reading); a POD that dips again
+    // (one soft magnet whose local mode meets the rotor's) moves it past the dip.
+    for (std::size_t k = pod.points.size(); k-- > 0;) {
+      const ModelPodPoint& pt = pod.points[k];
+      if (pt.pod < 0.9) {
+        if (k + 1 < pod.points.size()) {
+          const ModelPodPoint& up = pod.points[k + 1];
+          pod.a90 = pt.loss + (0.9 - pt.pod) / (up.pod - pt.pod) * (up.loss - pt.loss);
+        }
+        break;
+      }
+      if (k == 0) pod.a90 = pt.loss;
     }
     s.pod.push_back(pod);
   }

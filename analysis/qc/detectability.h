@@ -26,9 +26,10 @@
 // at each stiffness loss a of pod_losses (stiffness and damping of the good bond times 1 - a),
 // POD(a) = 1 - miss of the best measurement at its recommended limit (the largest of the
 // measurements' detection probabilities: a lower bound for the OR of all limits); a fit that
-// finds no resonance is an ERROR, never a PASS: POD 1. a90 is interpolated between the grid
-// points. The model has no sampling error, so no a90/95: that needs units (hit/miss data from
-// `eol production-bench` or `eol pod`).
+// finds no resonance is an ERROR, never a PASS: POD 1. a90 is the loss from which POD stays
+// at or above 0.9 on the grid (interpolated): where POD dips again (one soft magnet whose own
+// mode meets the rotor's near a loss of 0.98) a90 lies past the dip. The model has no sampling
+// error, so no a90/95: that needs units (hit/miss data from `eol production-bench` or `eol pod`).
 #pragma once
 
 #include <map>
@@ -99,7 +100,7 @@ struct ModelPodPoint {
 struct ModelPod {
   std::string name;  // "one_magnet", "all_magnets"
   std::vector<ModelPodPoint> points;
-  double a90 = 0.0;  // NaN when POD stays below 0.9 on the grid
+  double a90 = 0.0;  // NaN when POD ends below 0.9 on the grid
 };
 
 struct DetectabilitySummary {

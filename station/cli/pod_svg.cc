@@ -46,7 +46,7 @@ io::SvgFigure PodFigure(const std::string& title, const std::vector<PodCurve>& c
   for (std::size_t k = 0; k < curves.size(); ++k) {
     const PodCurve& c = curves[k];
     const std::string colour = kColours[k % 6];
-    io::SvgSeries hits = Series(c.label + " units (hit 1, miss 0)", colour);
+    io::SvgSeries hits = Series(c.label + " hit/miss", colour);
     hits.markers = true;
     for (const auto& h : c.data) {
       hits.x.push_back(h.size);
@@ -54,8 +54,8 @@ io::SvgFigure PodFigure(const std::string& title, const std::vector<PodCurve>& c
     }
     p.series.push_back(hits);
     if (!c.fit.usable) continue;
-    io::SvgSeries pod = Series(c.label + ": POD, a90 " + Fixed(c.fit.a90), colour);
-    io::SvgSeries bound = Series(c.label + ": lower 95 % bound", colour);
+    io::SvgSeries pod = Series(c.label + " POD", colour);
+    io::SvgSeries bound = Series(c.label + " lower bound", colour);
     bound.dashed = true;
     bound.width = 1.0;
     for (int i = 0; i <= 200; ++i) {
@@ -68,7 +68,7 @@ io::SvgFigure PodFigure(const std::string& title, const std::vector<PodCurve>& c
     p.series.push_back(pod);
     p.series.push_back(bound);
     if (std::isfinite(c.fit.a90_95_lr) && c.fit.a90_95_lr <= hi) {
-      io::SvgSeries mark = Series(c.label + ": a90/95 " + Fixed(c.fit.a90_95_lr) + " (LR)", colour,
+      io::SvgSeries mark = Series(c.label + " a90/95 " + Fixed(c.fit.a90_95_lr), colour,
                                   {c.fit.a90_95_lr, c.fit.a90_95_lr}, {0.0, 1.0});
       mark.width = 2.5;
       p.series.push_back(mark);
@@ -87,6 +87,7 @@ io::SvgFigure F0Figure(const std::vector<F0Group>& groups, const std::vector<F0L
   double lo = 1e300, hi = -1e300;
   for (const F0Group& g : groups)
     for (double v : g.f0_hz) lo = std::min(lo, v), hi = std::max(hi, v);
+  for (const F0Limit& l : limits) lo = std::min(lo, l.f0_hz), hi = std::max(hi, l.f0_hz);
   lo = std::floor(lo);
   hi = std::ceil(hi) + 1.0;
   double top = 0.0;

@@ -77,6 +77,31 @@ TEST(Detectability, StiffClampSeparatesWhatTheSoftOneHides) {
   EXPECT_GT(t.best_separation, s.best_separation);
 }
 
+// Model POD against the bond stiffness loss: the bond sits in series with the bridges and the
+// fixture, so f0 hardly moves until most of the bond is lost. Mild losses are invisible (POD at
+// the limit's false-call level), all ten bonds are found from a loss of 0.9-0.96, and the
+// a90 of one magnet is never below that of all ten.
+TEST(Detectability, ModelPodRisesOnlyForSevereLoss) {
+  const DetectabilitySummary s = PredictDetectability(Options(1.0));
+  ASSERT_TRUE(s.usable) << s.message;
+  ASSERT_EQ(s.pod.size(), 2u);
+  const ModelPod& one = s.pod[0];
+  const ModelPod& all = s.pod[1];
+  ASSERT_EQ(all.name, "all_magnets");
+  ASSERT_EQ(all.points.size(), DetectabilityOptions{}.pod_losses.size());
+  EXPECT_LT(all.points.front().pod, 0.01);  // loss 0.2
+  EXPECT_GE(all.points.back().pod, 0.9);    // loss 0.99
+  EXPECT_GT(all.a90, 0.9);
+  EXPECT_LT(all.a90, 0.96);
+  // Beyond a90 POD stays at or above 0.9 (the reading of a90).
+  for (const ModelPod* m : {&one, &all})
+    for (const ModelPodPoint& p : m->points)
+      EXPECT_TRUE(p.loss < m->a90 || p.pod >= 0.9) << m->name << " " << p.loss << " " << p.pod;
+  EXPECT_GE(one.a90, all.a90);
+  // f0 falls with the loss (all ten soft).
+  EXPECT_LT(all.points.back().f0_hz, all.points.front().f0_hz - 20.0);
+}
+
 TEST(Detectability, InvalidOptionsAreNamed) {
   DetectabilityOptions o = Options(1.0);
   o.rotor.fixture.reset();
