@@ -288,6 +288,11 @@ PodSummary FitPod(const std::vector<HitMiss>& data, const PodOptions& options) {
     x_lr = FirstCrossing(
         [&](double x) { return 2.0 * (l - ProfileLogLik(link, d, q, x, b1)) - z * z; }, x90, span);
   s.a90_95_lr = std::isfinite(x_lr) ? ToA(scale, x_lr) : kInf;
+  for (const HitMiss& h : data)
+    if (!h.hit && h.size >= s.a90_95_lr) {
+      ++s.misses_beyond_a90_95;
+      s.largest_miss_beyond = std::max(s.largest_miss_beyond, h.size);
+    }
   s.usable = true;
   m << ToString(link) << " POD on " << (scale == PodScale::kLog ? "ln a" : "a") << " from "
     << s.units << " units (" << s.hits << " hits, sizes " << s.size_min << "-" << s.size_max
@@ -301,6 +306,10 @@ PodSummary FitPod(const std::vector<HitMiss>& data, const PodOptions& options) {
     m << "; a" << std::lround(100 * options.pod_level) << "/"
       << std::lround(100 * options.confidence)
       << " lies beyond the largest size tested (extrapolated)";
+  if (s.misses_beyond_a90_95 > 0)
+    m << "; " << s.misses_beyond_a90_95 << " miss(es) at or beyond a"
+      << std::lround(100 * options.pod_level) << "/" << std::lround(100 * options.confidence)
+      << " (up to " << s.largest_miss_beyond << "): POD may not rise monotonically there";
   s.message = m.str();
   return s;
 }
@@ -349,6 +358,8 @@ nlohmann::json PodToJson(const PodSummary& s) {
   j["a90"] = s.a90;
   j["a90_95_lr"] = finite(s.a90_95_lr);
   j["a90_95_wald"] = finite(s.a90_95_wald);
+  j["misses_beyond_a90_95"] = s.misses_beyond_a90_95;
+  if (s.misses_beyond_a90_95 > 0) j["largest_miss_beyond"] = s.largest_miss_beyond;
   return j;
 }
 

@@ -66,6 +66,10 @@ struct PodSummary {
   double a50 = 0.0, a90 = 0.0;  // a at POD 0.5 and at pod_level
   double a90_95_lr = std::numeric_limits<double>::infinity();
   double a90_95_wald = std::numeric_limits<double>::infinity();
+  // Misses at sizes at or beyond a90/95 (LR), and the largest such size: the model is monotone,
+  // the data need not be (one soft magnet whose own mode meets the rotor's hides again).
+  int misses_beyond_a90_95 = 0;
+  double largest_miss_beyond = 0.0;
 
   // POD at size a and its one-sided lower Wald bound (confidence as fitted).
   double Pod(double a) const;

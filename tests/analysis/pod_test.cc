@@ -102,6 +102,11 @@ TEST(Pod, RecoversAKnownCurve) {
   EXPECT_GT(s.a90_95_lr, s.a90);
   EXPECT_LT(s.a90_95_lr, s.a90 + 0.02);
   EXPECT_NEAR(s.a90_95_lr, s.a90_95_wald, 0.005);
+  // A few misses beyond a90/95 are expected (POD 0.9+ there, not 1) and counted by hand.
+  int beyond = 0;
+  for (const HitMiss& h : d) beyond += !h.hit && h.size >= s.a90_95_lr ? 1 : 0;
+  EXPECT_EQ(s.misses_beyond_a90_95, beyond);
+  EXPECT_GT(beyond, 0);
 }
 
 TEST(Pod, SeparatedDataHaveNoEstimate) {
