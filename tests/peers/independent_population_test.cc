@@ -15,8 +15,10 @@
 //    confidence. The one-magnet POD is printed: this fixture does not reach 90 % for one soft
 //    magnet at any loss below about 0.98.
 // 3. The same sweep taught by physics (the default) and by the even split: physics rejects at
-//    least as many all-ten-soft and more one-soft rotors, and its all-magnets a90 is no
-//    larger. Parts 1 and 2 also hold with `--allocation even` on this generator (its good
+//    least as many all-ten-soft and more one-soft rotors. (Not a90: physics also catches a
+//    few rotors at losses of 0.85-0.9, which flattens the fitted logistic; on population seed
+//    1 its a90 comes out 0.001 above the even split's although it rejects more in every
+//    loss bin.) Parts 1 and 2 also hold with `--allocation even` on this generator (its good
 //    units spread less than the blind populations', so both f0 limits sit close): part 3 is
 //    the one that tells the allocations apart.
 // Milder softness (losses below about 0.9) moves f0 by less than the good units' spread: no
@@ -142,10 +144,6 @@ TEST_F(IndependentPopulation, PhysicsAllocationFindsMoreThanEvenSplit) {
             << rejected(even, "one_soft") << "\n";
   EXPECT_GE(rejected(phys, "all_soft"), rejected(even, "all_soft"));
   EXPECT_GT(rejected(phys, "one_soft"), rejected(even, "one_soft"));
-  const auto& pa = phys.at("pod").at("all_soft");
-  const auto& ea = even.at("pod").at("all_soft");
-  ASSERT_TRUE(pa.at("usable").get<bool>() && ea.at("usable").get<bool>());
-  EXPECT_LE(pa.at("a90").get<double>(), ea.at("a90").get<double>());
 }
 
 }  // namespace
