@@ -205,6 +205,8 @@ bool TeachOptions::IsValid(std::string* why) const {
   if (mask_segments < 0 || mask_segments > 200) return fail("mask_segments must be in [0, 200]");
   if (!(mask_guard_sigma >= 0.0)) return fail("mask_guard_sigma must not be negative");
   if (!(marginal_scales >= 0.0)) return fail("marginal_scales must not be negative");
+  if (!(known_bad_max_donation >= 0.0 && known_bad_max_donation <= 1.0))
+    return fail("known_bad_max_donation must be in [0, 1]");
   return true;
 }
 
@@ -450,9 +452,9 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
       for (std::size_t i = 0; i < scalar_count; ++i) {
         const Stat& st = stats[i];
         if (i != f0 && st.want_lo && st.defect_lo && !by_lo[i])
-          movable += std::max(0.0, st.w_lo - kPlausibilityWeight);
+          movable += o.known_bad_max_donation * std::max(0.0, st.w_lo - kPlausibilityWeight);
         if (st.want_hi && st.defect_hi && !by_hi[i])
-          movable += std::max(0.0, st.w_hi - kPlausibilityWeight);
+          movable += o.known_bad_max_donation * std::max(0.0, st.w_hi - kPlausibilityWeight);
       }
       // The highest f0 among the escapes the whole movable share can still catch.
       double target = -INFINITY;
@@ -470,7 +472,8 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
           const double mid = 0.5 * (lo + hi);
           (f0_lo(f.w_lo + mid) > target ? hi : lo) = mid;
         }
-        const double moved = hi, scale_down = 1.0 - moved / movable;
+        // Each donor gives the same fraction of what it may give.
+        const double moved = hi, scale_down = 1.0 - o.known_bad_max_donation * moved / movable;
         for (std::size_t i = 0; i < scalar_count; ++i) {
           Stat& st = stats[i];
           if (i != f0 && st.want_lo && st.defect_lo && !by_lo[i] && st.w_lo > kPlausibilityWeight) {

@@ -56,7 +56,8 @@
 // confirmed defective; allocation "physics" only). The budget alone sets every bound as above;
 // a known-bad unit that passes all the scalar bounds so set is an escape. The f0 lower bound
 // then takes share from the defect-side scalar bounds that catch none of the known-bad units
-// (each keeps a plausibility weight), just as much as makes it catch every escape it can: the
+// (each keeps its plausibility weight and 1 - known_bad_max_donation of the rest), just as much
+// as makes it catch every escape it can: the
 // smallest share s with centre - k(s) scale above the escapes' f0 (k the one-sided factor as
 // above). The total budget, and so the false-reject statement, is unchanged; the bound that
 // catches the known defects gets more of it. Escapes whose f0 lies within what the whole
@@ -110,6 +111,10 @@ struct TeachOptions {
   int mask_segments = 12;        // in all masks; 0: no mask taught
   double mask_guard_sigma = 3.0;
   double marginal_scales = 1.0;
+  // Known-bad units: the share of each donor bound's weight (above plausibility) that may move
+  // to the f0 lower bound. Below 1 because a bound none of the known-bad units trips may still
+  // catch a defect they do not represent (chi2 and one soft magnet).
+  double known_bad_max_donation = 0.5;
 
   bool IsValid(std::string* why) const;
 };

@@ -150,6 +150,10 @@ void AddTeachCommand(CLI::App& app) {
                   "FAIL): the f0 lower bound takes budget from bounds that catch none of them "
                   "until it catches those it can; teach reports the escapes before and after")
       ->expected(1, -1);
+  cmd->add_option("--bad-max-donation", args->options.known_bad_max_donation,
+                  "With --bad: share of each other bound's budget (above plausibility) that may "
+                  "move to the f0 lower bound")
+      ->capture_default_str();
   cmd->add_option("--out", args->out, "The new recipe file")->required();
   cmd->add_option("--confidence", args->options.confidence, "Confidence of the tolerance intervals")
       ->capture_default_str();

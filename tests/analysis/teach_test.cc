@@ -205,6 +205,7 @@ TEST(Teach, PhysicsAllocationSpendsTheBudgetOnTheDefectSide) {
 TEST(Teach, KnownBadUnitsMoveBudgetToTheF0Bound) {
   TeachOptions o;
   o.mask_segments = 0;
+  o.known_bad_max_donation = 1.0;  // all a donor has above plausibility (the default is half)
   const std::vector<GoldenUnit> golden = StationUnits(40, 3);
   const TeachSummary plain = TeachLimits(kStationSpecs, golden, o);
   ASSERT_TRUE(plain.usable) << plain.message;
@@ -245,6 +246,13 @@ TEST(Teach, KnownBadUnitsMoveBudgetToTheF0Bound) {
   EXPECT_EQ(s.known_bad_donors,
             (std::vector<std::string>{"resonance_q lo", "winding_r_ohm lo", "winding_r_ohm hi"}));
   EXPECT_NE(s.message.find("1 pass the taught limits"), std::string::npos) << s.message;
+  // By default a donor gives at most half: escape-b is out of reach, escape-a is caught.
+  o.known_bad_max_donation = 0.5;
+  const TeachSummary half = TeachLimits(kStationSpecs, golden, o, known);
+  ASSERT_TRUE(half.usable) << half.message;
+  EXPECT_EQ(half.known_bad_escapes, (std::vector<std::string>{"escape-b", "hidden"}));
+  EXPECT_GT(*half.limits[0].limit.lo, f0_lo + 0.1);
+  EXPECT_LT(*half.limits[0].limit.lo, f0_lo + 0.1 + 0.005);
   // Only the physics allocation has shares to move.
   EXPECT_FALSE(TeachLimits(kStationSpecs, golden, Even(), known).usable);
 }
