@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace eol::analysis {
 namespace {
 
@@ -100,6 +102,32 @@ TEST(Detectability, ModelPodRisesOnlyForSevereLoss) {
   EXPECT_GE(one.a90, all.a90);
   // f0 falls with the loss (all ten soft).
   EXPECT_LT(all.points.back().f0_hz, all.points.front().f0_hz - 20.0);
+}
+
+// a90/95 from the spread's sampling error: with the spread from 40 golden units every spread
+// is taken at its 95 % upper bound, sqrt(39 / chi2_39(0.05)) = sqrt(39 / 25.6954) = 1.23199
+// times (chi-square table); the lower POD equals the POD of a run with the spreads so scaled.
+TEST(Detectability, ModelA9095TakesTheSpreadAtItsUpperBound) {
+  DetectabilityOptions o = Options(1.0);
+  const DetectabilitySummary given = PredictDetectability(o);
+  ASSERT_TRUE(given.usable) << given.message;
+  EXPECT_TRUE(std::isnan(given.pod[1].a90_95));  // not a sample: no confidence bound
+  o.spread_units = 40;
+  const DetectabilitySummary sampled = PredictDetectability(o);
+  ASSERT_TRUE(sampled.usable) << sampled.message;
+  DetectabilityOptions wide = Options(1.0);
+  for (auto& [name, spread] : wide.unit_spread) spread *= std::sqrt(39.0 / 25.6954);
+  const DetectabilitySummary upper = PredictDetectability(wide);
+  ASSERT_TRUE(upper.usable) << upper.message;
+  for (std::size_t c = 0; c < 2; ++c) {
+    const ModelPod& p = sampled.pod[c];
+    EXPECT_DOUBLE_EQ(p.a90, given.pod[c].a90) << p.name;
+    EXPECT_NEAR(p.a90_95, upper.pod[c].a90, 1e-4) << p.name;
+    EXPECT_GE(p.a90_95, p.a90) << p.name;
+    for (std::size_t k = 0; k < p.points.size(); ++k)
+      EXPECT_NEAR(p.points[k].pod_lower, upper.pod[c].points[k].pod, 1e-4)
+          << p.name << " " << p.points[k].loss;
+  }
 }
 
 TEST(Detectability, InvalidOptionsAreNamed) {
