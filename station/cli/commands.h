@@ -24,5 +24,6 @@ void AddTeachCommand(CLI::App& app);
 void AddDetectabilityCommand(CLI::App& app);
 void AddProductionBenchCommand(CLI::App& app);
 void AddHttpBenchCommand(CLI::App& app);
+void AddPodCommand(CLI::App& app);
 
 }  // namespace eol::station::cli

@@ -45,10 +45,11 @@ analysis::GoldenUnit FromMeasured(const std::string& path, const Recipe& recipe)
   return u;
 }
 
-analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string& path) {
+analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string& path,
+                                     bool known_bad) {
   if (!j.value("usable", false))
     throw std::runtime_error(path + ": the analysis is not usable (\"usable\": false)");
-  if (j.contains("verdict") && j.at("verdict").value("outcome", "") != "PASS")
+  if (!known_bad && j.contains("verdict") && j.at("verdict").value("outcome", "") != "PASS")
     throw std::runtime_error(path + ": the verdict is " + j.at("verdict").value("outcome", "?") +
                              ": only PASS units are golden units");
   static const std::map<std::string, std::string_view> kParams = {
@@ -72,7 +73,8 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
 
 std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>& paths,
                                                   const Recipe& recipe,
-                                                  std::vector<std::string>* skipped) {
+                                                  std::vector<std::string>* skipped,
+                                                  bool known_bad) {
   if (skipped) skipped->clear();  // nothing is skipped any more: unusable records are refused
   std::vector<analysis::GoldenUnit> units;
   for (const std::string& path : paths) {
@@ -90,7 +92,7 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
     }
     try {
       if (j.is_object() && j.contains("params")) {
-        units.push_back(FromAnalyzeJson(j, path));
+        units.push_back(FromAnalyzeJson(j, path, known_bad));
       } else if (j.is_array() || (j.is_object() && j.contains("measurements"))) {
         const nlohmann::json list = j.is_array() ? j : nlohmann::json::array({j});
         for (std::size_t i = 0; i < list.size(); ++i) {
@@ -98,10 +100,14 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
           const std::string label = path + "[" + std::to_string(i) + "] " + r.serial;
           // A golden unit is a good production unit tested with this very recipe: anything
           // else would teach limits from what they must reject, or from another test.
-          if (r.outcome != analysis::Outcome::kPass)
+          if (known_bad && r.outcome != analysis::Outcome::kPass &&
+              r.outcome != analysis::Outcome::kFail)
+            throw std::runtime_error("record " + label + " is " + analysis::ToString(r.outcome) +
+                                     ": a known-bad unit needs a PASS or FAIL measurement");
+          if (!known_bad && r.outcome != analysis::Outcome::kPass)
             throw std::runtime_error("record " + label + " is " + analysis::ToString(r.outcome) +
                                      ": only PASS records are golden units");
-          if (r.kind != db::RecordKind::kProduction)
+          if (!known_bad && r.kind != db::RecordKind::kProduction)
             throw std::runtime_error("record " + label + " is a " + db::ToString(r.kind) +
                                      " test (a master part), not a production unit");
           if (r.recipe_hash != recipe.hash)
@@ -124,7 +130,9 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
       throw std::runtime_error(path + ": " + what);
     }
   }
-  if (units.empty()) throw std::runtime_error("no golden unit could be read");
+  if (units.empty())
+    throw std::runtime_error(known_bad ? "no known-bad unit could be read"
+                                       : "no golden unit could be read");
   return units;
 }
 

@@ -8,6 +8,9 @@
 //                           the record): FAIL, ERROR or ABORTED records, masters (kind other
 //                           than "production") and records of another recipe hash than
 //                           `recipe`'s. *skipped is left empty (kept for callers' reports).
+// With `known_bad` (`eol teach --bad`: units an engineer confirmed defective) a unit's verdict
+// may be PASS or FAIL (a torn-down escape passed) and records may be masters (limit masters);
+// ERROR and ABORTED records (no measurement to judge) and other recipes are still refused.
 // Throws std::runtime_error naming the file (and record) that cannot be used.
 #pragma once
 
@@ -21,6 +24,7 @@ namespace eol::station::cli {
 
 std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>& paths,
                                                   const Recipe& recipe,
-                                                  std::vector<std::string>* skipped);
+                                                  std::vector<std::string>* skipped,
+                                                  bool known_bad = false);
 
 }  // namespace eol::station::cli

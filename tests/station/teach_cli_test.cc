@@ -190,6 +190,37 @@ TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
       << r.out;
 }
 
+// Known-bad units (`--bad`): one with every magnet poorly cemented is caught by the limits the
+// budget sets; a unit an engineer marked bad that measures like the good ones passes any limit
+// within the budget, and teach says so by name (text and JSON). The even split has no share to
+// move and refuses known-bad units.
+TEST_F(TeachCli, KnownBadUnitsAreReportedWithTheirEscapes) {
+  const std::string caught = Simulated(dir_, "bad-all-soft.csv", 997, "all_soft", 1.0);
+  const std::string hidden = Simulated(dir_, "bad-hidden.csv", 996, "none", 1.0);
+  std::vector<std::string> args = TeachArgs(dir_ / "kb.json");
+  args.insert(args.end(), {"--bad", caught, hidden, "--json"});
+  CliRun r = Eol(args, false);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("known_bad")) << r.out;
+  EXPECT_EQ(j["known_bad"]["units"], 2);
+  EXPECT_EQ(j["known_bad"]["escapes"], nlohmann::json::array({hidden})) << r.out;
+  EXPECT_NE(
+      j["message"].get<std::string>().find("no bound within the budget catches them: " + hidden),
+      std::string::npos)
+      << r.out;
+  std::vector<std::string> text = TeachArgs(dir_ / "kb-text.json");
+  text.insert(text.end(), {"--bad", caught, hidden});
+  r = Eol(text);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("known-bad unit passes: " + hidden), std::string::npos) << r.out;
+  std::vector<std::string> even = TeachArgs(dir_ / "kb-even.json");
+  even.insert(even.end(), {"--bad", caught, "--allocation", "even"});
+  r = Eol(even);
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("known-bad units need allocation physics"), std::string::npos) << r.out;
+}
+
 TEST_F(TeachCli, ErrorsNameTheFile) {
   const std::string junk = dir_ / "junk.json";
   std::ofstream(junk) << "{\"hello\": 1}";
