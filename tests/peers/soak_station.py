@@ -190,6 +190,7 @@ def main():
     faulted = set()        # serials with a fault during their test
     counts = {"fault": 0, "kill": 0, "full": 0, "no_verdict": 0, "full_no_verdict": 0}
     rss = []               # (life, test index in that life, MiB)
+    refusals = {}          # "status code" -> times POST /api/tests was refused
     life, in_life = 0, 0
     started_at = time.time()
     try:
@@ -223,10 +224,21 @@ def main():
                 full_left = 4
             if episode:
                 counts[episode] += 1
-            try:
-                status, body = station.request("POST", "/api/tests", {"serial": serial})
-            except OSError as e:
-                status, body = 0, str(e).encode()
+            # A busy or recovering station refuses; like a line PLC, retry for a while.
+            deadline = time.time() + 15
+            while True:
+                try:
+                    status, body = station.request("POST", "/api/tests", {"serial": serial})
+                except OSError as e:
+                    status, body = 0, str(e).encode()
+                if status == 202 or time.time() > deadline or station.proc.poll() is not None:
+                    break
+                try:
+                    code = json.loads(body)["error"]["code"]
+                except (ValueError, KeyError, TypeError):
+                    code = "no_answer"
+                refusals[f"{status} {code}"] = refusals.get(f"{status} {code}", 0) + 1
+                time.sleep(0.2)
             if status != 202:
                 counts["no_verdict"] += 1
             elif episode == "kill":
@@ -285,7 +297,7 @@ def main():
     if len(longest) > 60:
         growth = longest[-1][1] - dict(longest).get(50, longest[0][1])
     summary = {"tests": a.tests, "seed": a.seed, "seconds": round(time.time() - started_at, 1),
-               "episodes": counts,
+               "episodes": counts, "refusals": refusals,
                "acknowledged": len(acknowledged), "stored": len(stored),
                "acknowledged_lost": len(lost), "pass_during_fault": len(pass_during_fault),
                "left_running": len(running), "integrity": integrity,
