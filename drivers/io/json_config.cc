@@ -115,7 +115,8 @@ void JsonObject::Require(bool ok, const std::string& key, const std::string& rul
 nlohmann::json ParseJsonText(const std::string& text, const std::string& source) {
   try {
     return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // Not only parse_error: a number beyond double's range ("1e999") is out_of_range.406.
     throw ConfigError(source + ": not valid JSON: " + e.what());
   }
 }
