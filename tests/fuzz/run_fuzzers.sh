@@ -57,6 +57,8 @@ for t in "${targets[@]}"; do
   cp "$seeds"/* "$run/corpus/"
   opts=(-max_total_time="$seconds" -rss_limit_mb=512 -malloc_limit_mb=512 -timeout=10
         -artifact_prefix="$run/findings/" -print_final_stats=1)
+  # The JSON readers get the schema's keys and edge values as a dictionary.
+  case "$t" in recipe | config | http_body) opts+=(-dict="$src/tests/fuzz/json.dict") ;; esac
   if ((fork > 0)); then opts+=(-fork="$fork" -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1); fi
   echo "run_fuzzers: $t for ${seconds} s"
   status=0
