@@ -6,12 +6,14 @@
 
 namespace eol::db {
 
-std::string UtcIso8601(std::chrono::system_clock::time_point t) {
+namespace {
+
+// Formats a millisecond time. Not through system_clock::time_point: its nanoseconds hold only
+// the years 1678 to 2262, and a client's date outside them overflowed (undefined behaviour).
+std::string FormatUtc(std::chrono::sys_time<std::chrono::milliseconds> ms) {
   using std::chrono::floor;
-  using std::chrono::milliseconds;
   using std::chrono::seconds;
   // floor, not duration_cast: times before 1970 must not round towards the epoch.
-  const auto ms = floor<milliseconds>(t);
   const auto s = floor<seconds>(ms);
   const int millis = static_cast<int>((ms - s).count());
   const std::time_t secs = static_cast<std::time_t>(s.time_since_epoch().count());
@@ -22,6 +24,12 @@ std::string UtcIso8601(std::chrono::system_clock::time_point t) {
   std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
                 tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, millis);
   return buf;
+}
+
+}  // namespace
+
+std::string UtcIso8601(std::chrono::system_clock::time_point t) {
+  return FormatUtc(std::chrono::floor<std::chrono::milliseconds>(t));
 }
 
 std::string UtcNowIso8601() { return UtcIso8601(std::chrono::system_clock::now()); }
@@ -59,7 +67,14 @@ std::optional<std::string> NormaliseIso8601(const std::string& text, std::string
                             day{static_cast<unsigned>(d)}};
   if (!date.ok()) return fail("no such date");
   sys_time<milliseconds> t = sys_days{date};
-  if (p == text.size()) return UtcIso8601(t);
+  // The store's format has four digits of year: an offset must not carry a time out of them.
+  auto finish = [&](sys_time<milliseconds> utc) -> std::optional<std::string> {
+    const year_month_day ymd{floor<days>(utc)};
+    if (ymd.year() < year{0} || ymd.year() > year{9999})
+      return fail("outside the years 0000 to 9999 in UTC");
+    return FormatUtc(utc);
+  };
+  if (p == text.size()) return finish(t);
   if (text[p++] != 'T') return fail("expected 'T' after the date");
   if (!Digits(text, &p, 2, &h) || p >= text.size() || text[p++] != ':' || !Digits(text, &p, 2, &mi))
     return fail("expected hh:mm after 'T'");
@@ -78,7 +93,7 @@ std::optional<std::string> NormaliseIso8601(const std::string& text, std::string
   if (h > 23 || mi > 59 || s > 59) return fail("hour, minute or second out of range");
   t += hours{h} + minutes{mi} + seconds{s} + milliseconds{ms};
   if (p == text.size()) return fail("a time of day needs 'Z' or an offset such as +02:00");
-  if (text[p] == 'Z' && p + 1 == text.size()) return UtcIso8601(t);
+  if (text[p] == 'Z' && p + 1 == text.size()) return finish(t);
   const char sign = text[p] == ' ' ? '+' : text[p];
   if (sign != '+' && sign != '-') return fail("expected 'Z' or an offset such as +02:00");
   ++p;
@@ -90,7 +105,7 @@ std::optional<std::string> NormaliseIso8601(const std::string& text, std::string
   // Local time = UTC + offset, so UTC = local time - offset.
   const minutes offset = hours{oh} + minutes{om};
   t += sign == '+' ? -offset : offset;
-  return UtcIso8601(t);
+  return finish(t);
 }
 
 }  // namespace eol::db

@@ -14,6 +14,7 @@ test_pkgs=(
   python3 python3-numpy python3-scipy python3-pymodbus python3-serial-asyncio python3-can
   can-utils socat sqlite3
   chromium dpkg-dev pulseaudio libasound2-plugins clang-format systemd
+  clang-14 libclang-rt-14-dev
 )
 
 pkgs=("${build_pkgs[@]}")

@@ -80,5 +80,20 @@ TEST(ClockTest, RefusesWhatIsNotAnIso8601TimeNamingWhy) {
             "such as +02:00");
 }
 
+// Found by tests/fuzz/http_body_fuzzer (?from=1026-11-26T10:00:00.123+01:00): a year outside
+// 1678..2262 overflowed system_clock's nanoseconds (undefined behaviour, a wrong time).
+TEST(ClockTest, NormalisesEveryFourDigitYearAndRefusesOffsetsBeyondThem) {
+  auto n = [](const std::string& text) { return NormaliseIso8601(text, nullptr).value_or("-"); };
+  EXPECT_EQ(n("1026-11-26T10:00:00.123+01:00"), "1026-11-26T09:00:00.123Z");
+  EXPECT_EQ(n("0000-01-01"), "0000-01-01T00:00:00.000Z");
+  EXPECT_EQ(n("9999-12-31T23:59:59.999Z"), "9999-12-31T23:59:59.999Z");
+  EXPECT_EQ(n("1600-02-29T12:00-12:00"), "1600-03-01T00:00:00.000Z");
+  for (const std::string out : {"0000-01-01T00:30+01:00", "9999-12-31T23:30-01:00"}) {
+    std::string why;
+    EXPECT_EQ(NormaliseIso8601(out, &why), std::nullopt) << out;
+    EXPECT_EQ(why, "'" + out + "' is not an ISO 8601 time: outside the years 0000 to 9999 in UTC");
+  }
+}
+
 }  // namespace
 }  // namespace eol::db
