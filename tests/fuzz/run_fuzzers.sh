@@ -40,8 +40,8 @@ if [[ ! -f "$build/build.ninja" ]]; then
   launcher=()
   if command -v ccache >/dev/null 2>&1; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
   cmake -S "$src" -B "$build" -G Ninja -DEOL_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" > "$build.configure.log" 2>&1 ||
-    { cat "$build.configure.log"; exit 1; }
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" > "$build/configure.log" 2>&1 ||
+    { cat "$build/configure.log"; exit 1; }
 fi
 # The machine is shared with the rest of the suite: build and fuzz at a lower priority.
 CCACHE_BASEDIR="${CCACHE_BASEDIR:-$src}" nice -n 10 cmake --build "$build" --target eol_fuzzers
@@ -63,8 +63,9 @@ for t in "${targets[@]}"; do
   echo "run_fuzzers: $t for ${seconds} s"
   status=0
   (cd "$run" && nice -n 10 "$bin" "${opts[@]}" "$run/corpus") > "$run/fuzz.log" 2>&1 || status=$?
-  { grep -E '^(stat::number_of_executed_units|stat::new_units_added)' "$run/fuzz.log" || true; } |
-    sed "s/^/  $t: /"
+  # One process prints stat:: lines; -fork prints "#<runs>: cov: ..." progress lines.
+  { grep -E '^(stat::number_of_executed_units|stat::new_units_added)' "$run/fuzz.log" ||
+    grep -E '^#[0-9]+: cov' "$run/fuzz.log" | tail -1 || true; } | sed "s/^/  $t: /"
   shopt -s nullglob
   found=("$run/findings"/*)
   shopt -u nullglob
