@@ -92,14 +92,15 @@ analysis::Recording ReadWavRecording(const std::string& path, double voltage_gai
   rec.voltage_v.resize(static_cast<std::size_t>(got));
   rec.current_a.resize(static_cast<std::size_t>(got));
   for (std::size_t k = 0; k < rec.voltage_v.size(); ++k) {
-    // Float encodings can hold NaN and infinities; the CSV reader refuses them too.
-    for (int c = 0; c < 2; ++c)
-      if (!std::isfinite(frames[2 * k + static_cast<std::size_t>(c)]))
-        throw FileError(path, 0, 0,
-                        "frame " + std::to_string(k) + ": the " + (c == 0 ? "voltage" : "current") +
-                            " sample is not a finite number");
     rec.voltage_v[k] = frames[2 * k] * voltage_gain_v;
     rec.current_a[k] = frames[2 * k + 1] * current_gain_a;
+    // Float encodings can hold NaN and infinities, and a 64-bit float near its maximum
+    // overflows once scaled by the gain; the CSV reader refuses non-finite values too.
+    for (int c = 0; c < 2; ++c)
+      if (!std::isfinite(c == 0 ? rec.voltage_v[k] : rec.current_a[k]))
+        throw FileError(path, 0, 0,
+                        "frame " + std::to_string(k) + ": the " + (c == 0 ? "voltage" : "current") +
+                            " sample is not a finite number once scaled by its gain");
   }
   rec.voltage_full_scale_v = voltage_gain_v;
   rec.current_full_scale_a = current_gain_a;

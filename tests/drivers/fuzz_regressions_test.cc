@@ -68,10 +68,19 @@ TEST(FuzzRegressions, AWavSampleThatIsNotFiniteIsRefusedNamingTheFrame) {
   r.current_a = {0.1, std::numeric_limits<double>::infinity(), 0.2};
   WriteWavRecording(path, r, 1.0, 1.0);
   EXPECT_EQ(FileErrorOf([&] { ReadWavRecording(path, 10.0, 5.0); }),
-            path + ": frame 1: the current sample is not a finite number");
+            path + ": frame 1: the current sample is not a finite number once scaled by its gain");
   r.current_a[1] = 0.3;
   WriteWavRecording(path, r, 1.0, 1.0);
   EXPECT_EQ(ReadWavRecording(path, 10.0, 5.0).current_a.at(1), 0.3f * 5.0);
+}
+
+// wav_fuzzer in the suite's run: a malformed header whose samples read back finite but
+// overflow once scaled by the gain (kept as tests/fuzz/corpus/wav/finding-scaled-overflow.wav).
+TEST(FuzzRegressions, AWavSampleThatOverflowsOnceScaledIsRefused) {
+  const std::string path =
+      std::string(EOL_SOURCE_DIR) + "/tests/fuzz/corpus/wav/finding-scaled-overflow.wav";
+  const std::string e = FileErrorOf([&] { ReadWavRecording(path, 10.0, 5.0); });
+  EXPECT_NE(e.find("is not a finite number once scaled by its gain"), std::string::npos) << e;
 }
 
 // recipe_fuzzer and config_fuzzer's check that whole numbers are kept: get<int>() wrapped,
