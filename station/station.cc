@@ -43,6 +43,7 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
 }
 
 Station::~Station() {
+  if (plc_) plc_->Stop();
   if (http_) http_->Stop();
   if (drivers_.fixture) drivers_.fixture->Disconnect();
   if (drivers_.daq) drivers_.daq->Disconnect();
@@ -157,6 +158,11 @@ int Station::http_port() const { return http_ ? http_->port() : 0; }
 db::TestRecord Station::RunTest(const std::string& serial) { return sequencer_->RunTest(serial); }
 
 bool Station::Enqueue(const std::string& serial, std::string* why) {
+  return Enqueue(TestRequest{serial}, why);
+}
+
+bool Station::Enqueue(const TestRequest& request, std::string* why,
+                      std::uint64_t* verdicts_before) {
   std::lock_guard<std::mutex> lock(queue_mu_);
   if (stop_) {
     *why = "station is stopping";
@@ -166,14 +172,15 @@ bool Station::Enqueue(const std::string& serial, std::string* why) {
     *why = "busy: a test is running or waiting";
     return false;
   }
-  queue_.push_back(serial);
+  queue_.push_back(request);
+  if (verdicts_before != nullptr) *verdicts_before = verdicts_;
   queue_cv_.notify_all();
   return true;
 }
 
 void Station::Serve() {
   while (true) {
-    std::string serial;
+    TestRequest request;
     {
       std::unique_lock<std::mutex> lock(queue_mu_);
       // Wakes at least every second to tell systemd's watchdog the loop is alive; a test that
@@ -186,14 +193,20 @@ void Station::Serve() {
       }
       NotifyWatchdog();
       if (stop_) return;
-      serial = queue_.front();
+      request = queue_.front();
       queue_.pop_front();
       running_test_ = true;
     }
-    const db::TestRecord r = sequencer_->RunTest(serial);
+    const db::TestRecord r = sequencer_->RunTest(request.serial);
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),
                  r.reasons.empty() ? "" : r.reasons.front().text);
     std::lock_guard<std::mutex> lock(queue_mu_);
+    // Plant integration: what the line PLC reads, changed together with running_test_.
+    ++verdicts_;
+    if (r.id != 0) ++stored_;  // refusals by the sequencer (lockout, ...) store nothing
+    last_outcome_ = r.outcome;
+    last_reason_.reset();
+    if (!r.reasons.empty()) last_reason_ = r.reasons.front().code;
     running_test_ = false;
   }
 }
@@ -207,5 +220,38 @@ void Station::RequestStop(const std::string& why) {
   }
   sequencer_->RequestAbort(why);
 }
+
+// ---- Plant integration (issue 15) ----
+
+void Station::StartPlc() {
+  if (!config_.plc || plc_) return;
+  plc::PlcBackend backend;
+  backend.start = [this](const TestRequest& request) {
+    plc::PlcStartReply reply;
+    if (Enqueue(request, &reply.message, &reply.verdicts_before)) return reply;
+    std::lock_guard<std::mutex> lock(queue_mu_);
+    reply.refusal = stop_ ? plc::PlcRefusal::kStopping : plc::PlcRefusal::kBusy;
+    return reply;
+  };
+  backend.view = [this] {
+    plc::PlcStationView v;
+    {
+      std::lock_guard<std::mutex> lock(queue_mu_);
+      v.busy = running_test_ || !queue_.empty();
+      v.stopping = stop_;
+      v.verdicts = verdicts_;
+      v.stored = stored_;
+      v.last_outcome = last_outcome_;
+      v.last_reason = last_reason_;
+    }
+    const nlohmann::json lockout = board_->Snapshot()["lockout"];
+    v.lockout = lockout.is_object() && lockout.value("locked", false);
+    return v;
+  };
+  plc_ = std::make_unique<plc::PlcServer>(*config_.plc, std::move(backend));
+  plc_->Start();
+}
+
+int Station::plc_port() const { return plc_ ? plc_->port() : 0; }
 
 }  // namespace eol::station

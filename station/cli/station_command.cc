@@ -1,5 +1,6 @@
 // `eol station --config FILE`: the station as a long-running daemon. Serials arrive over
-// HTTP (POST /api/tests) or, with "serial_from_stdin", from a scanner typing into stdin.
+// HTTP (POST /api/tests), from the line PLC (a "plc" block: station/plc/plc_map.h) or, with
+// "serial_from_stdin", from a scanner typing into stdin.
 // SIGTERM/SIGINT abort the test in flight safely (excitation off, safe state, stored as
 // ABORTED) and stop the daemon.
 #include <signal.h>
@@ -29,9 +30,13 @@ int RunStation(const std::string& config_path, std::string web_root) {
   Station station(LoadStationConfig(config_path));
   if (web_root.empty()) web_root = DefaultWebRoot();
   station.StartHttp(web_root);
+  station.StartPlc();  // when the config has a "plc" block
   std::cout << "eol station: " << station.config().station_id << " ready, recipe "
             << station.recipe()->id << " v" << station.recipe()->version << ", http://"
-            << station.config().http_listen << ":" << station.http_port() << "/" << std::endl;
+            << station.config().http_listen << ":" << station.http_port() << "/";
+  if (station.config().plc)
+    std::cout << ", plc modbus://" << station.config().plc->listen << ":" << station.plc_port();
+  std::cout << std::endl;
 
   NotifyReady("testing " + station.recipe()->id + " v" + std::to_string(station.recipe()->version));
   std::thread signal_thread([&] {
