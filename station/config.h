@@ -14,6 +14,7 @@
 //   "sim": {...},                                    the simulated bench, when a driver is sim
 //   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500},
 //   "serial_from_stdin": false,                      a scanner typing serials into stdin
+//                                                    (its line format: station/test_request.h)
 //   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
 //                  "every_n_tests": 50, "every_hours": 8}       optional, station/self_check.h
 //   "plc": {"listen": "0.0.0.0", "port": 502, "unit_id": 1, "max_clients": 8,

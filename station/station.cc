@@ -57,7 +57,7 @@ void Station::StartHttp(const std::string& web_root) {
   o.tokens = config_.tokens;
   o.web_root = web_root;
   HttpHandlers h;
-  h.start_test = [this](const std::string& s, std::string* why) { return Enqueue(s, why); };
+  h.start_test = [this](const TestRequest& r, std::string* why) { return Enqueue(r, why); };
   h.recipe = [this] {
     const auto r = recipe();
     nlohmann::json j = r->source;
@@ -158,7 +158,7 @@ int Station::http_port() const { return http_ ? http_->port() : 0; }
 db::TestRecord Station::RunTest(const std::string& serial) { return sequencer_->RunTest(serial); }
 
 bool Station::Enqueue(const std::string& serial, std::string* why) {
-  return Enqueue(TestRequest{serial}, why);
+  return Enqueue(TestRequest{serial, {}}, why);
 }
 
 bool Station::Enqueue(const TestRequest& request, std::string* why,
@@ -197,7 +197,7 @@ void Station::Serve() {
       queue_.pop_front();
       running_test_ = true;
     }
-    const db::TestRecord r = sequencer_->RunTest(request.serial);
+    const db::TestRecord r = sequencer_->RunTest(request.serial, request.work);
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),
                  r.reasons.empty() ? "" : r.reasons.front().text);
     std::lock_guard<std::mutex> lock(queue_mu_);

@@ -15,6 +15,7 @@
 #include "station/serial_number.h"
 #include "station/station.h"
 #include "station/systemd_notify.h"
+#include "station/test_request.h"
 
 namespace eol::station::cli {
 namespace {
@@ -53,9 +54,12 @@ int RunStation(const std::string& config_path, std::string web_root) {
       std::string line;
       while (std::getline(std::cin, line)) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
+        // The scanner's line: the serial, then TAB-separated key=value fields
+        // (station/test_request.h).
         std::string why;
-        if (!ValidSerial(line, &why) || !station.Enqueue(line, &why))
-          spdlog::warn("serial '{}' refused: {}", line, why);
+        const std::optional<TestRequest> request = ParseScannerLine(line, &why);
+        if (!request || !station.Enqueue(*request, &why))
+          spdlog::warn("scanner line '{}' refused: {}", line, why);
       }
     }).detach();
   }

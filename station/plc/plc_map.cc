@@ -32,8 +32,11 @@ struct SignalSpec {
   int width;  // addresses taken
 };
 
-constexpr std::array<SignalSpec, 10> kSignals = {{
+constexpr std::array<SignalSpec, 13> kSignals = {{
     {"serial", &PlcMap::serial, Table::kHoldingRegister, kSerialRegisters},
+    {"operator_id", &PlcMap::operator_id, Table::kHoldingRegister, kOperatorIdRegisters},
+    {"shift", &PlcMap::shift, Table::kHoldingRegister, kShiftRegisters},
+    {"order_number", &PlcMap::order_number, Table::kHoldingRegister, kOrderNumberRegisters},
     {"start", &PlcMap::start, Table::kCoil, 1},
     {"busy", &PlcMap::busy, Table::kDiscreteInput, 1},
     {"done", &PlcMap::done, Table::kDiscreteInput, 1},

@@ -7,6 +7,9 @@
 //   table             addr     signal        meaning
 //   holding register  100-115  serial        serial number, ASCII, two characters per register,
 //                                            high byte first, NUL padded (at most 32 characters)
+//   holding register  116-131  operator_id   who tests, the same encoding (at most 32; NUL: none)
+//   holding register  132-139  shift         the shift (at most 16 characters; NUL: none)
+//   holding register  140-155  order_number  production order or batch (at most 32)
 //   coil              100      start         the PLC sets it to start a test of `serial`; the
 //                                            station clears it when it has taken the request
 //                                            (accepted or refused, see `refusal`)
@@ -24,7 +27,8 @@
 //   input register    103      refusal       why the last start was refused (PlcRefusal below;
 //                                            0 when it was accepted)
 //
-// The handshake: write `serial`, set `start`; wait until `start` reads 0; `refusal` 0 means
+// The handshake: write `serial` (and operator_id, shift, order_number, which are stored with
+// the record; leave them NUL for none), set `start`; wait until `start` reads 0; `refusal` 0 means
 // accepted (busy follows at once), otherwise nothing was started and the previous result
 // stays readable. Then wait for `done`, read `result`, `reason` and `counter`. A start
 // refused by the sequencer itself (lockout, retest limit, database down) ends with done = 1,
@@ -34,9 +38,11 @@
 // Each address can be moved in the station config's "plc": {"map": {...}}; the tables are
 // fixed by what a signal is (the PLC writes coils and holding registers, reads the others):
 //
-//   "map": {"serial": 0, "start": 0, "busy": 8, "result": 20}
+//   "map": {"serial": 0, "operator_id": 16, "shift": 32, "order_number": 40, "start": 0,
+//           "busy": 8, "result": 20}
 //
-// Blocks (serial) may not overlap another signal of their table.
+// Blocks (serial, operator_id, shift, order_number) may not overlap another signal of their
+// table.
 #pragma once
 
 #include <cstdint>
@@ -48,13 +54,19 @@
 
 namespace eol::station::plc {
 
-// Registers of the serial block: 16 registers, 32 ASCII characters.
+// Registers of the text blocks: two characters each (station/test_request.h's lengths).
 inline constexpr int kSerialRegisters = 16;
+inline constexpr int kOperatorIdRegisters = 16;
+inline constexpr int kShiftRegisters = 8;
+inline constexpr int kOrderNumberRegisters = 16;
 
 struct PlcMap {
-  int serial = 100;  // holding registers serial .. serial + kSerialRegisters - 1
-  int start = 100;   // coil
-  int busy = 100;    // discrete inputs
+  int serial = 100;        // holding registers serial .. serial + kSerialRegisters - 1
+  int operator_id = 116;   // .. + kOperatorIdRegisters - 1
+  int shift = 132;         // .. + kShiftRegisters - 1
+  int order_number = 140;  // .. + kOrderNumberRegisters - 1
+  int start = 100;         // coil
+  int busy = 100;          // discrete inputs
   int done = 101;
   int ready = 102;
   int lockout = 103;

@@ -85,7 +85,10 @@ void PlcServer::Start() {
   const PlcMap& m = settings_.map;
   const Range coils = Span({{m.start, 1}});
   const Range inputs = Span({{m.busy, 1}, {m.done, 1}, {m.ready, 1}, {m.lockout, 1}});
-  const Range holding = Span({{m.serial, kSerialRegisters}});
+  const Range holding = Span({{m.serial, kSerialRegisters},
+                              {m.operator_id, kOperatorIdRegisters},
+                              {m.shift, kShiftRegisters},
+                              {m.order_number, kOrderNumberRegisters}});
   const Range input_registers =
       Span({{m.result, 1}, {m.counter, 1}, {m.reason, 1}, {m.refusal, 1}});
   mapping_ = modbus_mapping_new_start_address(
@@ -215,11 +218,22 @@ void PlcServer::TakeStart() {
   PlcStartReply reply;
   TestRequest r;
   std::string why;
-  if (!DecodeAscii(mapping_->tab_registers + (m.serial - mapping_->start_registers),
-                   kSerialRegisters, &r.serial, &why)) {
+  const auto text = [&](int address, int count, std::string* out) {
+    return DecodeAscii(mapping_->tab_registers + (address - mapping_->start_registers), count, out,
+                       &why);
+  };
+  if (!text(m.serial, kSerialRegisters, &r.serial)) {
     reply = {PlcRefusal::kBadSerial, "serial registers: " + why, 0};
   } else if (!ValidSerial(r.serial, &why)) {
     reply = {PlcRefusal::kBadSerial, "serial '" + r.serial + "': " + why, 0};
+  } else if (!text(m.operator_id, kOperatorIdRegisters, &r.work.operator_id)) {
+    reply = {PlcRefusal::kBadField, "operator_id registers: " + why, 0};
+  } else if (!text(m.shift, kShiftRegisters, &r.work.shift)) {
+    reply = {PlcRefusal::kBadField, "shift registers: " + why, 0};
+  } else if (!text(m.order_number, kOrderNumberRegisters, &r.work.order_number)) {
+    reply = {PlcRefusal::kBadField, "order_number registers: " + why, 0};
+  } else if (!ValidWorkContext(r.work, &why)) {
+    reply = {PlcRefusal::kBadField, why, 0};
   } else {
     reply = backend_.start(r);
   }

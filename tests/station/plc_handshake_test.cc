@@ -208,8 +208,36 @@ TEST_F(PlcHandshakeTest, APlcThatDisconnectsMidTestReadsTheStoredResultOnReconne
   EXPECT_EQ(r[2]["values"], nlohmann::json({1, 1, 0, 0}));
 }
 
+TEST_F(PlcHandshakeTest, OperatorShiftAndOrderBlocksAreStoredWithTheRecord) {
+  StartStation();
+  const int bad_field = static_cast<int>(plc::PlcRefusal::kBadField);
+  // A shift with a control character is refused with its own code, nothing started.
+  nlohmann::json ops = {{"write_text", 100, 16, "GOOD-1"},
+                        {"write_hrs", 132, {0x4101, 0, 0, 0, 0, 0, 0, 0}},
+                        {"write_coil", 100, 1},
+                        {"wait_coil", 100, 0, 5},
+                        {"read_ir", 103, 1},
+                        {"write_text", 116, 16, "op-17"},
+                        {"write_text", 132, 8, "night"},
+                        {"write_text", 140, 16, "PO-4711/batch 3"},
+                        {"write_coil", 100, 1},
+                        {"wait_coil", 100, 0, 5},
+                        {"read_ir", 103, 1},
+                        {"wait_di", 101, 1, 120}};
+  const nlohmann::json r = Plc(ops);
+  ASSERT_EQ(r.size(), 12u);
+  EXPECT_EQ(r[4]["values"], nlohmann::json::array({bad_field}));
+  EXPECT_EQ(r[10]["values"], nlohmann::json::array({0}));
+  const std::vector<db::TestRecord> stored = Stored();
+  ASSERT_EQ(stored.size(), 1u);
+  EXPECT_EQ(stored[0].work, (db::WorkContext{"op-17", "night", "PO-4711/batch 3"}));
+}
+
 TEST_F(PlcHandshakeTest, AMovedMapServesTheSameHandshakeAtTheNewAddresses) {
   StartStation(0.02, {{"serial", 0},
+                      {"operator_id", 16},
+                      {"shift", 32},
+                      {"order_number", 40},
                       {"start", 7},
                       {"busy", 10},
                       {"done", 11},
@@ -286,6 +314,8 @@ TEST(PlcMap, OverridesAreCheckedNamingTheJsonPath) {
             0u)
       << message({{"strat", 1}});
   EXPECT_EQ(message({{"busy", 101}}), "/plc/map: busy and done share discrete input address 101");
+  EXPECT_EQ(message({{"serial", 110}}),
+            "/plc/map: serial and operator_id share holding register address 116");
   EXPECT_EQ(message({{"serial", 65530}}),
             "/plc/map: serial: holding register address 65530 (16 registers) is outside 0..65535");
   EXPECT_EQ(message({{"result", "100"}}),
