@@ -116,4 +116,16 @@ CREATE TABLE self_checks (
 CREATE INDEX self_checks_at ON self_checks(at);
 )sql";
 
+// Version 3 -> 4: who tested and for which order (db/test_record.h WorkContext).
+//
+// tests.operator_id, tests.shift, tests.order_number: as given with the serial; '' when not
+//   given, and for every row written before version 4. Authoritative like the other columns
+//   (the record JSON holds copies). The index serves "every unit of this order".
+inline constexpr const char kSchemaV4[] = R"sql(
+ALTER TABLE tests ADD COLUMN operator_id TEXT NOT NULL DEFAULT '';
+ALTER TABLE tests ADD COLUMN shift TEXT NOT NULL DEFAULT '';
+ALTER TABLE tests ADD COLUMN order_number TEXT NOT NULL DEFAULT '';
+CREATE INDEX tests_order_started ON tests(order_number, started_at);
+)sql";
+
 }  // namespace eol::db::schema

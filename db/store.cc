@@ -179,8 +179,12 @@ void MigrateTo3(sqlite3* db, const std::string& path) {
   Exec(db, path, schema::kSchemaV3, "migrate the schema to version 3");
 }
 
+void MigrateTo4(sqlite3* db, const std::string& path) {
+  Exec(db, path, schema::kSchemaV4, "migrate the schema to version 4");
+}
+
 constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {&MigrateTo1, &MigrateTo2,
-                                                                      &MigrateTo3};
+                                                                      &MigrateTo3, &MigrateTo4};
 
 std::int64_t PragmaInt(sqlite3* db, const std::string& path, const char* sql,
                        const std::string& op) {
@@ -285,9 +289,10 @@ void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
   if (record.started_at.empty()) throw StoreError(Message(path, op, "record.started_at is empty"));
   Statement s(db, path, R"sql(
     INSERT INTO tests (serial, station_id, recipe_id, recipe_version, recipe_hash,
-                       software_version, started_at, outcome, retest_of, kind)
+                       software_version, started_at, outcome, retest_of, kind,
+                       operator_id, shift, order_number)
     VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, 'RUNNING',
-            (SELECT min(id) FROM tests WHERE serial = ?1), ?8)
+            (SELECT min(id) FROM tests WHERE serial = ?1), ?8, ?9, ?10, ?11)
     RETURNING id, retest_of)sql",
               op);
   s.BindText(1, record.serial);
@@ -298,6 +303,9 @@ void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
   s.BindText(6, record.software_version);
   s.BindText(7, record.started_at);
   s.BindText(8, ToString(record.kind));
+  s.BindText(9, record.work.operator_id);
+  s.BindText(10, record.work.shift);
+  s.BindText(11, record.work.order_number);
   if (!s.Step()) throw StoreError(Message(path, op, "the insert returned no id"));
   const std::int64_t id = s.Int(0);
   const std::optional<std::int64_t> retest_of = s.OptInt(1);
@@ -393,7 +401,8 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
 
 constexpr std::string_view kSelectTests =
     "SELECT id, serial, station_id, recipe_id, recipe_version, recipe_hash, software_version, "
-    "started_at, finished_at, outcome, retest_of, reasons, record, kind FROM tests ";
+    "started_at, finished_at, outcome, retest_of, reasons, record, kind, operator_id, shift, "
+    "order_number FROM tests ";
 
 TestRecord RowToRecord(const Statement& s, const std::string& path) {
   const std::int64_t id = s.Int(0);
@@ -427,6 +436,9 @@ TestRecord RowToRecord(const Statement& s, const std::string& path) {
   } catch (const std::invalid_argument& e) {
     throw StoreError(Message(path, op, e.what()));
   }
+  r.work.operator_id = s.Text(14);
+  r.work.shift = s.Text(15);
+  r.work.order_number = s.Text(16);
   r.curves.clear();
   return r;
 }
@@ -634,6 +646,8 @@ std::vector<TestRecord> Store::Tests(const TestQuery& query) {
   if (outcome_i) sql += " AND outcome = ?" + std::to_string(outcome_i);
   const int serial_i = query.serial ? ++n : 0;
   if (serial_i) sql += " AND serial = ?" + std::to_string(serial_i);
+  const int order_i = query.order_number ? ++n : 0;
+  if (order_i) sql += " AND order_number = ?" + std::to_string(order_i);
   const int limit_i = ++n;
   sql += " ORDER BY started_at DESC, id DESC LIMIT ?" + std::to_string(limit_i);
 
@@ -642,6 +656,7 @@ std::vector<TestRecord> Store::Tests(const TestQuery& query) {
   if (to_i) s.BindText(to_i, *query.to);
   if (outcome_i) s.BindText(outcome_i, analysis::ToString(*query.outcome));
   if (serial_i) s.BindText(serial_i, *query.serial);
+  if (order_i) s.BindText(order_i, *query.order_number);
   s.BindInt(limit_i, std::clamp(query.limit, 1, kMaxQueryLimit));
   return ReadTests(db_, path_, s, query.with_curves);
 }

@@ -36,6 +36,7 @@ struct TestQuery {
   std::optional<std::string> to;    // ISO 8601, exclusive
   std::optional<analysis::Outcome> outcome;
   std::optional<std::string> serial;
+  std::optional<std::string> order_number;  // schema v4
   int limit = 100;
   bool with_curves = false;
 };
@@ -91,7 +92,7 @@ struct MeasurementRow {
 
 class Store {
  public:
-  static constexpr int kSchemaVersion = 3;
+  static constexpr int kSchemaVersion = 4;
 
   // kWriter: the station's one connection; recovers unfinished tests as ABORTED. It holds an
   // exclusive flock on "<path>.lock" (created 0600 beside the file) for as long as it is open:

@@ -83,7 +83,10 @@ void to_json(nlohmann::json& j, const TestRecord& r) {
        {"curves", r.curves},
        {"trace", r.trace},
        {"kind", r.kind},
-       {"self_check", r.self_check}};
+       {"self_check", r.self_check},
+       {"operator_id", r.work.operator_id},
+       {"shift", r.work.shift},
+       {"order_number", r.work.order_number}};
 }
 
 void from_json(const nlohmann::json& j, TestRecord& r) {
@@ -110,6 +113,9 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   r.trace = j.value("trace", std::vector<StateEntry>{});
   r.kind = j.value("kind", RecordKind::kProduction);
   r.self_check = j.value("self_check", nlohmann::json::object());
+  r.work.operator_id = j.value("operator_id", "");
+  r.work.shift = j.value("shift", "");
+  r.work.order_number = j.value("order_number", "");
 }
 
 }  // namespace eol::db

@@ -138,6 +138,20 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
           if (f.is_string()) f = Resolve(base_dir, f.get<std::string>());
     }
     if (root.Has("sim")) c.drivers["sim"] = root.Raw("sim");
+    // Plant integration (issue 15).
+    if (auto p = root.OptionalObject("plc")) {
+      plc::PlcServerSettings s;
+      s.listen = p->String("listen", s.listen);
+      s.port = p->Integer("port", s.port);
+      s.unit_id = p->Integer("unit_id", s.unit_id);
+      s.max_clients = p->Integer("max_clients", s.max_clients);
+      p->Require(s.port >= 0 && s.port <= 65535, "port", "must be in [0, 65535]");
+      p->Require(s.unit_id >= 1 && s.unit_id <= 247, "unit_id", "must be in [1, 247]");
+      p->Require(s.max_clients >= 1 && s.max_clients <= 64, "max_clients", "must be in [1, 64]");
+      if (p->Has("map")) s.map = plc::ParsePlcMap(p->Raw("map"), p->PathOf("map"));
+      p->RejectUnknown();
+      c.plc = s;
+    }
     root.RejectUnknown();
     return c;
   } catch (const io::ConfigError& e) {

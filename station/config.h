@@ -16,8 +16,12 @@
 //   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500, "poll_period_ms": 10,
 //              "safe_state_retry_s": 3},
 //   "serial_from_stdin": false,                      a scanner typing serials into stdin
+//                                                    (its line format: station/test_request.h)
 //   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
 //                  "every_n_tests": 50, "every_hours": 8}       optional, station/self_check.h
+//   "plc": {"listen": "0.0.0.0", "port": 502, "unit_id": 1, "max_clients": 8,
+//           "map": {"serial": 100, ...}}         optional: the line PLC's handshake, served
+//                                                when the block is there (station/plc/)
 // }
 #pragma once
 
@@ -26,6 +30,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "station/plc/plc_server.h"
 
 namespace eol::station {
 
@@ -72,6 +78,8 @@ struct StationConfig {
   bool serial_from_stdin = false;
   SelfCheckConfig self_check;
   nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}
+  // Plant integration (issue 15): the line PLC's handshake; nullopt without a "plc" block.
+  std::optional<plc::PlcServerSettings> plc;
 };
 
 // Non-empty when the station runs on simulators or recorded data rather than a real fixture

@@ -5,7 +5,9 @@
 //   GET  /api/units/{serial}    every test of that serial, newest first (no curves)
 //   GET  /api/tests/{id}        one test with its curves
 //   GET  /api/tests?from=&to=&verdict=&serial=&limit=   tests in a time range
-//   POST /api/tests             {"serial": "..."} starts a test (bearer token when configured)
+//   POST /api/tests             {"serial": "...", "operator_id", "shift", "order_number"}
+//                               starts a test (bearer token when configured; the three
+//                               optional fields as station/test_request.h accepts them)
 //   PUT  /api/recipe            a new version of the recipe (engineer token; audited)
 //   GET  /api/recipe/audit      who changed the recipe, when, old and new hash
 //   GET  /api/recipe            the recipe in use with its hash (limits and masks)
@@ -41,6 +43,7 @@
 #include "station/recipe.h"
 #include "station/recipe_change.h"
 #include "station/status_board.h"
+#include "station/test_request.h"
 
 namespace eol::station {
 
@@ -61,8 +64,8 @@ struct HttpOptions {
 
 // What the API asks of the station.
 struct HttpHandlers {
-  // Queues a test for `serial`; false with the reason when refused (busy, stopping).
-  std::function<bool(const std::string& serial, std::string* why)> start_test;
+  // Queues a test; false with the reason when refused (busy, stopping).
+  std::function<bool(const TestRequest& request, std::string* why)> start_test;
   // The recipe in use as JSON, with its "hash".
   std::function<nlohmann::json()> recipe;
   // The recipe in use, parsed (teaching and detectability work from it).

@@ -497,11 +497,16 @@ void Sequencer::StoreAndPublish(db::TestRecord& record) {
 }
 
 db::TestRecord Sequencer::RunTest(const std::string& serial) {
+  return RunTest(serial, db::WorkContext{});
+}
+
+db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkContext& work) {
   test_start_ = Clock::now();
   abort_.store(stop_requested_.load());
   beat_after_excitation_.reset();
   db::TestRecord record;
   record.serial = serial;
+  record.work = work;
   record.station_id = options_.station_id;
   record.recipe_id = recipe_->id;
   record.recipe_version = recipe_->version;

@@ -88,6 +88,8 @@ class Sequencer {
   // Runs one test to its end and returns the stored record. Never throws for station,
   // fixture, acquisition or data faults: they end as ERROR with the cause in reasons.
   db::TestRecord RunTest(const std::string& serial);
+  // The same, with who tests it for which order (stored with the record; issue 15).
+  db::TestRecord RunTest(const std::string& serial, const db::WorkContext& work);
   // Thread-safe: aborts the test in flight (excitation off, safe state, outcome ABORTED).
   void RequestAbort(const std::string& why);
   SeqState state() const { return state_.load(); }

@@ -95,6 +95,7 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
 }
 
 Station::~Station() {
+  if (plc_) plc_->Stop();
   if (http_) http_->Stop();
   if (drivers_.fixture) drivers_.fixture->Disconnect();
   if (drivers_.daq) drivers_.daq->Disconnect();
@@ -108,7 +109,7 @@ void Station::StartHttp(const std::string& web_root) {
   o.tokens = config_.tokens;
   o.web_root = web_root;
   HttpHandlers h;
-  h.start_test = [this](const std::string& s, std::string* why) { return Enqueue(s, why); };
+  h.start_test = [this](const TestRequest& r, std::string* why) { return Enqueue(r, why); };
   h.recipe = [this] {
     const auto r = recipe();
     nlohmann::json j = r->source;
@@ -224,6 +225,11 @@ int Station::http_port() const { return http_ ? http_->port() : 0; }
 db::TestRecord Station::RunTest(const std::string& serial) { return sequencer_->RunTest(serial); }
 
 bool Station::Enqueue(const std::string& serial, std::string* why) {
+  return Enqueue(TestRequest{serial, {}}, why);
+}
+
+bool Station::Enqueue(const TestRequest& request, std::string* why,
+                      std::uint64_t* verdicts_before) {
   std::lock_guard<std::mutex> lock(queue_mu_);
   if (stop_) {
     *why = "station is stopping";
@@ -237,7 +243,8 @@ bool Station::Enqueue(const std::string& serial, std::string* why) {
     *why = "busy: a test is running or waiting";
     return false;
   }
-  queue_.push_back(serial);
+  queue_.push_back(request);
+  if (verdicts_before != nullptr) *verdicts_before = verdicts_;
   queue_cv_.notify_all();
   return true;
 }
@@ -296,7 +303,7 @@ void Station::HealthLoop(const std::atomic<bool>& serving) {
 
 void Station::ServeQueue() {
   while (true) {
-    std::string serial;
+    TestRequest request;
     {
       std::unique_lock<std::mutex> lock(queue_mu_);
       int idle_s = 0;
@@ -305,17 +312,23 @@ void Station::ServeQueue() {
         if (++idle_s % 60 == 0) sequencer_->PublishLockout();  // a check falls due with time
       }
       if (stop_) return;
-      serial = queue_.front();
+      request = queue_.front();
       queue_.pop_front();
       running_test_ = true;
-      running_serial_ = serial;
+      running_serial_ = request.serial;
       test_started_ = std::chrono::steady_clock::now();
       test_deadline_s_ = TestDeadlineS(*recipe(), config_.safety);
     }
-    const db::TestRecord r = sequencer_->RunTest(serial);
+    const db::TestRecord r = sequencer_->RunTest(request.serial, request.work);
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),
                  r.reasons.empty() ? "" : r.reasons.front().text);
     std::lock_guard<std::mutex> lock(queue_mu_);
+    // Plant integration: what the line PLC reads, changed together with running_test_.
+    ++verdicts_;
+    if (r.id != 0) ++stored_;  // refusals by the sequencer (lockout, ...) store nothing
+    last_outcome_ = r.outcome;
+    last_reason_.reset();
+    if (!r.reasons.empty()) last_reason_ = r.reasons.front().code;
     running_test_ = false;
   }
 }
@@ -329,5 +342,38 @@ void Station::RequestStop(const std::string& why) {
   }
   sequencer_->RequestAbort(why);
 }
+
+// ---- Plant integration (issue 15) ----
+
+void Station::StartPlc() {
+  if (!config_.plc || plc_) return;
+  plc::PlcBackend backend;
+  backend.start = [this](const TestRequest& request) {
+    plc::PlcStartReply reply;
+    if (Enqueue(request, &reply.message, &reply.verdicts_before)) return reply;
+    std::lock_guard<std::mutex> lock(queue_mu_);
+    reply.refusal = stop_ ? plc::PlcRefusal::kStopping : plc::PlcRefusal::kBusy;
+    return reply;
+  };
+  backend.view = [this] {
+    plc::PlcStationView v;
+    {
+      std::lock_guard<std::mutex> lock(queue_mu_);
+      v.busy = running_test_ || !queue_.empty();
+      v.stopping = stop_;
+      v.verdicts = verdicts_;
+      v.stored = stored_;
+      v.last_outcome = last_outcome_;
+      v.last_reason = last_reason_;
+    }
+    const nlohmann::json lockout = board_->Snapshot()["lockout"];
+    v.lockout = lockout.is_object() && lockout.value("locked", false);
+    return v;
+  };
+  plc_ = std::make_unique<plc::PlcServer>(*config_.plc, std::move(backend));
+  plc_->Start();
+}
+
+int Station::plc_port() const { return plc_ ? plc_->port() : 0; }
 
 }  // namespace eol::station

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -14,10 +15,12 @@
 #include "drivers/factory/factory.h"
 #include "station/config.h"
 #include "station/http_api.h"
+#include "station/plc/plc_server.h"
 #include "station/recipe.h"
 #include "station/recipe_change.h"
 #include "station/sequencer.h"
 #include "station/status_board.h"
+#include "station/test_request.h"
 
 namespace eol::station {
 
@@ -47,6 +50,10 @@ class Station {
 
   // For the daemon: queue a serial (one test at a time; refused while one runs or waits).
   bool Enqueue(const std::string& serial, std::string* why);
+  // The same for a whole request; `verdicts_before` (optional) gets the number of tests
+  // ended before this one was accepted (the PLC's done bit waits for the next).
+  bool Enqueue(const TestRequest& request, std::string* why,
+               std::uint64_t* verdicts_before = nullptr);
   // Runs queued tests until RequestStop(); returns when the test in flight has ended. Feeds
   // systemd's watchdog from a health thread while it runs (see HealthLoop).
   void Serve();
@@ -65,6 +72,13 @@ class Station {
   drivers::SimBench* bench() { return drivers_.bench.get(); }
   db::Store& store() { return *store_; }
 
+  // ---- Plant integration (issue 15) ----
+  // Serves the line PLC's handshake (station/plc/plc_server.h) when the config has a "plc"
+  // block; the port actually bound is plc_port() (0 when not serving). Throws naming the
+  // address when it cannot listen.
+  void StartPlc();
+  int plc_port() const;
+
  private:
   StationConfig config_;
   mutable std::mutex recipe_mu_;
@@ -77,10 +91,11 @@ class Station {
   std::unique_ptr<StatusBoard> board_;
   std::unique_ptr<Sequencer> sequencer_;
   std::unique_ptr<HttpApi> http_;
+  std::unique_ptr<plc::PlcServer> plc_;
 
   std::mutex queue_mu_;
   std::condition_variable queue_cv_;
-  std::deque<std::string> queue_;
+  std::deque<TestRequest> queue_;
   bool running_test_ = false;
   std::string running_serial_;
   std::chrono::steady_clock::time_point test_started_{};
@@ -89,6 +104,12 @@ class Station {
 
   void ServeQueue();
   void HealthLoop(const std::atomic<bool>& serving);
+  // What the line PLC reads (under queue_mu_): tests ended and records stored since start,
+  // and the newest verdict.
+  std::uint64_t verdicts_ = 0;
+  std::uint64_t stored_ = 0;
+  std::optional<analysis::Outcome> last_outcome_;
+  std::optional<analysis::ReasonCode> last_reason_;
 };
 
 // Seconds after which a test of `recipe` is stuck (Station::HealthLoop).

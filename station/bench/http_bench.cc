@@ -113,7 +113,7 @@ HttpBenchResult RunHttpBench(const HttpBenchOptions& o) {
   options.port = 0;
   options.db_path = db_path;
   HttpHandlers handlers;
-  handlers.start_test = [](const std::string&, std::string* why) {
+  handlers.start_test = [](const TestRequest&, std::string* why) {
     *why = "http-bench: tests are not started";
     return false;
   };

@@ -1,6 +1,7 @@
-// `eol export --db FILE [--serial SN] [--from T] [--to T] [--format csv|json] [--out FILE]`:
-// records out of the station for quality engineering (one CSV row per test with one column
-// per measurement, or JSON records with curves).
+// `eol export --db FILE [--serial SN] [--from T] [--to T] [--order NO] [--format csv|json]
+// [--out FILE]`: records out of the station for quality engineering (one CSV row per test
+// with one column per measurement, or JSON records with curves), with the operator, shift
+// and order each test was run for.
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -18,6 +19,7 @@ struct ExportArgs {
   std::string serial;
   std::string from;
   std::string to;
+  std::string order;
   std::string format = "csv";
   std::string out;
   int limit = 10000;
@@ -43,14 +45,15 @@ void WriteCsv(std::ostream& out, const std::vector<db::TestRecord>& tests) {
   for (const auto& t : tests)
     for (const auto& m : t.measurements) names.insert(m.name);
   out << "id,serial,station_id,started_at,finished_at,outcome,recipe_id,recipe_version,"
-         "recipe_hash,software_version,retest_of";
+         "recipe_hash,software_version,retest_of,operator_id,shift,order_number";
   for (const auto& n : names) out << "," << n;
   out << ",reasons\n";
   for (const auto& t : tests) {
     out << t.id << "," << Csv(t.serial) << "," << Csv(t.station_id) << "," << t.started_at << ","
         << t.finished_at << "," << analysis::ToString(t.outcome) << "," << Csv(t.recipe_id) << ","
         << t.recipe_version << "," << t.recipe_hash << "," << Csv(t.software_version) << ","
-        << (t.retest_of ? std::to_string(*t.retest_of) : "");
+        << (t.retest_of ? std::to_string(*t.retest_of) : "") << "," << Csv(t.work.operator_id)
+        << "," << Csv(t.work.shift) << "," << Csv(t.work.order_number);
     for (const auto& n : names) {
       std::string v;
       for (const auto& m : t.measurements)
@@ -69,6 +72,7 @@ int RunExport(const ExportArgs& a) {
   if (!a.serial.empty()) q.serial = a.serial;
   if (!a.from.empty()) q.from = IsoOption("--from", a.from);
   if (!a.to.empty()) q.to = IsoOption("--to", a.to);
+  if (!a.order.empty()) q.order_number = a.order;
   q.limit = a.limit;
   q.with_curves = a.format == "json";
   const std::vector<db::TestRecord> tests = store->Tests(q);
@@ -98,7 +102,7 @@ void AddExportCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "export",
       "Export finished tests as CSV (one row per test, one column per measurement) or JSON\n"
-      "(full records with curves), by serial and/or time range (ISO 8601 UTC, e.g.\n"
+      "(full records with curves), by serial, order and/or time range (ISO 8601 UTC, e.g.\n"
       "2026-11-22T00:00:00.000Z; from inclusive, to exclusive).");
   cmd->add_option("--db", args->db, "SQLite file of the station")
       ->required()
@@ -108,6 +112,7 @@ void AddExportCommand(CLI::App& app) {
                   "Started at or after (ISO 8601: a date, or a time with Z or an offset)");
   cmd->add_option("--to", args->to,
                   "Started before (ISO 8601: a date, or a time with Z or an offset)");
+  cmd->add_option("--order", args->order, "Only tests of this order/batch number");
   cmd->add_option("--format", args->format, "csv or json")
       ->capture_default_str()
       ->check(CLI::IsMember({"csv", "json"}));

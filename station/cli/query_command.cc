@@ -1,4 +1,5 @@
-// `eol query --db FILE --serial SN [--json]`: the traceable history of one serial number.
+// `eol query --db FILE --serial SN [--json]`: the traceable history of one serial number,
+// with who tested it and for which order.
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -44,6 +45,11 @@ int RunQuery(const QueryArgs& a) {
                 t.started_at.c_str(), analysis::ToString(t.outcome), t.recipe_id.c_str(),
                 t.recipe_version, t.recipe_hash.substr(0, 12).c_str(),
                 t.retest_of ? (" retest of #" + std::to_string(*t.retest_of)).c_str() : "");
+    if (t.work != db::WorkContext{})  // who and for which order (schema v4), when given
+      std::printf("          operator %s, shift %s, order %s\n",
+                  t.work.operator_id.empty() ? "-" : t.work.operator_id.c_str(),
+                  t.work.shift.empty() ? "-" : t.work.shift.c_str(),
+                  t.work.order_number.empty() ? "-" : t.work.order_number.c_str());
     for (const auto& m : t.measurements) {
       if (!std::isfinite(m.value)) continue;
       std::printf("          %-18s %12.6g %-4s [%s] %s\n", m.name.c_str(), m.value, m.unit.c_str(),

@@ -1,5 +1,6 @@
 // `eol station --config FILE`: the station as a long-running daemon. Serials arrive over
-// HTTP (POST /api/tests) or, with "serial_from_stdin", from a scanner typing into stdin.
+// HTTP (POST /api/tests), from the line PLC (a "plc" block: station/plc/plc_map.h) or, with
+// "serial_from_stdin", from a scanner typing into stdin.
 // SIGTERM/SIGINT abort the test in flight safely (excitation off, safe state, stored as
 // ABORTED) and stop the daemon.
 #include <signal.h>
@@ -16,6 +17,7 @@
 #include "station/serial_number.h"
 #include "station/station.h"
 #include "station/systemd_notify.h"
+#include "station/test_request.h"
 
 namespace eol::station::cli {
 namespace {
@@ -42,6 +44,7 @@ int RunStation(const std::string& config_path, std::string web_root) {
   Station& station = *made;
   if (web_root.empty()) web_root = DefaultWebRoot();
   station.StartHttp(web_root);
+  station.StartPlc();  // when the config has a "plc" block
   // "ready" only when the fixture and the DAQ answered; otherwise the daemon is up (the API
   // answers, each test retries the drivers) and says what is missing.
   const nlohmann::json board = station.board().Snapshot();
@@ -50,8 +53,10 @@ int RunStation(const std::string& config_path, std::string web_root) {
   const std::string simulation = board.value("simulation", "");
   std::cout << "eol station: " << station.config().station_id << " " << readiness << ", recipe "
             << station.recipe()->id << " v" << station.recipe()->version << ", http://"
-            << station.config().http_listen << ":" << station.http_port() << "/"
-            << (simulation.empty() ? "" : ", SIMULATION (" + simulation + ")") << std::endl;
+            << station.config().http_listen << ":" << station.http_port() << "/";
+  if (station.config().plc)
+    std::cout << ", plc modbus://" << station.config().plc->listen << ":" << station.plc_port();
+  std::cout << (simulation.empty() ? "" : ", SIMULATION (" + simulation + ")") << std::endl;
 
   NotifyReady((station.ready() ? "testing " : "NOT READY, testing ") + station.recipe()->id + " v" +
               std::to_string(station.recipe()->version) +
@@ -70,9 +75,12 @@ int RunStation(const std::string& config_path, std::string web_root) {
       std::string line;
       while (std::getline(std::cin, line)) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
+        // The scanner's line: the serial, then TAB-separated key=value fields
+        // (station/test_request.h).
         std::string why;
-        if (!ValidSerial(line, &why) || !station.Enqueue(line, &why))
-          spdlog::warn("serial '{}' refused: {}", line, why);
+        const std::optional<TestRequest> request = ParseScannerLine(line, &why);
+        if (!request || !station.Enqueue(*request, &why))
+          spdlog::warn("scanner line '{}' refused: {}", line, why);
       }
     }).detach();
   }

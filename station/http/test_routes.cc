@@ -82,7 +82,9 @@ void PostTest(ApiContext& c, const httplib::Request& req, httplib::Response& res
   const std::string serial = body["serial"].get<std::string>();
   std::string why;
   if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
-  if (!c.handlers.start_test(serial, &why))
+  TestRequest request{serial, {}};
+  if (!ReadWorkContext(body, &request.work, &why)) return Send(res, BadRequest("bad_field", why));
+  if (!c.handlers.start_test(request, &why))
     return Send(res, ApiError{ApiErrorKind::kConflict, "busy", why});
   Send(res, HttpReply{202, {{"serial", serial}, {"accepted", true}}});
 }

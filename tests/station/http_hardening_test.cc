@@ -86,7 +86,7 @@ struct Api {
     o.db_path = dir / "s.sqlite";
     o.limits = limits;
     HttpHandlers h;
-    h.start_test = [this](const std::string&, std::string*) {
+    h.start_test = [this](const TestRequest&, std::string*) {
       ++started;
       return true;
     };

@@ -54,6 +54,8 @@ class QueryExportTest : public ::testing::Test {
     auto a = Record("SN-1", "2026-11-20T08:00:00.000Z", analysis::Outcome::kFail, 352.0);
     auto b = Record("SN-1", "2026-11-21T08:00:00.000Z", analysis::Outcome::kPass, 391.0);
     auto c = Record("SN-2", "2026-11-21T09:00:00.000Z", analysis::Outcome::kPass, 389.5);
+    b.work = {"op-17", "B", "PO-4711"};
+    c.work = {"op-2", "night", "PO-9, \"rush\""};
     store->Insert(a);
     store->Insert(b);
     store->Insert(c);
@@ -108,6 +110,31 @@ TEST_F(QueryExportTest, ExportJsonBySerialAndTimeRange) {
   for (const auto& t : j) EXPECT_EQ(t["outcome"], "PASS");
   const CliRun one = Eol({"export", "--db", db_, "--format", "json", "--serial", "SN-2"});
   EXPECT_EQ(nlohmann::json::parse(one.out).size(), 1u);
+}
+
+TEST_F(QueryExportTest, QueryAndExportShowWhoTestedAndForWhichOrder) {
+  const CliRun q = Eol({"query", "--db", db_, "--serial", "SN-1", "--json"});
+  ASSERT_EQ(q.code, 0) << q.out;
+  const auto j = nlohmann::json::parse(q.out);
+  EXPECT_EQ(j["tests"][0]["operator_id"], "op-17");
+  EXPECT_EQ(j["tests"][0]["shift"], "B");
+  EXPECT_EQ(j["tests"][0]["order_number"], "PO-4711");
+  EXPECT_EQ(j["tests"][1]["operator_id"], "") << "the first test was given none";
+  const CliRun text = Eol({"query", "--db", db_, "--serial", "SN-1"});
+  EXPECT_NE(text.out.find("operator op-17, shift B, order PO-4711"), std::string::npos) << text.out;
+
+  const CliRun csv = Eol({"export", "--db", db_, "--format", "csv"});
+  ASSERT_EQ(csv.code, 0) << csv.out;
+  EXPECT_NE(csv.out.find(",retest_of,operator_id,shift,order_number,"), std::string::npos)
+      << csv.out;
+  EXPECT_NE(csv.out.find(",op-2,night,\"PO-9, \"\"rush\"\"\","), std::string::npos) << csv.out;
+
+  const CliRun order = Eol({"export", "--db", db_, "--format", "json", "--order", "PO-4711"});
+  ASSERT_EQ(order.code, 0) << order.out;
+  const auto po = nlohmann::json::parse(order.out);
+  ASSERT_EQ(po.size(), 1u);
+  EXPECT_EQ(po[0]["serial"], "SN-1");
+  EXPECT_EQ(po[0]["operator_id"], "op-17");
 }
 
 TEST_F(QueryExportTest, MissingDatabaseNamesThePath) {
