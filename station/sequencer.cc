@@ -39,6 +39,11 @@ db::Curve ToCurve(const analysis::Frf& z, const std::string& name) {
   return c;
 }
 
+// "fixture heartbeat frozen for N ms": the start of every frozen-heartbeat reason.
+std::string FrozenHeartbeat(const HeartbeatMonitor& heartbeat, Clock::time_point now) {
+  return "fixture heartbeat frozen for " + Fixed(heartbeat.stale_ms(now), 0) + " ms";
+}
+
 }  // namespace
 
 const char* ToString(SeqState s) {
@@ -150,7 +155,7 @@ class Sequencer::Watchdog {
         }
         why = InterlockFault(in.value(), *seq_.recipe_, true);
         if (why.empty() && !seq_.heartbeat_.Update(in.value().heartbeat, now))
-          why = "fixture heartbeat frozen for " + Fixed(seq_.heartbeat_.stale_ms(now), 0) + " ms";
+          why = FrozenHeartbeat(seq_.heartbeat_, now);
       }
       if (!why.empty()) {
         const drivers::Status off = seq_.fixture_.Write(FixtureOutput::kExcitationEnable, false);
@@ -245,8 +250,7 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
   board_.SetReadiness(true, "");
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
     throw Fault{Outcome::kError,
-                {ReasonCode::kInterlock, "fixture heartbeat frozen for " +
-                                             Fixed(heartbeat_.stale_ms(Clock::now()), 0) + " ms"}};
+                {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, Clock::now())}};
   if (const std::string why = InterlockFault(in, *recipe_, false); !why.empty())
     throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock: " + why}};
 }
@@ -334,9 +338,8 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
     throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock after excitation: " + why}};
   if (!heartbeat_.Update(after.heartbeat, Clock::now()))
     throw Fault{Outcome::kError,
-                {ReasonCode::kInterlock, "fixture heartbeat frozen for " +
-                                             Fixed(heartbeat_.stale_ms(Clock::now()), 0) +
-                                             " ms at the end of excitation"}};
+                {ReasonCode::kInterlock,
+                 FrozenHeartbeat(heartbeat_, Clock::now()) + " at the end of excitation"}};
   beat_after_excitation_ = after.heartbeat;
   if (!result->ok())
     throw Fault{Outcome::kError,
@@ -401,9 +404,8 @@ void Sequencer::Unclamp(db::TestRecord& record) {
     fresh_beat = fresh_beat || in.heartbeat != *beat_after_excitation_;
     if (!fresh_beat && !heartbeat_.Update(in.heartbeat, now))
       throw Fault{Outcome::kError,
-                  {ReasonCode::kInterlock, "fixture heartbeat frozen for " +
-                                               Fixed(heartbeat_.stale_ms(now), 0) +
-                                               " ms after excitation: its inputs during the "
+                  {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, now) +
+                                               " after excitation: its inputs during the "
                                                "test cannot be trusted"}};
     if (released && fresh_beat) break;
     if (!released && now > deadline)
