@@ -191,8 +191,8 @@ Sequencer::Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& st
       heartbeat_(
           std::chrono::milliseconds(static_cast<long>(options_.safety.heartbeat_timeout_ms))) {}
 
-void Sequencer::SetRecipe(std::shared_ptr<const Recipe> recipe) {
-  excitation_ = analysis::DesignMultisine(recipe->excitation);
+void Sequencer::SetRecipe(std::shared_ptr<const Recipe> recipe, analysis::Excitation designed) {
+  excitation_ = std::move(designed);
   recipe_ = std::move(recipe);
 }
 

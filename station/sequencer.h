@@ -93,8 +93,10 @@ class Sequencer {
   // Thread-safe: aborts the test in flight (excitation off, safe state, outcome ABORTED).
   void RequestAbort(const std::string& why);
   SeqState state() const { return state_.load(); }
-  // Between tests only (the caller guarantees no RunTest is in progress).
-  void SetRecipe(std::shared_ptr<const Recipe> recipe);
+  // Between tests only (the caller guarantees no RunTest is in progress). `designed` is
+  // analysis::DesignMultisine(recipe->excitation), which the caller has already built to
+  // validate the recipe before anything was swapped.
+  void SetRecipe(std::shared_ptr<const Recipe> recipe, analysis::Excitation designed);
   const Recipe& recipe() const { return *recipe_; }
   // Re-reads the self-check state from the store and shows it on the board (GET /api/status).
   // Between tests only; a no-op when self-checks are off.

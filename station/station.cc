@@ -144,8 +144,9 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   }
   // Everything the new recipe needs is built before anything is renamed, audited or swapped:
   // a recipe whose excitation cannot be designed leaves the station as it was.
+  analysis::Excitation designed;
   try {
-    (void)analysis::DesignMultisine(next->excitation);
+    designed = analysis::DesignMultisine(next->excitation);
   } catch (const std::exception& e) {
     return refused(RecipeChange::Kind::kInvalid,
                    std::string("PUT /api/recipe: /excitation: cannot be designed: ") + e.what());
@@ -199,9 +200,21 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   if (!recipe_problem_.empty()) {  // under queue_mu_, as Enqueue reads it
     recipe_problem_.clear();
     board_->SetMessage("");
-    board_->SetReadiness(true, "");
+    // The recipe was the only thing wrong only if both drivers answered; otherwise the board
+    // keeps saying so until the next test reconnects them.
+    const auto connected = [](drivers::Lifecycle l) {
+      return l == drivers::Lifecycle::kInactive || l == drivers::Lifecycle::kActive;
+    };
+    const bool fixture_up = connected(drivers_.fixture->lifecycle());
+    const bool daq_up = connected(drivers_.daq->lifecycle());
+    std::string not_ready;
+    if (!fixture_up) not_ready = "fixture not connected (retried at the next test)";
+    if (!daq_up)
+      not_ready += (not_ready.empty() ? "" : "; ") +
+                   std::string("acquisition not connected (retried at the next test)");
+    board_->SetReadiness(not_ready.empty(), not_ready);
   }
-  sequencer_->SetRecipe(next);
+  sequencer_->SetRecipe(next, std::move(designed));
   board_->SetRecipe(next->id, next->hash);
   spdlog::warn("recipe {} changed by {} ({}): v{} {} -> v{} {}", next->id, who.name,
                ToString(who.role), current->version, current->hash.substr(0, 12), next->version,

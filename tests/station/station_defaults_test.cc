@@ -104,6 +104,32 @@ TEST(StationDefaults, ARecipeThatDoesNotLoadRefusesTestsButKeepsTheStationUp) {
   EXPECT_TRUE(s.ready());
 }
 
+// Fixing the recipe lifts only the recipe's refusal: a fixture that never answered keeps the
+// station "not ready" with its own cause.
+TEST(StationDefaults, FixingTheRecipeDoesNotHideAnUnreachableFixture) {
+  eol::testing::TempDir dir;
+  const std::string path = dir / "pmsm-10pole.json";
+  nlohmann::json good = io::ReadJsonFile(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json");
+  {
+    std::ofstream kept(dir / "pmsm-10pole.v1.json");
+    kept << good.dump(2);
+    std::ofstream broken(path);
+    broken << "{\"id\": \"pmsm-10pole\"";
+  }
+  nlohmann::json config = ConfigWith(
+      dir, {{"driver", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", 1}}, {{"driver", "sim"}});
+  config["recipe"] = path;
+  Station s(ParseStationConfig(config, "t", ""));
+  EXPECT_FALSE(s.ready());
+  good["version"] = 2;
+  const ApiToken anna{"qe-anna", Role::kEngineer, "engineer-token-0123456789"};
+  ASSERT_EQ(s.ChangeRecipe(good, anna).kind, RecipeChange::Kind::kChanged);
+  EXPECT_FALSE(s.ready());
+  EXPECT_NE(s.board().Snapshot()["not_ready_reason"].get<std::string>().find("fixture"),
+            std::string::npos)
+      << s.board().Snapshot().dump();
+}
+
 TEST(StationDefaults, ARecipeThatDoesNotLoadWithNoKeptVersionIsAConfigError) {
   eol::testing::TempDir dir;
   const std::string path = dir / "r.json";
