@@ -7,6 +7,7 @@ find_package(CLI11 REQUIRED)
 find_package(OpenSSL REQUIRED)  # SHA-256 of recipes
 find_package(Threads REQUIRED)
 find_package(ZLIB REQUIRED)       # compressed raw curves in the store
+find_package(prometheus-cpp CONFIG REQUIRED)  # /metrics (core registry and text format)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 pkg_check_modules(MODBUS REQUIRED IMPORTED_TARGET libmodbus)

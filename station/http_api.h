@@ -72,6 +72,8 @@ struct HttpHandlers {
   std::function<std::shared_ptr<const Recipe>()> current_recipe;
   // Validates, stores and activates a new recipe version (Station::ChangeRecipe).
   std::function<RecipeChange(const nlohmann::json& recipe, const ApiToken& who)> change_recipe;
+  // GET /metrics: the Prometheus exposition text (station/station_metrics.h).
+  std::function<std::string()> metrics;
 };
 
 class HttpApi {

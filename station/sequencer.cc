@@ -12,6 +12,7 @@
 #include "analysis/text.h"
 #include "db/clock.h"
 #include "drivers/daq/calibration_file.h"
+#include "station/cycle_time.h"
 #include "station/judge.h"
 #include "station/self_check.h"
 #include "station/version.h"
@@ -160,6 +161,7 @@ class Sequencer::Watchdog {
       if (!why.empty()) {
         const drivers::Status off = seq_.fixture_.Write(FixtureOutput::kExcitationEnable, false);
         seq_.abort_.store(true);
+        seq_.watchdog_trips_.fetch_add(1);
         spdlog::error("watchdog: {}; excitation off{}", why,
                       off.ok() ? "" : " command failed (" + off.message() + ")");
         std::lock_guard<std::mutex> lock(mu_);
@@ -481,6 +483,8 @@ void Sequencer::SafeState(db::TestRecord& record) {
 
 void Sequencer::StoreAndPublish(db::TestRecord& record) {
   Enter(record, SeqState::kStore, analysis::ToString(record.outcome));
+  record.cycle_s =
+      CycleBreakdown({record.trace.begin(), record.trace.end() - 1}, record.trace.back().t_ms);
   record.finished_at = db::UtcNowIso8601();
   try {
     store_.FinishTest(record);
@@ -595,6 +599,8 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
   StoreAndPublish(record);
   if (options_.self_check.enabled()) PublishLockout();
   Enter(record, SeqState::kWaitSerial);
+  record.cycle_s =
+      CycleBreakdown({record.trace.begin(), record.trace.end() - 1}, record.trace.back().t_ms);
   return record;
 }
 

@@ -101,6 +101,8 @@ class Sequencer {
   // Re-reads the self-check state from the store and shows it on the board (GET /api/status).
   // Between tests only; a no-op when self-checks are off.
   void PublishLockout();
+  // Times the interlock watchdog cut the excitation since construction. Thread-safe.
+  std::uint64_t watchdog_trips() const { return watchdog_trips_.load(); }
 
  private:
   struct Fault;
@@ -137,7 +139,8 @@ class Sequencer {
 
   std::atomic<SeqState> state_{SeqState::kWaitSerial};
   std::atomic<bool> stop_requested_{false};  // sticky: RequestAbort() was called
-  std::atomic<bool> abort_{false};           // read by the DAQ: stop playing now (reset per test)
+  std::atomic<std::uint64_t> watchdog_trips_{0};
+  std::atomic<bool> abort_{false};  // read by the DAQ: stop playing now (reset per test)
   std::mutex abort_mu_;
   std::string abort_reason_;
   std::chrono::steady_clock::time_point test_start_{};

@@ -9,6 +9,7 @@
 #include "analysis/text.h"
 #include "db/clock.h"
 #include "station/systemd_notify.h"
+#include "station/version.h"
 
 namespace eol::station {
 
@@ -120,6 +121,7 @@ void Station::StartHttp(const std::string& web_root) {
   h.change_recipe = [this](const nlohmann::json& j, const ApiToken& who) {
     return ChangeRecipe(j, who);
   };
+  h.metrics = [this] { return metrics_.Render(LiveValues()); };
   http_ = std::make_unique<HttpApi>(*board_, o, h);
   http_->Start();
 }
@@ -235,7 +237,34 @@ bool Station::ready() const { return board_->Snapshot().value("ready", false); }
 
 int Station::http_port() const { return http_ ? http_->port() : 0; }
 
-db::TestRecord Station::RunTest(const std::string& serial) { return sequencer_->RunTest(serial); }
+db::TestRecord Station::RunTest(const std::string& serial) {
+  db::TestRecord r = sequencer_->RunTest(serial);
+  metrics_.OnTest(r);
+  return r;
+}
+
+LiveMetrics Station::LiveValues() {
+  LiveMetrics m;
+  const nlohmann::json board = board_->Snapshot();
+  const std::string state = board.value("state", "");
+  m.testing = state != "wait_serial" && state != "idle";
+  m.ready = board.value("ready", false);
+  m.locked_out = board["lockout"].is_object() && board["lockout"].value("locked", false);
+  m.simulation = !board.value("simulation", std::string()).empty();
+  {
+    std::lock_guard<std::mutex> lock(queue_mu_);
+    m.queue_length = queue_.size();
+  }
+  m.fixture_errors = drivers_.fixture->failures();
+  m.watchdog_trips = sequencer_->watchdog_trips();
+  m.db_path = config_.db_path;
+  m.station_id = config_.station_id;
+  const auto r = recipe();
+  m.recipe_id = r->id;
+  m.recipe_hash = r->hash;
+  m.software_version = SoftwareVersion();
+  return m;
+}
 
 bool Station::Enqueue(const std::string& serial, std::string* why) {
   return Enqueue(TestRequest{serial, {}}, why);
@@ -307,6 +336,7 @@ void Station::HealthLoop(const std::atomic<bool>& serving) {
       spdlog::error("{}: excitation off, watchdog pings stopped (systemd restarts the daemon)",
                     stuck);
       board_->SetMessage(stuck + "; call maintenance");
+      metrics_.OnStuckTest();
       reported = true;
     }
     for (int i = 0; i < 10 && serving; ++i)
@@ -333,6 +363,7 @@ void Station::ServeQueue() {
       test_deadline_s_ = TestDeadlineS(*recipe(), config_.safety);
     }
     const db::TestRecord r = sequencer_->RunTest(request.serial, request.work);
+    metrics_.OnTest(r);
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),
                  r.reasons.empty() ? "" : r.reasons.front().text);
     std::lock_guard<std::mutex> lock(queue_mu_);

@@ -19,6 +19,7 @@
 #include "station/recipe.h"
 #include "station/recipe_change.h"
 #include "station/sequencer.h"
+#include "station/station_metrics.h"
 #include "station/status_board.h"
 #include "station/test_request.h"
 
@@ -92,6 +93,7 @@ class Station {
   std::unique_ptr<Sequencer> sequencer_;
   std::unique_ptr<HttpApi> http_;
   std::unique_ptr<plc::PlcServer> plc_;
+  StationMetrics metrics_;
 
   std::mutex queue_mu_;
   std::condition_variable queue_cv_;
@@ -103,6 +105,8 @@ class Station {
   bool stop_ = false;
 
   void ServeQueue();
+  // What /metrics reads at scrape time (board, queue, driver and sequencer counters).
+  LiveMetrics LiveValues();
   void HealthLoop(const std::atomic<bool>& serving);
   // What the line PLC reads (under queue_mu_): tests ended and records stored since start,
   // and the newest verdict.

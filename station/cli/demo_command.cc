@@ -2,15 +2,18 @@
 // known share of poorly cemented rotors, and scoring its verdicts against the truth.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/text.h"
 #include "drivers/emulators/modbus_fixture_server.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/cycle_time.h"
 #include "station/data_files.h"
 #include "station/station.h"
 
@@ -30,6 +33,18 @@ struct DemoArgs {
   bool verbose = false;
   std::string fixture = "modbus";
 };
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double CycleStep(const db::TestRecord& r, const char* step) {
+  const auto it = r.cycle_s.find(step);
+  return it == r.cycle_s.end() ? 0.0 : it->second;
+}
 
 double MeasurementValue(const db::TestRecord& r, std::string_view name) {
   for (const auto& m : r.measurements)
@@ -78,6 +93,9 @@ int RunDemo(const DemoArgs& a) {
 
   int pass = 0, fail = 0, error = 0, defective = 0, detected = 0, false_rejects = 0;
   nlohmann::json serials = nlohmann::json::array();
+  // Cycle time per unit (station/cycle_time.h): excitation of all phase pairs, serial
+  // received -> verdict published, and the station's own overhead.
+  std::vector<double> excitation_s, cycle_s, overhead_s;
   for (int i = 1; i <= a.units; ++i) {
     char serial[64];
     std::snprintf(serial, sizeof serial, "DEMO-%llu-%04d", static_cast<unsigned long long>(a.seed),
@@ -85,6 +103,9 @@ int RunDemo(const DemoArgs& a) {
     const db::TestRecord r = station.RunTest(serial);
     const bool is_defective = station.bench()->part() && station.bench()->part()->defective;
     serials.push_back(serial);
+    excitation_s.push_back(CycleStep(r, "excitation"));
+    cycle_s.push_back(CycleStep(r, "total"));
+    overhead_s.push_back(StationOverheadS(r.cycle_s));
     switch (r.outcome) {
       case analysis::Outcome::kPass:
         ++pass;
@@ -103,14 +124,18 @@ int RunDemo(const DemoArgs& a) {
       ++false_rejects;
     }
     char line[256];
-    std::snprintf(line, sizeof line, "[%3d/%d] %-16s f0 = %7.2f Hz  %-7s truth: %-9s ", i, a.units,
-                  serial, MeasurementValue(r, analysis::names::kResonanceFHz),
-                  analysis::ToString(r.outcome), is_defective ? "defective" : "good");
+    std::snprintf(line, sizeof line, "[%3d/%d] %-16s f0 = %7.2f Hz  %-7s truth: %-9s %5.2f s ", i,
+                  a.units, serial, MeasurementValue(r, analysis::names::kResonanceFHz),
+                  analysis::ToString(r.outcome), is_defective ? "defective" : "good",
+                  CycleStep(r, "total"));
     out << line << (r.reasons.empty() ? "" : r.reasons.front().text) << "\n" << std::flush;
   }
   out << "summary: " << a.units << " units: " << pass << " PASS, " << fail << " FAIL, " << error
       << " ERROR; " << detected << " of " << defective << " defective rotors caught, "
-      << false_rejects << " good rotors rejected\n";
+      << false_rejects << " good rotors rejected\n"
+      << "cycle (medians per unit): excitation " << analysis::Fixed(Median(excitation_s), 3)
+      << " s, serial to verdict " << analysis::Fixed(Median(cycle_s), 3) << " s, station overhead "
+      << analysis::Fixed(Median(overhead_s), 3) << " s (time scale " << a.time_scale << ")\n";
   if (a.json) {
     const nlohmann::json summary = {{"units", a.units},
                                     {"pass", pass},
@@ -120,6 +145,10 @@ int RunDemo(const DemoArgs& a) {
                                     {"detected", detected},
                                     {"false_rejects", false_rejects},
                                     {"serials", serials},
+                                    {"excitation_s", Median(excitation_s)},
+                                    {"cycle_s", Median(cycle_s)},
+                                    {"overhead_s", Median(overhead_s)},
+                                    {"time_scale", a.time_scale},
                                     {"db", a.db},
                                     {"http_port", station.http_port()}};
     std::cout << summary.dump() << std::endl;

@@ -43,24 +43,10 @@ void GetEvents(ApiContext& c, const httplib::Request&, httplib::Response& res) {
 }
 
 void GetMetrics(ApiContext& c, const httplib::Request&, httplib::Response& res) {
-  const nlohmann::json st = c.board.Snapshot();
-  std::ostringstream m;
-  m << "# HELP eol_tests_total Finished tests since the station started, by outcome.\n"
-    << "# TYPE eol_tests_total counter\n";
-  for (const char* o : {"pass", "fail", "error", "aborted"})
-    m << "eol_tests_total{outcome=\"" << o << "\"} " << st["counts"][o].get<std::uint64_t>()
-      << "\n";
-  m << "# HELP eol_testing 1 while a test is in progress.\n# TYPE eol_testing gauge\n"
-    << "eol_testing " << (st["state"] == "wait_serial" || st["state"] == "idle" ? 0 : 1) << "\n";
-  if (st["last"].is_object()) {
-    for (const auto& meas : st["last"]["measurements"]) {
-      if (meas["name"] != "resonance_f_hz" || !meas["value"].is_number()) continue;
-      m << "# HELP eol_last_resonance_hz Resonance of the last tested unit.\n"
-        << "# TYPE eol_last_resonance_hz gauge\n"
-        << "eol_last_resonance_hz " << meas["value"].get<double>() << "\n";
-    }
-  }
-  res.set_content(m.str(), "text/plain; version=0.0.4");
+  if (!c.handlers.metrics)
+    return Send(res, ApiError{ApiErrorKind::kUnavailable, "no_metrics",
+                              "this server has no station behind it to measure"});
+  res.set_content(c.handlers.metrics(), "text/plain; version=0.0.4");
 }
 
 std::string ReadFile(const std::string& path) {
