@@ -62,6 +62,12 @@
 // variance of the middle line, A being the quadratic form it applies to the noise (nu = 2 x
 // that in real terms; measured values in tests/analysis/transient_frf_test.cc).
 //
+// Measured (eol fit-bench, time-domain records from rest, 200-800 Hz at 4 Hz, P = 2, 2 mV /
+// 1 mA noise, 1000 runs, Q = 50): std(f0) 1.03 x the bound of the channels' true noise over
+// the whole 0.5 s, bias +0.25 std (the mode's transient residue), coverage of +-2 sigma 96 %
+// (the leverage term is conservative for f0: neighbouring lines' removal errors are
+// correlated). Q = 15: 1.04, bias 0.02 std. Q = 150: 1.15, bias 0.6 std (see above).
+//
 // Cost: one real FFT of the whole record per channel (N log N), then per excited line a
 // (2 w) x (R + 1) least-squares fit: O(N log N + lines w R^2). Under a millisecond for the
 // recipe's record (README).
@@ -84,8 +90,11 @@ struct TransientFrfOptions {
   std::size_t half_width = 3;  // w, non-excited bins on each side; 2 w > R + 1 (residual dof)
   // Input amplitude over the corrected bin's noise below which a line has no signal.
   double min_line_snr = 10.0;
-  // Half-width h of the pooling of the noise (co)variances over neighbouring lines.
-  std::size_t noise_smoothing_lines = 5;
+  // Half-width h of the pooling of the noise (co)variances over neighbouring lines. Wider
+  // than periodic_frf.h's 5: adjacent windows share most of their bins, so 2 h + 1 = 21
+  // lines give about 18 complex dof at P = 2 (11 lines: 10, and chi2/dof 1.10 from the
+  // weights' scatter, nu / (nu - 2) with nu = 20 real dof; 21 lines: 1.05).
+  std::size_t noise_smoothing_lines = 10;
 
   bool IsValid(std::string* why) const;
 };
