@@ -14,6 +14,25 @@ void AddValue(ImpedanceAnalysis& a, std::string_view measurement, const char* pa
 
 }  // namespace
 
+const char* ToString(FrfMethod method) {
+  switch (method) {
+    case FrfMethod::kDiscardTransient:
+      return "discard_transient";
+    case FrfMethod::kTransientLpm:
+      return "transient_lpm";
+  }
+  return "?";
+}
+
+bool ParseFrfMethod(std::string_view text, FrfMethod* method) {
+  for (FrfMethod m : {FrfMethod::kDiscardTransient, FrfMethod::kTransientLpm})
+    if (text == ToString(m)) {
+      *method = m;
+      return true;
+    }
+  return false;
+}
+
 ImpedanceAnalysis AnalyzeImpedance(const Frf& z, const ResonanceFitOptions& options) {
   ImpedanceAnalysis a;
   a.frf.frf = z;
@@ -37,7 +56,9 @@ ImpedanceAnalysis AnalyzeImpedance(const Frf& z, const ResonanceFitOptions& opti
 ImpedanceAnalysis AnalyzeRecording(const Recording& recording,
                                    const std::vector<std::size_t>& lines,
                                    const ImpedanceAnalysisOptions& options) {
-  const FrfSummary frf = EstimatePeriodicFrf(recording, lines, options.frf);
+  const FrfSummary frf = options.frf_method == FrfMethod::kTransientLpm
+                             ? EstimateTransientFrf(recording, lines, options.lpm)
+                             : EstimatePeriodicFrf(recording, lines, options.frf);
   if (!frf.usable) {
     ImpedanceAnalysis a;
     a.frf = frf;

@@ -122,6 +122,10 @@ void ParseAnalysis(const JsonObject& a, Recipe& r) {
   a.Require(fit.q_min > 0 && fit.q_max > fit.q_min, "q_max", "must be above q_min > 0");
   std::string why;
   a.Require(fit.IsValid(&why), "f0_min_hz", why);
+  const std::string method =
+      a.String("frf_method", analysis::ToString(analysis::FrfMethod::kDiscardTransient));
+  a.Require(analysis::ParseFrfMethod(method, &r.analysis.frf_method), "frf_method",
+            "must be \"discard_transient\" or \"transient_lpm\"");
   a.RejectUnknown();
 }
 
@@ -374,7 +378,8 @@ nlohmann::json RecipeToJson(const Recipe& r) {
        {{"f0_min_hz", r.analysis.fit.f0_min_hz},
         {"f0_max_hz", r.analysis.fit.f0_max_hz},
         {"q_min", r.analysis.fit.q_min},
-        {"q_max", r.analysis.fit.q_max}}},
+        {"q_max", r.analysis.fit.q_max},
+        {"frf_method", analysis::ToString(r.analysis.frf_method)}}},
       {"retest", {{"max_tests_per_serial", r.max_tests_per_serial}}},
       {"limits", limits},
       {"masks", masks}};

@@ -8,7 +8,10 @@
 //                  "phase_pairs": [0, 1, 2]},
 //   "fixture":    {"clamp_pressure_bar": {"lo": 4.5, "hi": 6.5}, "clamp_timeout_s": 2.0,
 //                  "release_timeout_s": 2.0},
-//   "analysis":   {"f0_min_hz": 250, "f0_max_hz": 700, "q_min": 5, "q_max": 500},
+//   "analysis":   {"f0_min_hz": 250, "f0_max_hz": 700, "q_min": 5, "q_max": 500,
+//                  "frf_method": "discard_transient" (default: drop transient_periods, average
+//                  the rest) | "transient_lpm" (keep every period, remove the start transient;
+//                  analysis/signal/transient_frf.h)},
 //   "retest":     {"max_tests_per_serial": 3},                                    optional
 //   "limits": [ {"name": "resonance_f_hz", "unit": "Hz", "lo": 370, "hi": 420,
 //                "marginal": 3, "doc": "..."}, ... ],

@@ -83,6 +83,9 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
       {[](auto& j) { j["analysis"]["f0_max_hz"] = 900; },
        "/analysis/f0_max_hz: must lie inside the excited band"},
       {[](auto& j) { j["version"] = 0; }, "/version: must be a whole number >= 1"},
+      {[](auto& j) { j["analysis"]["frf_method"] = "lpm"; },
+       "/analysis/frf_method: must be \"discard_transient\" or \"transient_lpm\" (got "
+       "\"lpm\")"},
       {[](auto& j) {
          j["excitation"]["phase_pairs"] = {0, 1};
        },
@@ -110,6 +113,21 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
     EXPECT_NE(err.find(c.expected), std::string::npos)
         << "got: " << err << "\nwant: " << c.expected;
   }
+}
+
+// Issue 16: the analysis block chooses the FRF estimator; absent, today's.
+TEST(Recipe, FrfMethodIsChosenInTheAnalysisBlock) {
+  EXPECT_EQ(LoadRecipe(kRecipe).analysis.frf_method, analysis::FrfMethod::kDiscardTransient);
+  nlohmann::json j = Good();
+  j["analysis"]["frf_method"] = "transient_lpm";
+  j["excitation"]["transient_periods"] = 0;
+  j["excitation"]["periods"] = 2;
+  const Recipe r = ParseRecipe(j, "test.json");
+  EXPECT_EQ(r.analysis.frf_method, analysis::FrfMethod::kTransientLpm);
+  EXPECT_EQ(RecipeToJson(r)["analysis"]["frf_method"], "transient_lpm");
+  j["analysis"]["frf_method"] = "discard_transient";
+  EXPECT_EQ(ParseRecipe(j, "test.json").analysis.frf_method,
+            analysis::FrfMethod::kDiscardTransient);
 }
 
 TEST(Recipe, PhasePairsInOrder) {
