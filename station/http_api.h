@@ -10,7 +10,8 @@
 //                               optional fields as station/test_request.h accepts them)
 //   PUT  /api/recipe            a new version of the recipe (engineer token; audited)
 //   GET  /api/recipe/audit      who changed the recipe, when, old and new hash
-//   GET  /api/recipe            the recipe in use with its hash (limits and masks)
+//   GET  /api/recipe            the recipe in use with its hash (limits and masks) and its
+//                               operator "instructions" with their defaults written out
 //   GET  /api/stats?from=&to=&recipe_hash=&gauge=&reference=NAME=VALUE&sigma_span=
 //                               capability, drift alarms, gauge study (station/stats_report.h)
 //   GET  /api/detectability?k_fixture=&limit_sigmas=&required_sigmas=
