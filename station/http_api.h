@@ -4,7 +4,8 @@
 //   GET  /api/events            server-sent events: state changes and verdicts
 //   GET  /api/units/{serial}    every test of that serial, newest first (no curves)
 //   GET  /api/tests/{id}        one test with its curves
-//   GET  /api/tests?from=&to=&verdict=&serial=&limit=   tests in a time range
+//   GET  /api/tests?from=&to=&outcome=&serial=&limit=   tests in a time range ("verdict=",
+//                               the older name of outcome=, is still accepted)
 //   POST /api/tests             {"serial": "...", "operator_id", "shift", "order_number"}
 //                               starts a test (bearer token when configured; the three
 //                               optional fields as station/test_request.h accepts them)
