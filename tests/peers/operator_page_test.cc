@@ -276,5 +276,52 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
   station.Stop(SIGTERM, 20s);
 }
 
+// A station with tokens (any station that listens beyond loopback must have them): the page
+// asks for the operator's token when the API answers 401, and the scan then starts the test.
+TEST(OperatorPage, AsksForTheOperatorsTokenWhenTheStationHasTokens) {
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"));
+  const std::string node = NodeBinary();
+  ASSERT_FALSE(node.empty());
+  const std::string token = "op-token-0123456789abcdef";
+  eol::testing::TempDir dir;
+  std::ofstream(dir / "station.json") << nlohmann::json{
+      {"station_id", "page-token"},
+      {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
+      {"db", dir / "s.sqlite"},
+      {"http",
+       {{"listen", "127.0.0.1"},
+        {"port", 0},
+        {"tokens", {{{"name", "line-op"}, {"role", "operator"}, {"token", token}}}}}},
+      {"fixture", {{"driver", "sim"}}},
+      {"daq", {{"driver", "sim"}}}}.dump();
+  ChildProcess station({EOL_BINARY, "station", "--config", dir / "station.json", "--web-root",
+                        std::string(EOL_SOURCE_DIR) + "/station/web"});
+  ASSERT_TRUE(station.WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; }, 30s))
+      << station.output();
+  const int port = PortFromReadyLine(station.output());
+  ChildProcess browser({node, kBrowserDir + "/check_token.mjs",
+                        "http://127.0.0.1:" + std::to_string(port), token, "TOKEN-0001"},
+                       /*merge_stderr=*/false);
+  const auto code = browser.Wait(120s);
+  ASSERT_TRUE(code.has_value()) << "browser did not finish";
+  ASSERT_EQ(*code, 0) << browser.output();
+  const auto j = nlohmann::json::parse(browser.output());
+  EXPECT_FALSE(j["token_row_at_start"].get<bool>());
+  EXPECT_NE(j["refused"].get<std::string>().find("TOKEN-0001 not started: this station needs an "
+                                                 "operator token"),
+            std::string::npos)
+      << j["refused"];
+  EXPECT_TRUE(j["token_row_after_refusal"].get<bool>());
+  EXPECT_EQ(j["focus_after_token"], "scan");
+  EXPECT_EQ(j["started"], "TOKEN-0001 started");
+  httplib::Client http("127.0.0.1", port);
+  const auto res = http.Get("/api/units/TOKEN-0001");
+  ASSERT_TRUE(res && res->status == 200);
+  const auto tests = nlohmann::json::parse(res->body)["tests"];
+  ASSERT_EQ(tests.size(), 1u) << "the refused scan must not have started a test";
+  EXPECT_EQ(j["verdict"], tests[0]["outcome"]);
+  station.Stop(SIGTERM, 20s);
+}
+
 }  // namespace
 }  // namespace eol
