@@ -93,16 +93,18 @@ function instructionFor(outcome) {
   return (i && FINAL.includes(outcome) && outcome !== "PASS" && i[outcome.toLowerCase()]) || "";
 }
 
-// outcome: PASS, FAIL, ERROR, ABORTED, RUNNING (shown as TESTING) or none.
-function renderOutcome(outcome, serial, reasons) {
+// outcome: PASS, FAIL, ERROR, ABORTED, RUNNING (shown as TESTING) or none. A master part's
+// self-check (kind "self_check") gets no production instruction: it goes back to the masters.
+function renderOutcome(outcome, serial, reasons, kind) {
   const v = $("verdict");
   v.className = "verdict " + (outcome || "none");
   v.textContent = outcome === "RUNNING" ? "TESTING" : (outcome || "—");
   $("serial").textContent = serial || "";
-  const instruction = instructionFor(outcome);
+  const master = kind === "self_check";
+  const instruction = master ? "Master part (self-check): keep it with the master parts" : instructionFor(outcome);
   const box = $("instruction");
   box.hidden = !instruction;
-  box.className = outcome || "";
+  box.className = master ? "MASTER" : outcome || "";
   box.textContent = instruction;
   const ul = $("reasons");
   ul.replaceChildren();
@@ -129,7 +131,7 @@ function renderHistory(status) {
     const f0 = (r.measurements || []).find(m => m.name === "resonance_f_hz");
     const row = el("tr");
     row.append(el("td", {}, r.serial), el("td", {class: r.outcome}, r.outcome),
-               el("td", {}, num(f0 && f0.value, 4)),
+               el("td", {}, num(f0 && f0.value, 4, true)),
                el("td", {"data-utc": r.finished_at || r.started_at || ""},
                   localTime(r.finished_at || r.started_at)));
     t.appendChild(row);
@@ -282,7 +284,7 @@ async function showTest(id) {
 // A finished result: its record when it was stored (id > 0); a refusal before anything moved
 // (lockout, retest limit) is not stored and has no curve.
 function showResult(summary) {
-  renderOutcome(summary.outcome, summary.serial, summary.reasons);
+  renderOutcome(summary.outcome, summary.serial, summary.reasons, summary.kind);
   if (summary.id > 0) {
     showTest(summary.id);
   } else {

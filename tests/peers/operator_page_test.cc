@@ -166,6 +166,10 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
   EXPECT_EQ(j["focus_after_click"], "scan");
   EXPECT_EQ(j["good_master"], "PASS");
   EXPECT_EQ(j["limit_master"], "FAIL");
+  // A master part's FAIL is its self-check passing: not the red bin.
+  EXPECT_EQ(j["limit_master_instruction"].get<std::string>().rfind("Master part (self-check)", 0),
+            0u)
+      << j["limit_master_instruction"];
 
   // What the page shows is what the station stored for the scanned serials, and the page's
   // start carried the operator and shift typed into it.

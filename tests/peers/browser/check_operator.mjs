@@ -140,6 +140,7 @@ try {
   await scan(page, limitMaster);
   await waitForStored(page, limitMaster);
   out.limit_master = await text(page, "#verdict");
+  out.limit_master_instruction = await text(page, "#instruction");
   await page.waitForSelector("#lockout", { state: "hidden", timeout: 10000 });
 
   // A click elsewhere must not take the scanner's field away.
