@@ -248,6 +248,8 @@ function plotCurves(record) {
   }
   if (maskCount)
     keys.push(["mask", "limit mask: Re Z must stay out of the shaded area" + (sameRecipe ? "" : " (recipe in use)")]);
+  const absMasks = ((recipe && recipe.masks) || []).filter(m => m.quantity === "abs_ohm").length;
+  if (absMasks) keys.push(["note", `${absMasks} |Z| mask${absMasks > 1 ? "s" : ""} judged, not drawn here`]);
   const line = (c, cls) => {
     const d = c.freq_hz.map((f, i) => (i ? "L" : "M") + X(f).toFixed(1) + "," + Y(c.re[i]).toFixed(1)).join("");
     svg.appendChild(el("path", {class: cls, d, "data-points": c.freq_hz.length}));
@@ -255,7 +257,7 @@ function plotCurves(record) {
   line(meas, "measured");
   if (resonance && isFinite(resonance.value)) {
     svg.appendChild(el("line", {class: "f0", x1: X(resonance.value), x2: X(resonance.value), y1: T, y2: H - B}));
-    keys.push(["f0", `measured resonance ${num(resonance.value, 4)} Hz`]);
+    keys.push(["f0", `measured resonance ${num(resonance.value, 4, true)} Hz`]);
   }
   if (model) {  // last: on top of the measured curve, never hidden under it
     line(model, "model");
