@@ -4,13 +4,15 @@
 //   GET  /api/events            server-sent events: state changes and verdicts
 //   GET  /api/units/{serial}    every test of that serial, newest first (no curves)
 //   GET  /api/tests/{id}        one test with its curves
-//   GET  /api/tests?from=&to=&verdict=&serial=&limit=   tests in a time range
+//   GET  /api/tests?from=&to=&outcome=&serial=&limit=   tests in a time range ("verdict=",
+//                               the older name of outcome=, is still accepted)
 //   POST /api/tests             {"serial": "...", "operator_id", "shift", "order_number"}
 //                               starts a test (bearer token when configured; the three
 //                               optional fields as station/test_request.h accepts them)
 //   PUT  /api/recipe            a new version of the recipe (engineer token; audited)
 //   GET  /api/recipe/audit      who changed the recipe, when, old and new hash
-//   GET  /api/recipe            the recipe in use with its hash (limits and masks)
+//   GET  /api/recipe            the recipe in use with its hash (limits and masks) and its
+//                               operator "instructions" with their defaults written out
 //   GET  /api/stats?from=&to=&recipe_hash=&gauge=&reference=NAME=VALUE&sigma_span=
 //                               capability, drift alarms, gauge study (station/stats_report.h)
 //   GET  /api/detectability?k_fixture=&limit_sigmas=&required_sigmas=

@@ -231,6 +231,21 @@ void ParseConditions(const JsonObject& c, Recipe& r) {
   c.RejectUnknown();
 }
 
+void ParseInstructions(const JsonObject& o, Recipe& r) {
+  for (auto [key, text] :
+       {std::pair{"fail", &r.instructions.fail}, std::pair{"error", &r.instructions.error},
+        std::pair{"aborted", &r.instructions.aborted}}) {
+    *text = o.String(key, *text);
+    const bool control = std::any_of(text->begin(), text->end(), [](char ch) {
+      return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7F;
+    });
+    o.Require(!text->empty() && text->size() <= kMaxInstructionBytes && !control, key,
+              "must be 1 to " + std::to_string(kMaxInstructionBytes) +
+                  " bytes of text without control characters");
+  }
+  o.RejectUnknown();
+}
+
 }  // namespace
 
 std::vector<analysis::MeasurementSpec> Recipe::Specs() const {
@@ -287,6 +302,7 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
     ParseLimits(root.Raw("limits"), "/limits", r);
     if (root.Has("masks")) ParseMasks(root.Raw("masks"), "/masks", r);
     if (auto c = root.OptionalObject("conditions")) ParseConditions(*c, r);
+    if (auto i = root.OptionalObject("instructions")) ParseInstructions(*i, r);
     root.RejectUnknown();
     r.source = j;
     r.hash = CanonicalHash(j);
@@ -325,6 +341,10 @@ nlohmann::json ConditionsJson(const ConditionWindows& w) {
 }
 
 }  // namespace
+
+nlohmann::json InstructionsJson(const OperatorInstructions& i) {
+  return {{"fail", i.fail}, {"error", i.error}, {"aborted", i.aborted}};
+}
 
 nlohmann::json LimitJson(const analysis::MeasurementSpec& s) {
   nlohmann::json j = {{"name", s.name}, {"unit", s.unit}, {"doc", s.doc}};
@@ -382,7 +402,8 @@ nlohmann::json RecipeToJson(const Recipe& r) {
         {"frf_method", analysis::ToString(r.analysis.frf_method)}}},
       {"retest", {{"max_tests_per_serial", r.max_tests_per_serial}}},
       {"limits", limits},
-      {"masks", masks}};
+      {"masks", masks},
+      {"instructions", InstructionsJson(r.instructions)}};
   if (r.conditions.enabled) j["conditions"] = ConditionsJson(r.conditions);
   return j;
 }

@@ -21,6 +21,7 @@
 //   "conditions": {"winding_temperature_c": {"r_ref_ohm": 0.5, "t_ref_c": 20, "lo": 0, "hi": 45},
 //                  "excitation_v_rms": {"lo": 1.2, "hi": 1.45}, "excitation_a_rms": {...},
 //                  "out_of_window": "error" | "record"}       optional, station/conditions.h
+//   "instructions": {"fail": "...", "error": "...", "aborted": "..."}  optional, each optional
 // }
 // Validated on load: every message names the JSON path and the rule broken, and a recipe
 // that fails validation is never used. The hash is the SHA-256 of the canonical JSON (keys
@@ -54,6 +55,17 @@ inline constexpr double kMaxClampPressureBar = 300.0;  // hydraulic clamps inclu
 inline constexpr double kMaxClampPressureRatio = 2.0;  // hi / lo of the interlock window
 inline constexpr std::size_t kMaxMasks = 64;
 inline constexpr std::size_t kMaxMaskPoints = 512;
+inline constexpr std::size_t kMaxInstructionBytes = 200;
+
+// What the operator does with the unit after a verdict other than PASS: the operator page
+// shows it above the technical reason. Each is 1 to kMaxInstructionBytes bytes of UTF-8 text
+// without control characters; a key the recipe leaves out keeps its default.
+struct OperatorInstructions {
+  std::string fail = "Put the rotor in the red reject bin";
+  std::string error = "Test the rotor again; if ERROR repeats, call maintenance";
+  std::string aborted = "Test the rotor again";
+  bool operator==(const OperatorInstructions&) const = default;
+};
 
 struct Recipe {
   std::string id;
@@ -87,6 +99,7 @@ struct Recipe {
   std::vector<analysis::MeasurementSpec> limits;
   std::vector<analysis::CurveMask> masks;
   ConditionWindows conditions;
+  OperatorInstructions instructions;
 
   // Every declared measurement: the scalar limits, then one per mask.
   std::vector<analysis::MeasurementSpec> Specs() const;
@@ -105,6 +118,9 @@ Recipe LoadRecipe(const std::string& path);
 nlohmann::json RecipeToJson(const Recipe& r);
 // One curve mask in the recipe's "masks" schema.
 nlohmann::json MaskJson(const analysis::CurveMask& mask);
+// The recipe's "instructions" schema, every key written out (the page reads it from
+// GET /api/recipe).
+nlohmann::json InstructionsJson(const OperatorInstructions& instructions);
 // One limit in the recipe's "limits" schema ({"name", "unit", "doc", "lo"?, "hi"?, "marginal"};
 // an open side is left out). Also how a taught or benched limit is reported.
 nlohmann::json LimitJson(const analysis::MeasurementSpec& spec);

@@ -115,6 +115,7 @@ void Station::StartHttp(const std::string& web_root) {
     const auto r = recipe();
     nlohmann::json j = r->source;
     j["hash"] = r->hash;
+    j["instructions"] = InstructionsJson(r->instructions);  // defaults written out
     return j;
   };
   h.current_recipe = [this] { return recipe(); };

@@ -13,6 +13,7 @@ nlohmann::json RecordSummary(const db::TestRecord& r) {
       {"measurements", r.measurements},
       {"started_at", r.started_at},
       {"finished_at", r.finished_at},
+      {"kind", r.kind},  // a master part's self-check is no production unit
       {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}}};
 }
 

@@ -46,7 +46,8 @@ class StatusBoard {
 
   // {"station_id", "state", "serial", "detail", "message", "ready", "not_ready_reason",
   //  "simulation": "" | "<why>", "recipe": {...}, "counts": {...},
-  //  "last": {serial, outcome, reasons [{code, text}], measurements, finished_at, id} | null,
+  //  "last": {serial, outcome, reasons [{code, text}], measurements, finished_at, id,
+  //           kind: "production" | "self_check"} | null,
   //  "recent": [...], "lockout": {...} | null}
   nlohmann::json Snapshot() const;
 

@@ -56,10 +56,15 @@ void GetTests(ApiContext& c, const httplib::Request& req, httplib::Response& res
   if (q.from && q.to && !(*q.from < *q.to))
     return Send(res, BadRequest("bad_request", "from must be before to"));
   if (req.has_param("serial")) q.serial = req.get_param_value("serial");
-  if (req.has_param("verdict")) {
-    q.outcome = analysis::ParseOutcome(req.get_param_value("verdict"));
+  // "outcome", as records name it; "verdict" is its older name, still accepted.
+  if (req.has_param("outcome") && req.has_param("verdict"))
+    return Send(res,
+                BadRequest("bad_outcome", "give outcome or verdict (its older name), not both"));
+  for (const std::string name : {"outcome", "verdict"}) {
+    if (!req.has_param(name)) continue;
+    q.outcome = analysis::ParseOutcome(req.get_param_value(name));
     if (!q.outcome)
-      return Send(res, BadRequest("bad_verdict", "verdict must be PASS, FAIL, ERROR or ABORTED"));
+      return Send(res, BadRequest("bad_" + name, name + " must be PASS, FAIL, ERROR or ABORTED"));
   }
   std::vector<db::TestRecord> tests;
   {

@@ -9,6 +9,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -231,6 +232,45 @@ TEST(HttpGate, QueryParametersAreParsedWholeOrRefusedByName) {
   EXPECT_EQ(Code(c.Get("/api/tests?limit=10abc")), "400 bad_limit");
   EXPECT_EQ(Code(c.Get("/api/tests?from=notadate")), "400 bad_from");
   EXPECT_EQ(Code(c.Get("/api/tests?limit=10&from=2026-11-24T10:00:00%2B01:00")), "200 ");
+  EXPECT_EQ(Code(c.Get("/api/tests?outcome=MAYBE")), "400 bad_outcome");
+  EXPECT_EQ(Code(c.Get("/api/tests?verdict=MAYBE")), "400 bad_verdict");
+  EXPECT_EQ(Code(c.Get("/api/tests?outcome=PASS&verdict=PASS")), "400 bad_outcome");
+}
+
+// Issue 17: the filter is named "outcome" as in the records; "verdict" still works.
+TEST(HttpGate, TestsFilterByOutcomeUnderEitherName) {
+  Api api(ServerLimits{});
+  {
+    auto store = db::Store::Open(api.dir / "s.sqlite");
+    for (const auto& [serial, outcome] :
+         {std::pair{"F-1", analysis::Outcome::kPass}, std::pair{"F-2", analysis::Outcome::kFail},
+          std::pair{"F-3", analysis::Outcome::kPass}}) {
+      db::TestRecord r;
+      r.serial = serial;
+      r.station_id = "s";
+      r.recipe_id = "r";
+      r.started_at = r.finished_at = "2026-01-01T10:00:00.000Z";
+      r.outcome = outcome;
+      store->Insert(r);
+    }
+  }
+  httplib::Client c("127.0.0.1", api.port());
+  auto serials = [&](const std::string& query) {
+    const auto res = c.Get("/api/tests?" + query);
+    std::vector<std::string> out;
+    if (!res || res->status != 200) {
+      ADD_FAILURE() << query << ": " << (res ? res->body : "no answer");
+      return out;
+    }
+    const auto answer = nlohmann::json::parse(res->body);
+    for (const auto& t : answer["tests"]) out.push_back(t["serial"]);
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  EXPECT_EQ(serials("outcome=PASS"), (std::vector<std::string>{"F-1", "F-3"}));
+  EXPECT_EQ(serials("verdict=PASS"), (std::vector<std::string>{"F-1", "F-3"}));
+  EXPECT_EQ(serials("outcome=FAIL"), (std::vector<std::string>{"F-2"}));
+  EXPECT_EQ(serials(""), (std::vector<std::string>{"F-1", "F-2", "F-3"}));
 }
 
 TEST(HttpGate, AChunkedBodyAboveTheCapIsRefusedWithoutBuffering) {

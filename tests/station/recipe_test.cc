@@ -237,6 +237,42 @@ TEST(RecipeJson, OneFieldListReadsAndWritesEveryKey) {
   EXPECT_EQ(again.phase_pairs, r.phase_pairs);
   EXPECT_EQ(again.masks.size(), r.masks.size());
   EXPECT_FALSE(again.conditions.error_when_out);
+  EXPECT_EQ(again.instructions, r.instructions);
+}
+
+// Issue 17: what the operator does after FAIL, ERROR or ABORTED comes from the recipe; a key
+// left out keeps its default, and nothing but short text is accepted.
+TEST(RecipeInstructions, ShippedTextDefaultsAndStrictValidation) {
+  const Recipe shipped = LoadRecipe(kRecipe);
+  EXPECT_EQ(shipped.instructions.fail, "Red bin: put the rotor in the red reject bin");
+
+  nlohmann::json j = Good();
+  j.erase("instructions");
+  EXPECT_EQ(ParseRecipe(j, "none").instructions, OperatorInstructions{});
+  j["instructions"] = {{"error", "Call line 3 maintenance"}};
+  const Recipe partial = ParseRecipe(j, "partial");
+  EXPECT_EQ(partial.instructions.error, "Call line 3 maintenance");
+  EXPECT_EQ(partial.instructions.fail, OperatorInstructions{}.fail);
+  EXPECT_EQ(RecipeToJson(partial)["instructions"]["aborted"], OperatorInstructions{}.aborted);
+
+  const std::string rule = "must be 1 to 200 bytes of text without control characters";
+  const std::vector<std::pair<nlohmann::json, std::string>> bad = {
+      {{{"fail", 3}}, "/instructions/fail: must be a string (got 3)"},
+      {{{"error", ""}}, "/instructions/error: " + rule},
+      {{{"aborted", std::string(201, 'x')}}, "/instructions/aborted: " + rule},
+      {{{"fail", "red\nbin"}}, "/instructions/fail: " + rule},
+      {{{"pass", "green bin"}}, "/instructions/pass: unknown field"},
+      {"red bin", "/instructions: must be a JSON object"},
+  };
+  for (const auto& [instructions, expected] : bad) {
+    j = Good();
+    j["instructions"] = instructions;
+    const std::string err = ErrorOf(j);
+    EXPECT_NE(err.find(expected), std::string::npos) << "got: " << err << "\nwant: " << expected;
+  }
+  j = Good();
+  j["instructions"] = {{"fail", std::string(200, 'x')}};
+  EXPECT_EQ(ErrorOf(j), "");
 }
 
 }  // namespace
