@@ -14,25 +14,6 @@ void AddValue(ImpedanceAnalysis& a, std::string_view measurement, const char* pa
 
 }  // namespace
 
-const char* ToString(FrfMethod method) {
-  switch (method) {
-    case FrfMethod::kDiscardTransient:
-      return "discard_transient";
-    case FrfMethod::kTransientLpm:
-      return "transient_lpm";
-  }
-  return "?";
-}
-
-bool ParseFrfMethod(std::string_view text, FrfMethod* method) {
-  for (FrfMethod m : {FrfMethod::kDiscardTransient, FrfMethod::kTransientLpm})
-    if (text == ToString(m)) {
-      *method = m;
-      return true;
-    }
-  return false;
-}
-
 ImpedanceAnalysis AnalyzeImpedance(const Frf& z, const ResonanceFitOptions& options) {
   ImpedanceAnalysis a;
   a.frf.frf = z;

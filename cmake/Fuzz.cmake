@@ -21,6 +21,6 @@ set(A ${PROJECT_SOURCE_DIR}/analysis)
 set_property(TARGET eol_analysis PROPERTY SOURCES
   ${A}/frf.cc ${A}/qc/curve_mask.cc ${A}/signal/fft.cc ${A}/signal/waveform.cc
   ${A}/signal/multisine.cc ${A}/fit/motional_jacobian.cc ${A}/fit/least_squares.cc
-  ${A}/fit/resonance_fit.cc)
+  ${A}/fit/resonance_fit.cc ${A}/signal/frf_method.cc)
 add_subdirectory(drivers)
 add_subdirectory(tests/fuzz)

@@ -4,8 +4,10 @@
 //   step        sequencer states it covers
 //   start       wait_serial (serial received: retest limit, record opened, part loaded)
 //   interlocks  check_interlocks (reconnects included)
-//   clamp       clamp, confirm_clamp (command to clamp confirmed; phase-pair switches)
-//   excitation  excite (interlock re-checks, relay on, acquisition, relay off), all pairs
+//   clamp       clamp, confirm_clamp (command to clamp confirmed with the interlocks
+//               re-read before excitation; phase-pair switches)
+//   excitation  excite (relay on, acquisition, relay off, the interlocks read after), all
+//               pairs
 //   analysis    analyse (Z(f), fit), all pairs
 //   judge       judge
 //   unclamp     unclamp (release confirmed, fresh heartbeat)
@@ -35,7 +37,8 @@ inline constexpr std::array<const char*, 10> kCycleSteps = {
 std::string_view CycleStepOf(std::string_view state);
 
 // Seconds per step of trace[0 .. end), each entry lasting until the next one and the last
-// until end_ms (the first from 0, the test's clock start); plus "total" = end_ms / 1000. Entries with unknown states count in total only.
+// until end_ms (the first from 0, the test's clock start); plus "total" = end_ms / 1000. Entries
+// with unknown states count in total only.
 std::map<std::string, double> CycleBreakdown(const std::vector<db::StateEntry>& trace,
                                              double end_ms);
 

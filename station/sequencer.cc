@@ -289,14 +289,16 @@ void Sequencer::ClampAndConfirm(db::TestRecord& record) {
 }
 
 analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
-  Enter(record, SeqState::kExcite,
-        std::to_string(recipe_->transient_periods + recipe_->periods) + " periods of " +
-            Fixed(1.0 / excitation_.line_spacing_hz, 3) + " s");
   // Re-check right before closing the relay: nothing may have changed since confirmation.
+  // (Still in the clamp's state: the excite state, and the cycle's excitation step, begin
+  // when the stator is about to be excited.)
   const drivers::FixtureInputs in = ReadInputs("interlocks before excitation");
   if (const std::string why = InterlockFault(in, *recipe_, true); !why.empty())
     throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock before excitation: " + why}};
   ThrowIfAborted();
+  Enter(record, SeqState::kExcite,
+        std::to_string(recipe_->transient_periods + recipe_->periods) + " periods of " +
+            Fixed(1.0 / excitation_.line_spacing_hz, 3) + " s");
 
   drivers::AcquisitionRequest req;
   req.sample_rate_hz = excitation_.sample_rate_hz;

@@ -32,6 +32,7 @@ struct DemoArgs {
   double time_scale = 0.0;
   bool verbose = false;
   std::string fixture = "modbus";
+  std::string sim = "time_domain";
 };
 
 double Median(std::vector<double> v) {
@@ -54,13 +55,14 @@ double MeasurementValue(const db::TestRecord& r, std::string_view name) {
 
 int RunDemo(const DemoArgs& a) {
   const nlohmann::json sim = {{"population", {{"defect_share", a.defect_share}, {"seed", a.seed}}}};
-  nlohmann::json cfg = {{"station_id", "demo"},
-                        {"recipe", a.recipe},
-                        {"db", a.db},
-                        {"http", {{"listen", a.listen}, {"port", a.port}}},
-                        {"fixture", {{"driver", "sim"}}},
-                        {"daq", {{"driver", "sim"}, {"time_scale", a.time_scale}}},
-                        {"sim", sim}};
+  nlohmann::json cfg = {
+      {"station_id", "demo"},
+      {"recipe", a.recipe},
+      {"db", a.db},
+      {"http", {{"listen", a.listen}, {"port", a.port}}},
+      {"fixture", {{"driver", "sim"}}},
+      {"daq", {{"driver", "sim"}, {"time_scale", a.time_scale}, {"model", a.sim}}},
+      {"sim", sim}};
   spdlog::set_level(a.verbose ? spdlog::level::info : spdlog::level::warn);
   // One simulated bench: the DAQ plays into its motor, and with --fixture modbus the station
   // reaches its clamp and interlocks over real Modbus TCP through the fixture emulator that
@@ -192,6 +194,11 @@ void AddDemoCommand(CLI::App& app) {
          "server) on 127.0.0.1; sim: the in-process simulated fixture")
       ->capture_default_str()
       ->check(CLI::IsMember({"modbus", "sim"}));
+  cmd->add_option("--sim", args->sim,
+                  "Simulated motor: time_domain (integrated from rest, start transient\n"
+                  "included, as a real motor) or steady_state (no transient, faster)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"time_domain", "steady_state"}));
   cmd->add_flag("--verbose", args->verbose, "Log every sequencer state (to stderr)");
   cmd->callback([args] { RunGuarded("demo", [&] { return RunDemo(*args); }); });
 }

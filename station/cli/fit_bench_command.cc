@@ -100,7 +100,11 @@ int RunFitBench(const FitBenchArgs& a) {
   }
   ScipyPeerResult peer;
   peer.message = "skipped (--peer-runs 0)";
-  if (a.peer_runs > 0) peer = RunScipyPipelinePeer(r, o, a.python, a.script);
+  // The SciPy pipeline re-implements the discarding estimator only.
+  if (a.peer_runs > 0 && o.analysis.frf_method != analysis::FrfMethod::kDiscardTransient)
+    peer.message = "skipped: the SciPy pipeline implements discard_transient only";
+  else if (a.peer_runs > 0)
+    peer = RunScipyPipelinePeer(r, o, a.python, a.script);
   double peer_max_diff_sigma = 0.0;
   for (std::size_t k = 0; peer.ran && k < peer.f0_hz.size() && k < r.kept_f0_hat_hz.size(); ++k)
     peer_max_diff_sigma =

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <httplib.h>
 
+#include <cmath>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -33,6 +34,16 @@ std::string NodeBinary() {
   for (const char* p : {"/usr/local/bin/node", "/usr/bin/node", "/usr/bin/nodejs"})
     if (std::filesystem::exists(p)) return p;
   return "";
+}
+
+// One point per excited line of the shipped recipe's multisine (f_lo..f_hi at line_spacing).
+int ShippedRecipeLines() {
+  const nlohmann::json recipe = nlohmann::json::parse(
+      std::ifstream(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"));
+  const auto& e = recipe["excitation"];
+  return static_cast<int>(std::lround((e["f_hi_hz"].get<double>() - e["f_lo_hz"].get<double>()) /
+                                      e["line_spacing_hz"].get<double>())) +
+         1;
 }
 
 TEST(OperatorPage, ShowsVerdictCurveAndFollowsTestsLive) {
@@ -83,7 +94,7 @@ TEST(OperatorPage, ShowsVerdictCurveAndFollowsTestsLive) {
   const auto j = nlohmann::json::parse(browser.output());
   EXPECT_EQ(j["first"]["verdict"], outcome);
   EXPECT_EQ(j["first"]["serial"], "PAGE-0001");
-  EXPECT_EQ(j["first"]["points"], 601) << "the measured curve is not drawn";
+  EXPECT_EQ(j["first"]["points"], ShippedRecipeLines()) << "the measured curve is not drawn";
   EXPECT_EQ(j["first"]["model"], 1);
   EXPECT_GE(j["first"]["masks"].get<int>(), 1) << "the recipe's mask is not drawn";
   EXPECT_EQ(j["first"]["measurements"], 6);
@@ -234,8 +245,8 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
   EXPECT_DOUBLE_EQ(chart["window"]["lo"].get<double>(), 370.0) << chart;
   EXPECT_DOUBLE_EQ(chart["window"]["hi"].get<double>(), 420.0) << chart;
   EXPECT_GE(chart["masks"].get<int>(), 1);
-  EXPECT_EQ(chart["measured_points"], 601);
-  EXPECT_EQ(chart["model_points"], 601);
+  EXPECT_EQ(chart["measured_points"], ShippedRecipeLines());
+  EXPECT_EQ(chart["model_points"], ShippedRecipeLines());
   EXPECT_EQ(chart["order"].back(), "model") << chart["order"];
   std::vector<std::string> legend;
   for (const auto& k : chart["legend"]) legend.push_back(k[0]);

@@ -58,6 +58,7 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
       {[](auto& j) {
          j["excitation"]["line_spacing_hz"] = 0.1;
          j["excitation"]["periods"] = 10;
+         j["excitation"]["transient_periods"] = 1;
        },
        "/excitation/periods: (periods + transient_periods) / line_spacing_hz is 110.0 s"},
       {[](auto& j) {
@@ -115,10 +116,17 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
   }
 }
 
-// Issue 16: the analysis block chooses the FRF estimator; absent, today's.
+// Issue 16: the analysis block chooses the FRF estimator; absent, the discarding one. The
+// shipped recipe removes the transient (0.5 s from rest); the reference keeps today's.
 TEST(Recipe, FrfMethodIsChosenInTheAnalysisBlock) {
-  EXPECT_EQ(LoadRecipe(kRecipe).analysis.frf_method, analysis::FrfMethod::kDiscardTransient);
+  EXPECT_EQ(LoadRecipe(kRecipe).analysis.frf_method, analysis::FrfMethod::kTransientLpm);
+  EXPECT_EQ(LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-reference.json")
+                .analysis.frf_method,
+            analysis::FrfMethod::kDiscardTransient);
   nlohmann::json j = Good();
+  j["analysis"].erase("frf_method");
+  EXPECT_EQ(ParseRecipe(j, "test.json").analysis.frf_method,
+            analysis::FrfMethod::kDiscardTransient);
   j["analysis"]["frf_method"] = "transient_lpm";
   j["excitation"]["transient_periods"] = 0;
   j["excitation"]["periods"] = 2;
