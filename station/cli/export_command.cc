@@ -32,6 +32,7 @@ struct ExportArgs {
   std::string out;
   int limit = 10000;
   bool schema = false;
+  bool json = false;  // --json: --format json
 };
 
 // What a recipe declares beyond the standard names, in the order it judges them: its limits,
@@ -47,7 +48,12 @@ std::vector<std::string> DeclaredBy(const Recipe& r) {
   return all;
 }
 
-int RunExport(const ExportArgs& a) {
+int RunExport(ExportArgs a) {
+  if (a.json) {
+    if (a.format != "csv" && a.format != "json")
+      throw std::runtime_error("--json asks for --format json, not " + a.format);
+    a.format = "json";
+  }
   std::vector<std::string> extra;
   for (const std::string& path : a.recipes)
     for (std::string& n : DeclaredBy(LoadRecipe(path))) extra.push_back(std::move(n));
@@ -138,14 +144,11 @@ void AddExportCommand(CLI::App& app) {
                   "Recipe file(s) whose declared measurements (limits, masks, further phase\n"
                   "pairs) get columns after the standard ones; repeatable")
       ->check(CLI::ExistingFile);
-  CLI::Option* format =
-      cmd->add_option("--format", args->format,
-                      "csv or json (the export schema), or records (full records with curves)")
-          ->capture_default_str()
-          ->check(CLI::IsMember({"csv", "json", "records"}));
-  cmd->add_flag(
-         "--json", [args](std::int64_t) { args->format = "json"; }, "The same as --format json")
-      ->excludes(format);
+  cmd->add_option("--format", args->format,
+                  "csv or json (the export schema), or records (full records with curves)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"csv", "json", "records"}));
+  cmd->add_flag("--json", args->json, "The same as --format json");
   cmd->add_option("--out", args->out, "Output file (default: stdout)");
   cmd->add_option("--limit", args->limit, "At most this many tests")
       ->capture_default_str()

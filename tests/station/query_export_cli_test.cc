@@ -243,6 +243,14 @@ TEST_F(QueryExportTest, RecipeDeclaresItsMaskColumnsAndRecordsKeepCurves) {
   const CliRun outcome = Eol({"export", "--db", db_, "--json", "--outcome", "FAIL"});
   ASSERT_EQ(outcome.code, 0) << outcome.out;
   EXPECT_EQ(nlohmann::json::parse(outcome.out).size(), 1u);
+  // Rows of the schema are not records: teach says which format it reads.
+  const std::string rows = dir_ / "rows.json";
+  ASSERT_EQ(Eol({"export", "--db", db_, "--json", "--out", rows}).code, 0);
+  const CliRun teach = testing::RunEol({"teach", "--recipe", "recipes/pmsm-10pole.json", "--golden",
+                                        rows, "--out", dir_ / "taught.json"},
+                                       true, 60s);
+  EXPECT_EQ(teach.code, 2) << teach.out;
+  EXPECT_NE(teach.out.find("eol export --format records"), std::string::npos) << teach.out;
 }
 
 TEST(ExportSchemaDocs, TheReadmeTableIsWhatTheCommandPrints) {
