@@ -51,7 +51,7 @@ void Progress::Update(std::string_view phase, std::int64_t done, std::int64_t to
     if (drawn_) std::fputs("\n", stderr);  // the finished phase's line stays
     phase_ = std::string(phase);
     phase_start_ = now;
-  } else if (done < total && now - last_draw_ < std::chrono::milliseconds(100)) {
+  } else if (done > 1 && done < total && now - last_draw_ < std::chrono::milliseconds(100)) {
     return;
   }
   last_draw_ = now;
