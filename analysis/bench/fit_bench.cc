@@ -71,12 +71,14 @@ struct MonteCarlo {
 };
 
 MonteCarlo RunMonteCarlo(const FitBenchOptions& o, const Excitation& e, std::size_t periods,
-                         int runs, std::uint64_t seed, FitBenchResult* keep) {
+                         int runs, std::uint64_t seed, FitBenchResult* keep,
+                         std::string_view phase) {
   MonteCarlo mc;
   const double f_lo = o.analysis.fit.f0_min_hz > 0.0 ? o.analysis.fit.f0_min_hz : 0.0;
   const double f_hi = o.analysis.fit.f0_max_hz > 0.0 ? o.analysis.fit.f0_max_hz
                                                      : std::numeric_limits<double>::infinity();
   for (int r = 0; r < runs; ++r) {
+    if (o.progress) o.progress(phase, r, runs);
     const std::uint64_t run_seed = seed + 7919ULL * static_cast<std::uint64_t>(r);
     const Recording rec =
         o.simulation == BenchSimulation::kTimeDomain
@@ -111,6 +113,7 @@ MonteCarlo RunMonteCarlo(const FitBenchOptions& o, const Excitation& e, std::siz
     if (z.freq_hz == mc.freq_hz)
       for (std::size_t k = 0; k < z.size(); ++k) mc.sigma2_sum[k] += z.sigma[k] * z.sigma[k];
   }
+  if (o.progress) o.progress(phase, runs, runs);
   return mc;
 }
 
@@ -222,7 +225,7 @@ FitBenchResult RunFitBench(const FitBenchOptions& o) {
   res.excitation = DesignMultisine(o.excitation);
   res.runs = o.runs;
   res.f0_true_hz = o.truth.f0_hz;
-  const MonteCarlo mc = RunMonteCarlo(o, res.excitation, o.periods, o.runs, o.seed, &res);
+  const MonteCarlo mc = RunMonteCarlo(o, res.excitation, o.periods, o.runs, o.seed, &res, "runs");
   res.usable_runs = mc.usable;
   res.first_failure = mc.first_failure;
   if (mc.usable < 2) return res;
@@ -275,7 +278,7 @@ FitBenchResult RunFitBench(const FitBenchOptions& o) {
   res.check_measured_f0_std_hz = kNaN;
   if (o.check_runs >= 2) {
     const MonteCarlo check = RunMonteCarlo(o, res.excitation, res.check_periods, o.check_runs,
-                                           o.seed + 1000003ULL, nullptr);
+                                           o.seed + 1000003ULL, nullptr, "check runs");
     res.check_measured_f0_std_hz = check.usable >= 2 ? StdDev(check.f0_hat) : kNaN;
   }
   return res;

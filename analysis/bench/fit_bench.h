@@ -27,6 +27,7 @@
 
 #include "analysis/impedance_analysis.h"
 #include "analysis/model/motor_model.h"
+#include "analysis/progress.h"
 #include "analysis/signal/multisine.h"
 #include "analysis/signal/recording.h"
 
@@ -79,6 +80,8 @@ struct FitBenchOptions {
   int check_runs = 200;  // runs of the measurement-time check (0: skip it)
   // The first keep_recordings recordings are returned (for an external peer).
   std::size_t keep_recordings = 0;
+  // Sees each finished run: phase "runs", then "check runs" (analysis/progress.h).
+  ProgressCallback progress;
 
   bool IsValid(std::string* why) const;
 };

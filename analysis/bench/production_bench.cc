@@ -61,14 +61,22 @@ double ResonanceHz(const Measured& m) {
   return m.analysis.usable && it != m.analysis.values.end() ? it->second.value : std::nan("");
 }
 
-// Runs body(i) for i in [0, n) on `threads` threads.
+// Runs body(i) for i in [0, n) on `threads` threads, reporting each finished i to
+// o.progress under `phase`.
 template <typename Body>
-void ParallelFor(int n, int threads, Body body) {
+void ParallelFor(const ProductionBenchOptions& o, std::string_view phase, int n, int threads,
+                 Body body) {
   std::atomic<int> next{0};
+  std::atomic<std::int64_t> done{0};
+  if (o.progress) o.progress(phase, 0, n);
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t)
     pool.emplace_back([&] {
-      for (int i = next++; i < n; i = next++) body(i);
+      for (int i = next++; i < n; i = next++) {
+        body(i);
+        const std::int64_t d = ++done;
+        if (o.progress) o.progress(phase, d, n);
+      }
     });
   for (auto& t : pool) t.join();
 }
@@ -78,7 +86,7 @@ void RunPodSweep(const ProductionBenchOptions& o, const LineMeasurementSetup& se
   const auto n = static_cast<std::size_t>(o.pod_units);
   w.data.assign(n, HitMiss{});
   w.f0_hz.assign(n, std::nan(""));
-  ParallelFor(o.pod_units, o.threads, [&](int i) {
+  ParallelFor(o, "POD " + w.name, o.pod_units, o.threads, [&](int i) {
     const std::uint64_t index =
         kPodIndexBase + sweep * 100000000ULL + static_cast<std::uint64_t>(i);
     std::mt19937_64 gen(NoiseSeed(o.seed, index) ^ 0x5DEECE66DULL);
@@ -176,24 +184,17 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
   // 1. Golden units and teaching.
   std::vector<GoldenUnit> golden(static_cast<std::size_t>(o.golden_units));
   std::vector<int> golden_ok(golden.size(), 0);
-  {
-    std::atomic<std::size_t> next{0};
-    auto work = [&] {
-      for (std::size_t i = next++; i < golden.size(); i = next++) {
-        const std::uint64_t index = kGoldenIndexBase + i;
-        const LineUnit unit = DrawLineUnit(o.rotor, o.spread, DefectClass::kGood, o.seed, index);
-        Measured m = MeasureUnit(o, setup, unit, index);
-        golden[i].label = "golden-" + std::to_string(i);
-        if (!m.analysis.usable) continue;
-        for (const auto& [name, e] : m.analysis.values) golden[i].values[name] = e.value;
-        golden[i].curve = std::move(m.frf);
-        golden_ok[i] = 1;
-      }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(work);
-    for (auto& t : pool) t.join();
-  }
+  ParallelFor(o, "golden units", o.golden_units, threads, [&](int k) {
+    const auto i = static_cast<std::size_t>(k);
+    const std::uint64_t index = kGoldenIndexBase + i;
+    const LineUnit unit = DrawLineUnit(o.rotor, o.spread, DefectClass::kGood, o.seed, index);
+    Measured m = MeasureUnit(o, setup, unit, index);
+    golden[i].label = "golden-" + std::to_string(i);
+    if (!m.analysis.usable) return;
+    for (const auto& [name, e] : m.analysis.values) golden[i].values[name] = e.value;
+    golden[i].curve = std::move(m.frf);
+    golden_ok[i] = 1;
+  });
   std::vector<GoldenUnit> usable_golden;
   for (std::size_t i = 0; i < golden.size(); ++i)
     if (golden_ok[i]) usable_golden.push_back(std::move(golden[i]));
@@ -207,6 +208,8 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
   // 2. Production units, judged three ways.
   std::mutex merge;
   std::atomic<int> next{0};
+  std::atomic<std::int64_t> done{0};
+  if (o.progress) o.progress("production units", 0, o.units);
   auto work = [&] {
     ProductionBenchSummary local;
     for (int i = next++; i < o.units; i = next++) {
@@ -219,6 +222,8 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
       Count(local.counts[2][c], NaivePass(m.frf, o.naive) ? Outcome::kPass : Outcome::kFail);
       const double f0 = ResonanceHz(m);
       if (std::isfinite(f0)) local.f0_hz[c].push_back(f0);
+      const std::int64_t d = ++done;
+      if (o.progress) o.progress("production units", d, o.units);
     }
     const std::lock_guard<std::mutex> lock(merge);
     for (std::size_t r = 0; r < kBenchRules.size(); ++r)

@@ -28,6 +28,7 @@
 
 #include "analysis/bench/naive_rule.h"
 #include "analysis/fit/resonance_fit.h"
+#include "analysis/progress.h"
 #include "analysis/qc/line_population.h"
 #include "analysis/qc/pod.h"
 #include "analysis/qc/teach.h"
@@ -58,6 +59,9 @@ struct ProductionBenchOptions {
   // POD stays at the false-call level), so units there would only pile up misses.
   double pod_loss_lo = 0.80, pod_loss_hi = 0.99;
   PodOptions pod;
+  // Sees the phases "golden units", "production units", "POD one_magnet" and
+  // "POD all_magnets" (analysis/progress.h); called from the worker threads.
+  ProgressCallback progress;
 
   bool IsValid(std::string* why) const;
 };

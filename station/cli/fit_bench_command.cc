@@ -16,6 +16,7 @@
 #include "station/bench/fit_bench_peer.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/cli/progress.h"
 #include "station/data_files.h"
 #include "station/recipe.h"
 
@@ -92,7 +93,12 @@ int RunFitBench(const FitBenchArgs& a) {
   o.seed = a.seed;
   o.check_runs = a.check_runs;
   o.keep_recordings = static_cast<std::size_t>(std::max(0, std::min(a.peer_runs, a.runs)));
-  const analysis::FitBenchResult r = analysis::RunFitBench(o);
+  analysis::FitBenchResult r;
+  {
+    Progress progress("fit-bench");
+    o.progress = progress.Callback();
+    r = analysis::RunFitBench(o);
+  }
   if (r.usable_runs < 2) {
     std::cerr << "eol fit-bench: only " << r.usable_runs << " of " << r.runs
               << " runs were usable; first failure: " << r.first_failure << std::endl;

@@ -24,7 +24,8 @@ namespace {
 struct GapArgs {
   std::string sim;
   std::vector<std::string> measured;
-  std::string json_out;
+  bool json = false;     // the JSON report on stdout (the text report then on stderr)
+  std::string json_out;  // and/or into this file
   std::string plot;
   std::string quantity = "impedance";
   std::string predict_sim;
@@ -217,16 +218,13 @@ int RunGap(const GapArgs& a) {
   }
 
   const nlohmann::json j = GapReportJson(r);
-  std::ostream& text = a.json_out == "-" ? std::cerr : std::cout;
+  std::ostream& text = a.json ? std::cerr : std::cout;
   text << GapReportText(r);
+  if (a.json) std::cout << j.dump(2) << std::endl;
   if (!a.json_out.empty()) {
-    if (a.json_out == "-") {
-      std::cout << j.dump(2) << std::endl;
-    } else {
-      std::ofstream out(a.json_out);
-      out << j.dump(2) << "\n";
-      if (!out) throw io::FileError(a.json_out, 0, 0, "cannot write the JSON report");
-    }
+    std::ofstream out(a.json_out);
+    out << j.dump(2) << "\n";
+    if (!out) throw io::FileError(a.json_out, 0, 0, "cannot write the JSON report");
   }
   if (!a.plot.empty()) {
     io::WriteSvg(a.plot, Plot(r, r.measured.front()));
@@ -254,7 +252,8 @@ void AddGapCommand(CLI::App& app) {
                   "Measured unit (repeatable): FRF CSV with sigma (else the noise is estimated), "
                   ".zma, or a raw periodic recording CSV with t_s (plain or .gz)")
       ->required();
-  cmd->add_option("--json", a->json_out, "Write the JSON report to this file ('-': stdout)");
+  cmd->add_flag("--json", a->json, "Print the JSON report on stdout (the text goes to stderr)");
+  cmd->add_option("--json-out", a->json_out, "Write the JSON report to this file");
   cmd->add_option("--plot", a->plot,
                   "Write an SVG plot: measured, simulated and corrected curves, the normalised "
                   "residual, gap bands shaded");

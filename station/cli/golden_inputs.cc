@@ -73,11 +73,15 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
 
 std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>& paths,
                                                   const Recipe& recipe,
-                                                  std::vector<std::string>* skipped,
-                                                  bool known_bad) {
+                                                  std::vector<std::string>* skipped, bool known_bad,
+                                                  const analysis::ProgressCallback& progress) {
   if (skipped) skipped->clear();  // nothing is skipped any more: unusable records are refused
   std::vector<analysis::GoldenUnit> units;
+  const char* phase = known_bad ? "known-bad files" : "golden files";
+  const auto total = static_cast<std::int64_t>(paths.size());
+  std::int64_t done = 0;
   for (const std::string& path : paths) {
+    if (progress) progress(phase, done++, total);
     if (!EndsWith(path, ".json")) {
       units.push_back(FromMeasured(path, recipe));
       continue;
@@ -91,7 +95,14 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
       throw std::runtime_error(path + ": not JSON: " + e.what());
     }
     try {
-      if (j.is_object() && j.contains("params")) {
+      const auto is_export_row = [](const nlohmann::json& x) {
+        return x.is_object() && x.contains("schema_version");
+      };
+      if (is_export_row(j) || (j.is_array() && !j.empty() && is_export_row(j.front()))) {
+        throw std::runtime_error(
+            "rows of the export schema (`eol export --format json`) carry no curves; teach "
+            "reads full records: `eol export --format records`");
+      } else if (j.is_object() && j.contains("params")) {
         units.push_back(FromAnalyzeJson(j, path, known_bad));
       } else if (j.is_array() || (j.is_object() && j.contains("measurements"))) {
         const nlohmann::json list = j.is_array() ? j : nlohmann::json::array({j});
@@ -119,7 +130,7 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
         }
       } else {
         throw std::runtime_error(
-            "neither `eol analyze --json` output (\"params\") nor `eol export --format json` "
+            "neither `eol analyze --json` output (\"params\") nor `eol export --format records` "
             "records (\"measurements\")");
       }
     } catch (const nlohmann::json::exception& e) {
@@ -130,6 +141,7 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
       throw std::runtime_error(path + ": " + what);
     }
   }
+  if (progress) progress(phase, total, total);
   if (units.empty())
     throw std::runtime_error(known_bad ? "no known-bad unit could be read"
                                        : "no golden unit could be read");

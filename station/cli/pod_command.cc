@@ -19,6 +19,7 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/pod_svg.h"
+#include "station/cli/progress.h"
 
 namespace eol::station::cli {
 namespace {
@@ -105,8 +106,20 @@ int RunPod(const PodArgs& a) {
   json fits = json::object();
   std::vector<PodCurve> curves;
   bool all_usable = true;
-  for (const auto& [cls, data] : h.defective) {
-    analysis::PodSummary s = analysis::FitPod(data, a.options);
+  {
+    // Each class's fit, before anything is printed (the line ends before the results).
+    Progress progress("pod");
+    std::int64_t done = 0;
+    const auto total = static_cast<std::int64_t>(h.defective.size());
+    for (const auto& [cls, data] : h.defective) {
+      progress.Update("classes fitted", done++, total);
+      curves.push_back({cls, analysis::FitPod(data, a.options), data});
+    }
+    progress.Update("classes fitted", total, total);
+  }
+  for (const auto& curve : curves) {
+    const std::string& cls = curve.label;
+    const analysis::PodSummary& s = curve.fit;
     all_usable = all_usable && s.usable;
     fits[cls] = analysis::PodToJson(s);
     if (!a.json) {
@@ -115,7 +128,6 @@ int RunPod(const PodArgs& a) {
         std::cout << "  a50 " << s.a50 << ", a90 " << s.a90 << ", a90/95 " << Bound(s.a90_95_lr)
                   << " (likelihood ratio), " << Bound(s.a90_95_wald) << " (Wald)\n";
     }
-    curves.push_back({cls, std::move(s), data});
   }
   if (!a.svg.empty()) {
     std::vector<F0Group> groups;

@@ -11,6 +11,7 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/pod_svg.h"
+#include "station/cli/progress.h"
 #include "station/data_files.h"
 #include "station/recipe.h"
 
@@ -92,7 +93,12 @@ int RunBench(BenchArgs a) {
   o.recipe_masks = r.masks;
   o.naive.search_lo_hz = r.analysis.fit.f0_min_hz;
   o.naive.search_hi_hz = r.analysis.fit.f0_max_hz;
-  const analysis::ProductionBenchSummary s = analysis::RunProductionBench(o);
+  analysis::ProductionBenchSummary s;
+  {
+    Progress progress("production-bench");
+    o.progress = progress.Callback();
+    s = analysis::RunProductionBench(o);
+  }
   if (!s.usable) {
     std::cerr << "eol production-bench: " << s.message << std::endl;
     if (a.json) std::cout << json{{"usable", false}, {"error", s.message}}.dump() << std::endl;

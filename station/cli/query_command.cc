@@ -67,7 +67,7 @@ void AddQueryCommand(CLI::App& app) {
   auto args = std::make_shared<QueryArgs>();
   CLI::App* cmd = app.add_subcommand(
       "query",
-      "Show every test of a serial number, newest first, with measurements, limits, verdict,\n"
+      "Show every test of a serial number, newest first, with measurements, limits, outcome,\n"
       "reasons and recipe hash. Exit code 1 when the serial has no tests.");
   cmd->add_option("--db", args->db, "SQLite file of the station")
       ->required()

@@ -8,11 +8,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/golden_inputs.h"
+#include "station/cli/progress.h"
 #include "station/qc_service.h"
 #include "station/recipe.h"
 
@@ -56,10 +58,14 @@ int RunTeach(const TeachArgs& a) {
                              " exists: refusing to overwrite it (choose another --out, or "
                              "--force)");
   std::vector<std::string> skipped;
-  const std::vector<analysis::GoldenUnit> golden = ReadGoldenUnits(a.golden, recipe, &skipped);
+  auto progress = std::make_unique<Progress>("teach");
+  const std::vector<analysis::GoldenUnit> golden =
+      ReadGoldenUnits(a.golden, recipe, &skipped, false, progress->Callback());
   const std::vector<analysis::GoldenUnit> bad =
-      a.bad.empty() ? std::vector<analysis::GoldenUnit>{}
-                    : ReadGoldenUnits(a.bad, recipe, nullptr, /*known_bad=*/true);
+      a.bad.empty()
+          ? std::vector<analysis::GoldenUnit>{}
+          : ReadGoldenUnits(a.bad, recipe, nullptr, /*known_bad=*/true, progress->Callback());
+  progress.reset();  // ends the line before the results
   const analysis::TeachSummary s = analysis::TeachLimits(recipe.limits, golden, a.options, bad);
   for (const std::string& k : skipped) std::cerr << "eol teach: skipped " << k << "\n";
   if (!s.usable) {
@@ -139,7 +145,7 @@ void AddTeachCommand(CLI::App& app) {
       "--force) and\n"
       "prints its SHA-256 and how many golden units the stated confidence needs.\n"
       "Golden files: FRF CSV / .zma / recording CSV (analysed with the recipe), `eol analyze\n"
-      "--json` output, or `eol export --format json` records.\n"
+      "--json` output, or `eol export --format records` records.\n"
       "Exit: 0 written, 1 nothing could be learned, 2 usage or file error.");
   cmd->add_option("--recipe", args->recipe, "Recipe whose limits are taught")
       ->required()

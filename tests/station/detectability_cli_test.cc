@@ -38,7 +38,7 @@ TEST(DetectabilityCli, FixtureFromTheGapDiagnosis) {
   r = Eol({"simulate", "--motor", kMotors + "pmsm-10pole.json", "--out", dir / "meas.csv",
            "--model", "steady_state"});
   ASSERT_EQ(r.code, 0) << r.out;
-  r = Eol({"gap", "--sim", dir / "sim.csv", "--measured", dir / "meas.csv", "--json",
+  r = Eol({"gap", "--sim", dir / "sim.csv", "--measured", dir / "meas.csv", "--json-out",
            dir / "gap.json"});
   ASSERT_EQ(r.code, 0) << r.out;
   r = Eol({"detectability", "--gap", dir / "gap.json", "--json"}, false);

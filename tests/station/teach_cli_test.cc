@@ -129,7 +129,7 @@ TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
   EXPECT_GT(j["units_needed"].get<int>(), 6);
 }
 
-// `eol export --format json` records: PASS production records of this recipe are golden
+// `eol export --format records` records: PASS production records of this recipe are golden
 // units; a FAIL, ERROR or ABORTED record, a master's self-check and a record of another recipe
 // hash are refused, naming the record.
 TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
