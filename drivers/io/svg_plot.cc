@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "drivers/io/axis_ticks.h"
 #include "drivers/io/file_error.h"
 
 namespace eol::io {
@@ -75,36 +76,6 @@ std::pair<double, double> Range(const std::vector<const std::vector<double>*>& v
     return log ? std::make_pair(lo / 2.0, hi * 2.0) : std::make_pair(lo - d, hi + d);
   }
   return {lo, hi};
-}
-
-// Nice linear ticks covering [lo, hi].
-std::vector<double> LinearTicks(double lo, double hi, int target = 6) {
-  const double raw = (hi - lo) / target;
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = mag;
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * mag >= raw) {
-      step = m * mag;
-      break;
-    }
-  std::vector<double> t;
-  for (double v = std::ceil(lo / step) * step; v <= hi + 1e-9 * step; v += step)
-    t.push_back(std::abs(v) < 1e-12 * step ? 0.0 : v);
-  return t;
-}
-
-std::vector<double> LogTicks(double lo, double hi) {
-  std::vector<double> t;
-  const int a = static_cast<int>(std::floor(std::log10(lo)));
-  const int b = static_cast<int>(std::ceil(std::log10(hi)));
-  const bool few = b - a <= 3;
-  for (int e = a; e <= b; ++e)
-    for (double m : few ? std::vector<double>{1, 2, 5} : std::vector<double>{1}) {
-      const double v = m * std::pow(10.0, e);
-      if (v >= lo * (1 - 1e-9) && v <= hi * (1 + 1e-9)) t.push_back(v);
-    }
-  if (t.size() < 2) return LinearTicks(lo, hi);
-  return t;
 }
 
 void Polyline(std::ostringstream& os, const SvgSeries& s, const Axis& x, const Axis& y) {
