@@ -216,6 +216,16 @@ void DrawPanel(Painter& p, const ChartPanel& panel, double top, double width, do
   std::tie(x.lo, x.hi) = panel.x_range ? *panel.x_range : ex.Range(x.log, 0.02);
   std::tie(y.lo, y.hi) = panel.y_range ? *panel.y_range : ey.Range(y.log, 0.06);
   if (!panel.bars.empty() && !y.log && !panel.y_range) y.lo = std::max(y.lo, 0.0);
+  // Head room above the data for the notes box and the vertical lines' labels, so that
+  // neither hides a point or a bar (linear axes whose range is not fixed).
+  const double notes_h =
+      panel.notes.empty() ? 0.0 : 14.0 * static_cast<double>(panel.notes.size()) + 6.0;
+  const double head_px =
+      notes_h + 13.0 * static_cast<double>(panel.vlines.size()) + (panel.vlines.empty() ? 0 : 4);
+  if (!y.log && !panel.y_range && head_px > 0.0) {
+    const double room = plot_bottom - plot_top;
+    if (head_px < 0.6 * room) y.hi += (y.hi - y.lo) * head_px / (room - head_px);
+  }
   x.px_lo = plot_left;
   x.px_hi = plot_right;
   y.px_lo = plot_bottom;
@@ -327,9 +337,15 @@ void DrawPanel(Painter& p, const ChartPanel& panel, double top, double width, do
   for (const ChartLine& l : panel.hlines)
     if (y.Valid(l.value) && l.value >= y.lo && l.value <= y.hi)
       p.Text(l.label, plot_right - 4.0, y.Map(l.value) - 3.0, kSmallFont, 1.0, l.colour);
+  double label_y = plot_top + notes_h + 15.0;  // one row per vertical line, below the notes
   for (const ChartLine& l : panel.vlines)
-    if (x.Valid(l.value) && l.value >= x.lo && l.value <= x.hi)
-      p.Text(l.label, x.Map(l.value) + 3.0, plot_top + 11.0, kSmallFont, 0.0, l.colour);
+    if (x.Valid(l.value) && l.value >= x.lo && l.value <= x.hi) {
+      // Right of the line, or left of it when it would leave the frame.
+      const double px = x.Map(l.value);
+      const bool left = px + 3.0 + p.TextWidth(l.label, kSmallFont) > plot_right;
+      p.Text(l.label, left ? px - 3.0 : px + 3.0, label_y, kSmallFont, left ? 1.0 : 0.0, l.colour);
+      label_y += 13.0;
+    }
 
   // Frame.
   p.SetColour({0.2, 0.2, 0.2});
