@@ -1,4 +1,4 @@
-// Axis ticks shared by the plot writers (svg_plot.h, chart.h).
+// "Nice" axis ticks of the charts (chart.h).
 #pragma once
 
 #include <vector>

@@ -111,8 +111,10 @@ class Painter {
     cairo_show_text(cr_, s.c_str());
     cairo_restore(cr_);
   }
-  double TextWidth(const std::string& s, double size) {
+  double TextWidth(const std::string& s, double size, bool bold = false) {
     cairo_save(cr_);
+    cairo_select_font_face(cr_, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
+                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
     cairo_set_font_size(cr_, size);
     cairo_text_extents_t e;
     cairo_text_extents(cr_, s.c_str(), &e);
@@ -390,7 +392,10 @@ std::vector<std::string> Draw(cairo_t* cr, const Chart& c) {
   Painter p(cr);
   cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
   cairo_paint(cr);
-  p.Text(c.title, c.width_px / 2.0, 27.0, kTitleFont, 0.5, kChartBlack, 0.0, true);
+  // A long title (a file path) shrinks to the chart's width rather than leave it.
+  const double room = c.width_px - 20.0, wide = p.TextWidth(c.title, kTitleFont, true);
+  const double size = wide > room ? std::max(8.0, kTitleFont * room / wide) : kTitleFont;
+  p.Text(c.title, c.width_px / 2.0, 27.0, size, 0.5, kChartBlack, 0.0, true);
   for (std::size_t i = 0; i < c.panels.size(); ++i)
     DrawPanel(p, c.panels[i], kTitleH + static_cast<double>(i) * c.panel_height_px, c.width_px,
               c.panel_height_px);
