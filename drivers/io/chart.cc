@@ -455,6 +455,14 @@ std::string RenderChartSvg(const Chart& c) {
     cairo_surface_finish(surface.get());
     ThrowIf(cairo_surface_status(surface.get()), "SVG output");
   }
+  // Cairo numbers its surfaces with a process-wide counter ("surface6" for the sixth chart
+  // drawn); name the drawing's root group "chart" so the same chart gives the same bytes.
+  const std::string key = "<g id=\"surface";
+  if (const std::size_t at = svg.find(key); at != std::string::npos) {
+    const std::size_t id_at = at + 7, id_end = svg.find('"', id_at);
+    const std::string id = svg.substr(id_at, id_end - id_at);
+    if (svg.find("#" + id + "\"") == std::string::npos) svg.replace(id_at, id.size(), "chart");
+  }
   // The words, for readers that cannot read glyph outlines (see the header).
   const std::size_t root = svg.find("<svg");
   const std::size_t end = root == std::string::npos ? root : svg.find('>', root);
