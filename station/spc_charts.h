@@ -13,6 +13,7 @@
 //             over moving ranges (UCL = 3.267 MRbar), run-rule alarms marked and listed;
 //   xbar_r    subgroup means (xbarbar +- A2 Rbar) over ranges (D3, D4 Rbar), subgroups of
 //             `subgroup` consecutive units;
+//             the run rules watch the I or X-bar points; the MR and R charts show their limits;
 //   histogram the values with the recipe's limits as vertical lines, and Cp/Cpk (within
 //             sigma MRbar/d2: the units come one at a time), Pp/Ppk (overall s) printed.
 #pragma once
