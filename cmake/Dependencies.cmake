@@ -12,6 +12,8 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 pkg_check_modules(MODBUS REQUIRED IMPORTED_TARGET libmodbus)
 pkg_check_modules(SNDFILE REQUIRED IMPORTED_TARGET sndfile)  # WAV recordings (station/files)
+# Charts (drivers/io/chart.h): SVG and PNG through cairo's surfaces.
+pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
 # cpp-httplib 0.11 is compiled; its .pc carries the defines that fix its class layout.
 pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
 # systemd's readiness and watchdog notifications (optional: without it the daemon still runs).

@@ -13,8 +13,13 @@
 //   GET  /api/recipe/audit      who changed the recipe, when, old and new hash
 //   GET  /api/recipe            the recipe in use with its hash (limits and masks) and its
 //                               operator "instructions" with their defaults written out
-//   GET  /api/stats?from=&to=&recipe_hash=&gauge=&reference=NAME=VALUE&sigma_span=
-//                               capability, drift alarms, gauge study (station/stats_report.h)
+//   GET  /api/stats?from=&to=&recipe_hash=&population=&subgroup=&gauge=&reference=NAME=VALUE
+//        &sigma_span=           capability (Cp/Cpk within, Pp/Ppk overall), run-rule and drift
+//                               alarms, gauge study (station/stats_report.h)
+//   GET  /api/charts/<measurement>.svg?chart=imr|xbar_r|histogram&from=&to=&last=&subgroup=
+//        &population=pass|all&recipe_hash=
+//                               a control chart or histogram as image/svg+xml
+//                               (station/spc_charts.h); 404 "unknown_measurement", "no_units"
 //   GET  /api/detectability?k_fixture=&limit_sigmas=&required_sigmas=
 //                               where each defect class shows with this recipe and fixture
 //                               (station/qc_service.h; k_fixture from the gap diagnosis)

@@ -7,19 +7,20 @@
 #include <stdexcept>
 #include <utility>
 
-#include "drivers/io/svg_plot.h"
+#include "drivers/io/chart.h"
+#include "drivers/io/file_error.h"
 
 namespace eol::station::cli {
 namespace {
 
-constexpr const char* kColours[] = {"#1f77b4", "#d62728", "#2ca02c",
-                                    "#9467bd", "#ff7f0e", "#8c564b"};
+constexpr io::Colour kColours[] = {io::kChartBlue,   io::kChartRed,    io::kChartGreen,
+                                   io::kChartPurple, io::kChartOrange, {0.549, 0.337, 0.294}};
 
-io::SvgSeries Series(const std::string& label, const std::string& colour,
-                     std::vector<double> x = {}, std::vector<double> y = {}) {
-  io::SvgSeries s;
+io::ChartSeries Series(const std::string& label, const io::Colour& colour,
+                       std::vector<double> x = {}, std::vector<double> y = {}) {
+  io::ChartSeries s;
   s.label = label;
-  s.color = colour;
+  s.colour = colour;
   s.x = std::move(x);
   s.y = std::move(y);
   return s;
@@ -32,31 +33,37 @@ std::string Fixed(double v, int digits = 3) {
   return buf;
 }
 
-io::SvgFigure PodFigure(const std::string& title, const std::vector<PodCurve>& curves) {
-  io::SvgFigure f;
-  f.title = title;
-  f.x_label = "defect size a (bond stiffness loss)";
-  io::SvgPanel p;
+io::ChartPanel PodPanel(const std::vector<PodCurve>& curves) {
+  io::ChartPanel p;
+  p.title = "probability of detection against defect size";
+  p.x_label = "defect size a (bond stiffness loss)";
   p.y_label = "POD";
-  p.hlines = {0.9};
+  io::ChartLine ninety;
+  ninety.label = "POD 0.9";
+  ninety.value = 0.9;
+  ninety.colour = io::kChartGrey;
+  ninety.style = io::LineStyle::kDotted;
+  p.hlines.push_back(ninety);
   double lo = 1.0, hi = 0.0;
   for (const PodCurve& c : curves)
     for (const auto& h : c.data) lo = std::min(lo, h.size), hi = std::max(hi, h.size);
   if (!(hi > lo)) lo = 0.01, hi = 1.0;
   for (std::size_t k = 0; k < curves.size(); ++k) {
     const PodCurve& c = curves[k];
-    const std::string colour = kColours[k % 6];
-    io::SvgSeries hits = Series(c.label + " hit/miss", colour);
+    const io::Colour colour = kColours[k % 6];
+    io::ChartSeries hits = Series(c.label + " hit/miss", colour);
+    hits.line = false;
     hits.markers = true;
+    hits.marker_radius = 1.8;
     for (const auto& h : c.data) {
       hits.x.push_back(h.size);
       hits.y.push_back(h.hit ? 1.0 : 0.0);
     }
     p.series.push_back(hits);
     if (!c.fit.usable) continue;
-    io::SvgSeries pod = Series(c.label + " POD", colour);
-    io::SvgSeries bound = Series(c.label + " lower bound", colour);
-    bound.dashed = true;
+    io::ChartSeries pod = Series(c.label + " POD", colour);
+    io::ChartSeries bound = Series(c.label + " lower bound", colour);
+    bound.style = io::LineStyle::kDashed;
     bound.width = 1.0;
     for (int i = 0; i <= 200; ++i) {
       const double a = lo + (hi - lo) * i / 200.0;
@@ -68,21 +75,19 @@ io::SvgFigure PodFigure(const std::string& title, const std::vector<PodCurve>& c
     p.series.push_back(pod);
     p.series.push_back(bound);
     if (std::isfinite(c.fit.a90_95_lr) && c.fit.a90_95_lr <= hi) {
-      io::SvgSeries mark = Series(c.label + " a90/95 " + Fixed(c.fit.a90_95_lr), colour,
-                                  {c.fit.a90_95_lr, c.fit.a90_95_lr}, {0.0, 1.0});
+      io::ChartSeries mark = Series(c.label + " a90/95 " + Fixed(c.fit.a90_95_lr), colour,
+                                    {c.fit.a90_95_lr, c.fit.a90_95_lr}, {0.0, 1.0});
       mark.width = 2.5;
       p.series.push_back(mark);
     }
   }
-  f.panels.push_back(p);
-  return f;
+  return p;
 }
 
-io::SvgFigure F0Figure(const std::vector<F0Group>& groups, const std::vector<F0Limit>& limits) {
-  io::SvgFigure f;
-  f.title = "fitted f0 per class against the taught limits";
-  f.x_label = "f0 (Hz)";
-  io::SvgPanel p;
+io::ChartPanel F0Panel(const std::vector<F0Group>& groups, const std::vector<F0Limit>& limits) {
+  io::ChartPanel p;
+  p.title = "fitted f0 per class against the taught limits";
+  p.x_label = "f0 (Hz)";
   p.y_label = "share per 1 Hz";
   double lo = 1e300, hi = -1e300;
   for (const F0Group& g : groups)
@@ -96,7 +101,7 @@ io::SvgFigure F0Figure(const std::vector<F0Group>& groups, const std::vector<F0L
     if (g.f0_hz.empty()) continue;
     std::vector<double> share(static_cast<std::size_t>(hi - lo), 0.0);
     for (double v : g.f0_hz) share[static_cast<std::size_t>(v - lo)] += 1.0 / g.f0_hz.size();
-    io::SvgSeries s =
+    io::ChartSeries s =
         Series(g.label + " (" + std::to_string(g.f0_hz.size()) + ")", kColours[k % 6]);
     for (std::size_t b = 0; b < share.size(); ++b) {  // a step line per bin
       s.x.insert(s.x.end(), {lo + b, lo + b + 1.0});
@@ -106,49 +111,40 @@ io::SvgFigure F0Figure(const std::vector<F0Group>& groups, const std::vector<F0L
     p.series.push_back(s);
   }
   for (const F0Limit& l : limits) {
-    io::SvgSeries s = Series(l.label + " " + Fixed(l.f0_hz, 2) + " Hz", "#000000",
-                             {l.f0_hz, l.f0_hz}, {0.0, top});
+    io::ChartSeries s = Series(l.label + " " + Fixed(l.f0_hz, 2) + " Hz", io::kChartBlack,
+                               {l.f0_hz, l.f0_hz}, {0.0, top});
     s.width = 2.5;
     p.series.push_back(s);
   }
-  f.panels.push_back(p);
-  return f;
-}
-
-// The document without its XML declaration, and its height from the root element.
-std::string Inner(const std::string& doc, double* height) {
-  const std::size_t start = doc.find("<svg");
-  const std::size_t h = doc.find("height=\"", start);
-  *height = std::stod(doc.substr(h + 8));
-  return doc.substr(start);
+  return p;
 }
 
 }  // namespace
 
-std::string PodSvg(const std::string& title, const std::vector<PodCurve>& curves,
+io::Chart PodChart(const std::string& title, const std::vector<PodCurve>& curves,
                    const std::vector<F0Group>& groups, const std::vector<F0Limit>& limits) {
-  double h1 = 0.0, h2 = 0.0;
-  const io::SvgFigure pod_figure = PodFigure(title, curves);
-  std::string body = Inner(io::RenderSvg(pod_figure), &h1);
+  io::Chart chart;
+  chart.title = title;
+  chart.panels.push_back(PodPanel(curves));
   bool any_f0 = false;
   for (const F0Group& g : groups) any_f0 = any_f0 || !g.f0_hz.empty();
-  if (any_f0) {
-    std::string second = Inner(io::RenderSvg(F0Figure(groups, limits)), &h2);
-    second.insert(4, " y=\"" + std::to_string(static_cast<int>(h1)) + "\"");
-    body += second;
-  }
-  return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" +
-         std::to_string(pod_figure.width_px) + "\" height=\"" +
-         std::to_string(static_cast<int>(h1 + h2)) + "\">\n" + body + "</svg>\n";
+  if (any_f0) chart.panels.push_back(F0Panel(groups, limits));
+  return chart;
+}
+
+std::string PodSvg(const std::string& title, const std::vector<PodCurve>& curves,
+                   const std::vector<F0Group>& groups, const std::vector<F0Limit>& limits) {
+  return io::RenderChartSvg(PodChart(title, curves, groups, limits));
 }
 
 void WritePodSvg(const std::string& path, const std::string& title,
                  const std::vector<PodCurve>& curves, const std::vector<F0Group>& groups,
                  const std::vector<F0Limit>& limits) {
-  std::ofstream out(path);
-  if (out) out << PodSvg(title, curves, groups, limits);
-  if (!out) throw std::runtime_error("cannot write the POD figure to '" + path + "'");
+  try {
+    io::WriteChart(path, PodChart(title, curves, groups, limits));
+  } catch (const io::FileError&) {
+    throw std::runtime_error("cannot write the POD figure to '" + path + "'");
+  }
 }
 
 }  // namespace eol::station::cli

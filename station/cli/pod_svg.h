@@ -1,6 +1,6 @@
-// The POD figure (`--pod-svg FILE` of `eol pod`, `eol production-bench`), drawn with the
-// project's SVG plot writer (drivers/io/svg_plot.h) as two figures stacked in one document
-// (their x axes differ). Top: POD(a) of each sweep (solid), its one-sided lower Wald bound
+// The POD figure (`--pod-svg FILE` of `eol pod`, `eol production-bench`), drawn with cairo
+// (drivers/io/chart.h) as two panels, each with its own x axis; a path ending in .png
+// gives a PNG. Top: POD(a) of each sweep (solid), its one-sided lower Wald bound
 // (dashed), the a90/95 (likelihood ratio) as a vertical line, the hits (y = 1) and misses
 // (y = 0) as markers, a dotted line at POD 0.9. Bottom: the share of each group's units per
 // 1 Hz bin of fitted f0 (good units, each defect class) with the taught f0 limits as vertical

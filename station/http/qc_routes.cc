@@ -1,7 +1,13 @@
-// Quality engineering: capability and gauge statistics, detectability of defect classes, and
-// limits taught from stored good units.
+// Quality engineering: capability and gauge statistics, control charts, detectability of
+// defect classes, and limits taught from stored good units.
+#include <algorithm>
+#include <set>
+
+#include "analysis/qc/measurement_names.h"
+#include "drivers/io/chart.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
+#include "station/spc_charts.h"
 #include "station/stats_report.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
@@ -24,6 +30,12 @@ void GetStats(ApiContext& c, const httplib::Request& req, httplib::Response& res
   for (std::size_t i = 0; i < req.get_param_value_count("reference"); ++i)
     if (!ParseReference(req.get_param_value("reference", i), q.reference, &why))
       return Send(res, BadRequest("bad_reference", why));
+  if (req.has_param("population") &&
+      !ParsePopulation(req.get_param_value("population"), &q.population))
+    return Send(res, BadRequest("bad_population", "population must be pass or all"));
+  long long subgroup = 1;
+  if (const auto e = IntegerParam(req, "subgroup", 1, 10, &subgroup)) return Send(res, *e);
+  q.subgroup = static_cast<std::size_t>(subgroup);
   if (req.has_param("sigma_span")) {
     const std::string v = req.get_param_value("sigma_span");
     if (v != "4" && v != "6")
@@ -38,6 +50,54 @@ void GetStats(ApiContext& c, const httplib::Request& req, httplib::Response& res
     report = StatsReport(*c.db, q);
   }
   Send(res, HttpReply{200, report});
+}
+
+// GET /api/charts/<measurement>.svg?chart=imr|xbar_r|histogram&from=&to=&last=&subgroup=
+//   &population=pass|all&recipe_hash=: the chart as image/svg+xml (station/spc_charts.h).
+// Unknown parameters are refused (a misspelt "subgrup" would otherwise draw the default).
+void GetChart(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
+  static const std::set<std::string> kKnown = {"chart",    "from",       "to",         "last",
+                                               "subgroup", "population", "recipe_hash"};
+  for (const auto& [name, value] : req.params)
+    if (!kKnown.count(name))
+      return Send(res, BadRequest("unknown_parameter",
+                                  "unknown parameter '" + name +
+                                      "' (chart, from, to, last, subgroup, population, "
+                                      "recipe_hash)"));
+  ChartRequest q;
+  q.measurement = req.matches[1];
+  if (std::find(analysis::names::kAll.begin(), analysis::names::kAll.end(), q.measurement) ==
+      analysis::names::kAll.end())
+    return Send(res,
+                ApiError{ApiErrorKind::kNotFound, "unknown_measurement", ValidateChartRequest(q)});
+  for (const auto& e : {TimeParam(req, "from", &q.from), TimeParam(req, "to", &q.to)})
+    if (e) return Send(res, *e);
+  long long last = 0, subgroup = 5;
+  for (const auto& e : {IntegerParam(req, "last", 1, 100000, &last),
+                        IntegerParam(req, "subgroup", 2, 10, &subgroup)})
+    if (e) return Send(res, *e);
+  q.last = static_cast<std::size_t>(last);
+  q.subgroup = static_cast<std::size_t>(subgroup);
+  if (req.has_param("chart") && !ParseChartKind(req.get_param_value("chart"), &q.kind))
+    return Send(res, BadRequest("bad_chart", "chart must be imr, xbar_r or histogram (have '" +
+                                                 req.get_param_value("chart") + "')"));
+  if (req.has_param("population") &&
+      !ParsePopulation(req.get_param_value("population"), &q.population))
+    return Send(res, BadRequest("bad_population", "population must be pass or all (have '" +
+                                                      req.get_param_value("population") + "')"));
+  if (req.has_param("recipe_hash")) q.recipe_hash = req.get_param_value("recipe_hash");
+  if (const std::string bad = ValidateChartRequest(q); !bad.empty())
+    return Send(res, BadRequest("bad_request", bad));
+  std::optional<SpcSeries> series;
+  {
+    std::lock_guard<std::mutex> lock(c.db_mu);
+    series = ReadSpcSeries(*c.db, q);
+  }
+  if (!series)
+    return Send(res, ApiError{ApiErrorKind::kNotFound, "no_units",
+                              "no production test in the window measured " + q.measurement});
+  res.status = 200;
+  res.set_content(io::RenderChartSvg(MeasurementChart(*series, q)), "image/svg+xml");
 }
 
 void GetDetectability(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
@@ -109,6 +169,7 @@ HttpReply TeachReply(const TeachResult& result) {
 
 void AddQcRoutes(httplib::Server& s, ApiContext& c) {
   Route(s, c, "GET", "/api/stats", GetStats);
+  Route(s, c, "GET", R"(/api/charts/([^/]+)\.svg)", GetChart);
   Route(s, c, "GET", "/api/detectability", GetDetectability);
   Route(s, c, "POST", "/api/teach", PostTeach);
 }
