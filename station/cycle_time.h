@@ -3,11 +3,10 @@
 //
 //   step        sequencer states it covers
 //   start       wait_serial (serial received: retest limit, record opened, part loaded)
-//   interlocks  check_interlocks (reconnects included)
+//   interlocks  check_interlocks (reconnects included; and the re-read after excitation)
 //   clamp       clamp, confirm_clamp (command to clamp confirmed with the interlocks
 //               re-read before excitation; phase-pair switches)
-//   excitation  excite (relay on, acquisition, relay off, the interlocks read after), all
-//               pairs
+//   excitation  excite (relay on, acquisition, relay off, watchdog stopped), all pairs
 //   analysis    analyse (Z(f), fit), all pairs
 //   judge       judge
 //   unclamp     unclamp (release confirmed, fresh heartbeat)

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <sstream>
 #include <thread>
 
@@ -123,7 +124,11 @@ class Sequencer::Watchdog {
  public:
   Watchdog(Sequencer& seq) : seq_(seq), thread_([this] { Run(); }) {}
   ~Watchdog() {
-    stop_ = true;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      stop_ = true;
+    }
+    wake_.notify_all();  // stops now, not after the rest of its period
     thread_.join();
   }
   std::optional<std::string> fault() {
@@ -168,13 +173,16 @@ class Sequencer::Watchdog {
         fault_ = "interlock lost during excitation: " + why;
         return;
       }
-      std::this_thread::sleep_until(now + std::chrono::duration_cast<Clock::duration>(period));
+      std::unique_lock<std::mutex> lock(mu_);
+      wake_.wait_until(lock, now + std::chrono::duration_cast<Clock::duration>(period),
+                       [this] { return stop_.load(); });
     }
   }
 
   Sequencer& seq_;
   std::atomic<bool> stop_{false};
   std::mutex mu_;
+  std::condition_variable wake_;
   std::optional<std::string> fault_;
   std::optional<std::pair<double, double>> pressure_;
   std::thread thread_;  // last: starts after the members it uses exist
@@ -337,6 +345,7 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
   // The interlocks must still hold now that the relay is open: one that broke between the
   // watchdog's last read and the end of the record makes the recording worthless. The
   // heartbeat is confirmed alive by a fresh beat before the verdict (Unclamp).
+  Enter(record, SeqState::kCheckInterlocks, "after excitation");
   const drivers::FixtureInputs after = ReadInputs("interlocks after excitation");
   if (const std::string why = InterlockFault(after, *recipe_, true); !why.empty())
     throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock after excitation: " + why}};

@@ -1,7 +1,8 @@
 // The one path every test takes (ARCHITECTURE.md), as explicit, logged states:
 //
-//   wait_serial -> check_interlocks -> clamp -> confirm_clamp -> excite -> analyse -> judge
-//     -> unclamp -> store -> publish -> wait_serial
+//   wait_serial -> check_interlocks -> clamp -> confirm_clamp -> excite -> check_interlocks
+//     -> analyse -> judge -> unclamp -> store -> publish -> wait_serial
+//   (further phase pairs: after analyse, clamp (pair switch) -> excite -> ... again)
 //   any fault:  -> safe_state (excitation off first; unclamp only when that is safe)
 //               -> store (ERROR or ABORTED with the cause) -> publish
 //

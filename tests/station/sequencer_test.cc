@@ -97,9 +97,12 @@ TEST_F(SequencerTest, GoodRotorPassesAndIsStoredWithEverything) {
   // The trace walks the documented states in order.
   std::vector<std::string> states;
   for (const auto& t : stored->trace) states.push_back(t.state);
-  const std::vector<std::string> expected = {"wait_serial",   "check_interlocks", "clamp",
-                                             "confirm_clamp", "excite",           "analyse",
-                                             "judge",         "unclamp",          "store"};
+  const std::vector<std::string> expected = {
+      "wait_serial", "check_interlocks",
+      "clamp",       "confirm_clamp",
+      "excite",      "check_interlocks" /* after excitation */,
+      "analyse",     "judge",
+      "unclamp",     "store"};
   EXPECT_EQ(states, expected);
   EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
   EXPECT_FALSE(bench_->output(FixtureOutput::kClampCmd));
