@@ -1,5 +1,5 @@
-// Cycle-time benchmark (issue 16, `eol cycle-bench`): a recipe against today's reference
-// recipe on the same simulated units, measured in one run.
+// Cycle-time benchmark (issue 16, `eol cycle-bench`): a recipe against a reference recipe (the
+// shipped one) on the same simulated units, measured in one run.
 //
 // Each recipe tests the same serials (the simulated population draws a unit from its serial:
 // the same serial is the same motor, good or with a soft bond) on its own station: the
@@ -22,7 +22,7 @@ namespace eol::station {
 
 struct CycleBenchOptions {
   std::string recipe_path;     // the recipe measured
-  std::string reference_path;  // today's recipe, the reference
+  std::string reference_path;  // the reference (the shipped recipe)
   int units = 20;
   std::uint64_t seed = 1;                 // of the simulated population
   double defect_share = 0.2;              // share of soft-bond rotors

@@ -30,17 +30,18 @@ void PrintRecipe(const char* label, const CycleBenchRecipe& c) {
 
 void AddCycleBenchCommand(CLI::App& app) {
   auto o = std::make_shared<CycleBenchOptions>();
-  o->recipe_path = DefaultRecipePath();
-  o->reference_path = DefaultRecipePath("pmsm-10pole-reference.json");
+  o->recipe_path = DefaultRecipePath("pmsm-10pole-fast.json");
+  o->reference_path = DefaultRecipePath();
   auto json = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand(
       "cycle-bench",
-      "Benchmark: a recipe against today's reference recipe on the same simulated units\n"
-      "(simulated clamp with its own timing, motor integrated from rest): median excitation\n"
-      "and serial-to-verdict time, station overhead, sigma(f0), verdicts against the truth,\n"
-      "outcome agreement and the ratios, measured in one run. Exit: 0 done, 1 could not run.");
+      "Benchmark: a recipe (default: the 0.5 s variant) against the shipped recipe on the same\n"
+      "simulated units (simulated clamp with its own timing, motor integrated from rest): median\n"
+      "excitation and serial-to-verdict time, station overhead, sigma(f0), verdicts against the\n"
+      "truth, outcome agreement and the ratios, measured in one run. Exit: 0 done, 1 could not\n"
+      "run.");
   cmd->add_option("--recipe", o->recipe_path, "Recipe measured")->capture_default_str();
-  cmd->add_option("--reference", o->reference_path, "Today's recipe, the reference")
+  cmd->add_option("--reference", o->reference_path, "The reference recipe (the shipped one)")
       ->capture_default_str();
   cmd->add_option("--units", o->units, "Simulated units (each tested with both recipes)")
       ->capture_default_str()

@@ -26,8 +26,7 @@ namespace {
 #define EXPECT_CONTAINS(haystack, needle) \
   EXPECT_PRED_FORMAT2(::testing::IsSubstring, needle, haystack)
 
-// Recordings here are made with the 1 Hz multisine: the reference recipe analyses them.
-const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-reference.json";
+const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json";
 const analysis::MotionalImpedance kGood{0.5, 2.0e-3, 0.51, 390.0, 50.0};
 
 using eol::testing::CliRun;
@@ -102,7 +101,7 @@ TEST(AnalyzeCliTest, RecipeGivesVerdictPassAndFail) {
   const nlohmann::json jg = Json(g);
   EXPECT_EQ(jg["verdict"]["outcome"], "PASS") << jg["verdict"].dump();
   EXPECT_GE(jg["verdict"]["measurements"].size(), 5u);
-  EXPECT_EQ(jg["recipe"]["id"], "pmsm-10pole-reference");
+  EXPECT_EQ(jg["recipe"]["id"], "pmsm-10pole");
   const CliRun s = Eol({"--measured", dir / "soft.zma", "--recipe", kRecipe, "--json"});
   ASSERT_EQ(s.code, 0) << s.out;  // analysed: a FAIL is a result
   const nlohmann::json js = Json(s);

@@ -117,12 +117,12 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
 }
 
 // Issue 16: the analysis block chooses the FRF estimator; absent, the discarding one. The
-// shipped recipe removes the transient (0.5 s from rest); the reference keeps today's.
+// shipped recipe discards the first period; its 0.5 s variant removes the transient.
 TEST(Recipe, FrfMethodIsChosenInTheAnalysisBlock) {
-  EXPECT_EQ(LoadRecipe(kRecipe).analysis.frf_method, analysis::FrfMethod::kTransientLpm);
-  EXPECT_EQ(LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-reference.json")
+  EXPECT_EQ(LoadRecipe(kRecipe).analysis.frf_method, analysis::FrfMethod::kDiscardTransient);
+  EXPECT_EQ(LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json")
                 .analysis.frf_method,
-            analysis::FrfMethod::kDiscardTransient);
+            analysis::FrfMethod::kTransientLpm);
   nlohmann::json j = Good();
   j["analysis"].erase("frf_method");
   EXPECT_EQ(ParseRecipe(j, "test.json").analysis.frf_method,

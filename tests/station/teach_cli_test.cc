@@ -20,9 +20,7 @@ using namespace std::chrono_literals;
 using eol::testing::ChildProcess;
 
 const std::string kMotor = std::string(EOL_SOURCE_DIR) + "/recipes/motors/pmsm-10pole.json";
-// Teaching is checked on the reference recipe's curves (1 Hz lines, 4 s averaged), whose
-// per-unit scatter the expected unit counts were set for.
-const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-reference.json";
+const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json";
 
 using eol::testing::CliRun;
 
