@@ -508,8 +508,11 @@ void Sequencer::StoreAndPublish(db::TestRecord& record) {
   }
   Enter(record, SeqState::kPublish, analysis::ToString(record.outcome));
   board_.OnVerdict(record);
+  // The fixture's two lamps: green alone PASS, red alone FAIL (reject the rotor), both ERROR
+  // or ABORTED (the station could not judge: test again) - distinct without a third output.
   const bool pass = record.outcome == analysis::Outcome::kPass;
-  (void)fixture_.Write(FixtureOutput::kLampPass, pass);
+  const bool fail = record.outcome == analysis::Outcome::kFail;
+  (void)fixture_.Write(FixtureOutput::kLampPass, !fail);
   (void)fixture_.Write(FixtureOutput::kLampFail, !pass);
 }
 

@@ -164,6 +164,19 @@ TEST_F(SequencerTest, PoorlyCementedRotorFailsOnResonance) {
   EXPECT_EQ(r.reasons.front().code, analysis::ReasonCode::kLimit);
   ExpectStored(r);
   EXPECT_TRUE(bench_->output(FixtureOutput::kLampFail));
+  EXPECT_FALSE(bench_->output(FixtureOutput::kLampPass));
+}
+
+// Issue 17: ERROR is not shown as FAIL on the fixture: both lamps light (documented in
+// README, Safety), so an operator does not put a rotor the station could not judge in the
+// reject bin.
+TEST_F(SequencerTest, ErrorLightsBothLampsNotTheFailLampAlone) {
+  Build(0.0);
+  bench_->InjectFault(SimFault::kDoorOpens, 0ms, /*on_excitation=*/false);
+  const db::TestRecord r = Test("LAMP-ERR", false);
+  ASSERT_EQ(r.outcome, Outcome::kError);
+  EXPECT_TRUE(bench_->output(FixtureOutput::kLampFail));
+  EXPECT_TRUE(bench_->output(FixtureOutput::kLampPass));
 }
 
 TEST_F(SequencerTest, ClampLostDuringExcitationIsErrorWithExcitationCutFast) {
