@@ -123,13 +123,16 @@ struct Sequencer::MeasuredPair {
 class Sequencer::Watchdog {
  public:
   Watchdog(Sequencer& seq) : seq_(seq), thread_([this] { Run(); }) {}
-  ~Watchdog() {
+  ~Watchdog() { Stop(); }
+  // Stops the thread now, not after the rest of its period; idempotent. fault() and
+  // pressure_range() are final once it returns.
+  void Stop() {
     {
       std::lock_guard<std::mutex> lock(mu_);
       stop_ = true;
     }
-    wake_.notify_all();  // stops now, not after the rest of its period
-    thread_.join();
+    wake_.notify_all();
+    if (thread_.joinable()) thread_.join();
   }
   std::optional<std::string> fault() {
     std::lock_guard<std::mutex> lock(mu_);
@@ -165,12 +168,15 @@ class Sequencer::Watchdog {
       }
       if (!why.empty()) {
         const drivers::Status off = seq_.fixture_.Write(FixtureOutput::kExcitationEnable, false);
+        {
+          // The cause is stored before the abort wakes the sequencer, which reads it.
+          std::lock_guard<std::mutex> lock(mu_);
+          fault_ = "interlock lost during excitation: " + why;
+        }
         seq_.abort_.store(true);
         seq_.watchdog_trips_.fetch_add(1);
         spdlog::error("watchdog: {}; excitation off{}", why,
                       off.ok() ? "" : " command failed (" + off.message() + ")");
-        std::lock_guard<std::mutex> lock(mu_);
-        fault_ = "interlock lost during excitation: " + why;
         return;
       }
       std::unique_lock<std::mutex> lock(mu_);
@@ -327,6 +333,7 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
     }
     result.emplace(daq_.Acquire(req, abort_));
     (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
+    watchdog.Stop();  // a trip in flight has stored its cause before this returns
     watchdog_fault = watchdog.fault();
     // From the check right before the relay closed through the watchdog's reads (a very
     // short acquisition may end before the watchdog's first read).
