@@ -31,12 +31,14 @@ std::map<std::string, double> CycleBreakdown(const std::vector<db::StateEntry>& 
   return out;
 }
 
+double CycleStepS(const std::map<std::string, double>& cycle_s, const char* step) {
+  const auto it = cycle_s.find(step);
+  return it == cycle_s.end() ? 0.0 : it->second;
+}
+
 double StationOverheadS(const std::map<std::string, double>& cycle_s) {
-  const auto get = [&](const char* k) {
-    const auto it = cycle_s.find(k);
-    return it == cycle_s.end() ? 0.0 : it->second;
-  };
-  return get("total") - get("clamp") - get("excitation") - get("unclamp");
+  return CycleStepS(cycle_s, "total") - CycleStepS(cycle_s, "clamp") -
+         CycleStepS(cycle_s, "excitation") - CycleStepS(cycle_s, "unclamp");
 }
 
 }  // namespace eol::station

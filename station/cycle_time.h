@@ -41,6 +41,9 @@ std::string_view CycleStepOf(std::string_view state);
 std::map<std::string, double> CycleBreakdown(const std::vector<db::StateEntry>& trace,
                                              double end_ms);
 
+// Seconds of `step` (0 when the test did not take it).
+double CycleStepS(const std::map<std::string, double>& cycle_s, const char* step);
+
 // Station overhead in seconds: total minus clamp, excitation and unclamp (0 when absent).
 double StationOverheadS(const std::map<std::string, double>& cycle_s);
 

@@ -34,6 +34,9 @@
 
 namespace eol::analysis {
 
+// The median of v (the mean of the two middle values for an even count); NaN when empty.
+double Median(std::vector<double> v);
+
 struct SampleSummary {
   std::size_t n = 0;
   double mean = 0.0;

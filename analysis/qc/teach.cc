@@ -10,6 +10,7 @@
 
 #include "analysis/enum_names.h"
 #include "analysis/qc/measurement_names.h"
+#include "analysis/qc/statistics.h"
 #include "analysis/qc/tolerance.h"
 
 namespace eol::analysis {
@@ -42,12 +43,6 @@ SideWeights DesignWeights(const std::string& name) {
 // confidence 1 - coverage^n.
 int OneSidedWilksUnitsNeeded(double coverage, double confidence) {
   return static_cast<int>(std::ceil(std::log(1.0 - confidence) / std::log(coverage)));
-}
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 double RobustScale(const std::vector<double>& v, double median) {

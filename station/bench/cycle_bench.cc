@@ -10,24 +10,13 @@
 #include <vector>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/qc/statistics.h"
 #include "analysis/text.h"
 #include "station/cycle_time.h"
 #include "station/station.h"
 
 namespace eol::station {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double Step(const db::TestRecord& r, const char* step) {
-  const auto it = r.cycle_s.find(step);
-  return it == r.cycle_s.end() ? 0.0 : it->second;
-}
 
 struct UnitResult {
   analysis::Outcome outcome = analysis::Outcome::kError;
@@ -72,8 +61,8 @@ std::map<std::string, UnitResult> RunRecipe(const CycleBenchOptions& o,
     } else {
       summary.false_rejects += r.outcome == analysis::Outcome::kFail;
     }
-    excitation.push_back(Step(r, "excitation"));
-    cycle.push_back(Step(r, "total"));
+    excitation.push_back(CycleStepS(r.cycle_s, "excitation"));
+    cycle.push_back(CycleStepS(r.cycle_s, "total"));
     overhead.push_back(StationOverheadS(r.cycle_s));
     UnitResult u;
     u.outcome = r.outcome;
@@ -85,10 +74,10 @@ std::map<std::string, UnitResult> RunRecipe(const CycleBenchOptions& o,
     out[serial] = u;
     if (o.progress) o.progress(summary.recipe, i, o.units);
   }
-  summary.excitation_s = Median(excitation);
-  summary.cycle_s = Median(cycle);
-  summary.overhead_s = Median(overhead);
-  summary.f0_sigma_hz = Median(sigma);
+  summary.excitation_s = analysis::Median(excitation);
+  summary.cycle_s = analysis::Median(cycle);
+  summary.overhead_s = analysis::Median(overhead);
+  summary.f0_sigma_hz = analysis::Median(sigma);
   return out;
 }
 

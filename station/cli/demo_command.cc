@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/qc/statistics.h"
 #include "analysis/text.h"
 #include "drivers/emulators/modbus_fixture_server.h"
 #include "station/cli/commands.h"
@@ -34,18 +35,6 @@ struct DemoArgs {
   std::string fixture = "modbus";
   std::string sim = "time_domain";
 };
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double CycleStep(const db::TestRecord& r, const char* step) {
-  const auto it = r.cycle_s.find(step);
-  return it == r.cycle_s.end() ? 0.0 : it->second;
-}
 
 double MeasurementValue(const db::TestRecord& r, std::string_view name) {
   for (const auto& m : r.measurements)
@@ -105,8 +94,8 @@ int RunDemo(const DemoArgs& a) {
     const db::TestRecord r = station.RunTest(serial);
     const bool is_defective = station.bench()->part() && station.bench()->part()->defective;
     serials.push_back(serial);
-    excitation_s.push_back(CycleStep(r, "excitation"));
-    cycle_s.push_back(CycleStep(r, "total"));
+    excitation_s.push_back(CycleStepS(r.cycle_s, "excitation"));
+    cycle_s.push_back(CycleStepS(r.cycle_s, "total"));
     overhead_s.push_back(StationOverheadS(r.cycle_s));
     switch (r.outcome) {
       case analysis::Outcome::kPass:
@@ -129,15 +118,17 @@ int RunDemo(const DemoArgs& a) {
     std::snprintf(line, sizeof line, "[%3d/%d] %-16s f0 = %7.2f Hz  %-7s truth: %-9s %5.2f s ", i,
                   a.units, serial, MeasurementValue(r, analysis::names::kResonanceFHz),
                   analysis::ToString(r.outcome), is_defective ? "defective" : "good",
-                  CycleStep(r, "total"));
+                  CycleStepS(r.cycle_s, "total"));
     out << line << (r.reasons.empty() ? "" : r.reasons.front().text) << "\n" << std::flush;
   }
   out << "summary: " << a.units << " units: " << pass << " PASS, " << fail << " FAIL, " << error
       << " ERROR; " << detected << " of " << defective << " defective rotors caught, "
       << false_rejects << " good rotors rejected\n"
-      << "cycle (medians per unit): excitation " << analysis::Fixed(Median(excitation_s), 3)
-      << " s, serial to verdict " << analysis::Fixed(Median(cycle_s), 3) << " s, station overhead "
-      << analysis::Fixed(Median(overhead_s), 3) << " s (time scale " << a.time_scale << ")\n";
+      << "cycle (medians per unit): excitation "
+      << analysis::Fixed(analysis::Median(excitation_s), 3) << " s, serial to verdict "
+      << analysis::Fixed(analysis::Median(cycle_s), 3) << " s, station overhead "
+      << analysis::Fixed(analysis::Median(overhead_s), 3) << " s (time scale " << a.time_scale
+      << ")\n";
   if (a.json) {
     const nlohmann::json summary = {{"units", a.units},
                                     {"pass", pass},
@@ -147,9 +138,9 @@ int RunDemo(const DemoArgs& a) {
                                     {"detected", detected},
                                     {"false_rejects", false_rejects},
                                     {"serials", serials},
-                                    {"excitation_s", Median(excitation_s)},
-                                    {"cycle_s", Median(cycle_s)},
-                                    {"overhead_s", Median(overhead_s)},
+                                    {"excitation_s", analysis::Median(excitation_s)},
+                                    {"cycle_s", analysis::Median(cycle_s)},
+                                    {"overhead_s", analysis::Median(overhead_s)},
                                     {"time_scale", a.time_scale},
                                     {"db", a.db},
                                     {"http_port", station.http_port()}};
