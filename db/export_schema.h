@@ -30,7 +30,9 @@
 
 namespace eol::db {
 
-inline constexpr int kExportSchemaVersion = 1;
+// Version 2 (issue 12) appended the standard measurement motional_residue_ohm_per_s after
+// fit_chi2_per_dof; version 1 files have the same columns up to there.
+inline constexpr int kExportSchemaVersion = 2;
 
 enum class ExportType { kInteger, kNumber, kText, kTime, kBool };
 const char* ToString(ExportType t);  // "integer", "number", "text", "time", "bool"

@@ -24,6 +24,7 @@ constexpr double kPlausibilityWeight = 0.002;
 constexpr double kOtherWeight = 0.02;
 constexpr double kMaskMaxWeight = 0.20;   // all segments together
 constexpr double kMaskMinWeight = 0.005;  // all segments together
+constexpr double kResidueWeight = 0.30;
 
 struct SideWeights {
   double lo = 0.0, hi = 0.0;
@@ -33,9 +34,10 @@ struct SideWeights {
 SideWeights DesignWeights(const std::string& name) {
   namespace n = names;
   const double p = kPlausibilityWeight;
-  if (name == n::kResonanceFHz) return {0.40, p, true, false};
+  if (name == n::kResonanceFHz) return {0.30, p, true, false};
   if (name == n::kFitChi2PerDof) return {p, 0.25, false, true};
   if (name == n::kResonanceQ) return {0.05, p, true, false};
+  if (name == n::kMotionalResidueOhmPerS) return {p, kResidueWeight, false, true};
   return {kOtherWeight, kOtherWeight, true, true};
 }
 

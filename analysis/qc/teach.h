@@ -15,7 +15,14 @@
 // defect moves keeps a plausibility bound (weight 0.002: wrong motor, station fault) so that
 // the recipe keeps its shape without spending the budget there.
 //   measurement        defect side  weight  why
-//   resonance_f_hz     lo           0.40    a softer bond (or looser clamp) only lowers the mode
+//   resonance_f_hz     lo           0.30    a softer bond (or looser clamp) only lowers the mode
+//   motional_residue   hi           0.30    T^2/J: a softer bond lets less inertia follow the
+//     _ohm_per_s                            magnets (where the torque acts); it rises about
+//                                           twelve times faster than f0 falls and hardly moves
+//                                           with the clamp (motor_model.h). Evidence: on the
+//                                           independent generator, all ten bonds at losses of
+//                                           0.85-0.94, 29 of 80 rejected with it, 18 without
+//                                           (independent_population_test part 4)
 //   fit_chi2_per_dof   hi           0.25    a soft magnet's local mode is a peak the one-mode
 //                                           model cannot follow; it only raises chi2
 //   Re Z mask max      hi           0.20    (all segments together) an extra motional peak

@@ -64,6 +64,14 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
     const auto& p = j.at("params");
     if (p.contains(param)) u.values[std::string(name)] = p.at(param).at("value").get<double>();
   }
+  const auto& p = j.at("params");
+  if (p.contains("Rp_ohm") && p.contains("f0_hz") && p.contains("Q")) {
+    analysis::MotionalImpedance m;
+    m.rp_ohm = p.at("Rp_ohm").at("value").get<double>();
+    m.f0_hz = p.at("f0_hz").at("value").get<double>();
+    m.q = p.at("Q").at("value").get<double>();
+    u.values[std::string(names::kMotionalResidueOhmPerS)] = m.ResidueOhmPerS();
+  }
   if (j.contains("fit") && j.at("fit").contains("chi2_per_dof"))
     u.values[std::string(names::kFitChi2PerDof)] = j.at("fit").at("chi2_per_dof").get<double>();
   return u;
