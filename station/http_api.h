@@ -11,6 +11,7 @@
 //                               optional fields as station/test_request.h accepts them)
 //   PUT  /api/recipe            a new version of the recipe (engineer token; audited)
 //   GET  /api/recipe/audit      who changed the recipe, when, old and new hash
+//   POST /api/recipe/approve    approve a taught proposal and install it (engineer; audited)
 //   GET  /api/recipe            the recipe in use with its hash (limits and masks) and its
 //                               operator "instructions" with their defaults written out
 //   GET  /api/stats?from=&to=&recipe_hash=&population=&subgroup=&gauge=&reference=NAME=VALUE

@@ -1,5 +1,6 @@
 #include "station/qc_service.h"
 
+#include "db/clock.h"
 #include "station/serial_number.h"
 
 namespace eol::station {
@@ -30,6 +31,8 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
     note += " FORCED: " + std::to_string(s.units_used) + " golden units where " +
             std::to_string(s.units_needed) + " are needed.";
   taught.description += note;
+  // A proposal until an engineer approves it (recipe.h, RecipeApproval).
+  taught.approval = RecipeApproval{"proposed", "eol teach", db::UtcNowIso8601(), ""};
   return RecipeToJson(taught);
 }
 

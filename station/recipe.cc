@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <tuple>
 
 #include "analysis/qc/measurement_names.h"
 #include "analysis/text.h"
@@ -231,6 +232,23 @@ void ParseConditions(const JsonObject& c, Recipe& r) {
   c.RejectUnknown();
 }
 
+void ParseApproval(const JsonObject& o, Recipe& r) {
+  RecipeApproval a;
+  a.state = o.String("state", "");
+  o.Require(a.state == "proposed" || a.state == "approved", "state",
+            "must be \"proposed\" or \"approved\"");
+  for (auto [key, field, required] :
+       {std::tuple{"by", &a.by, true}, std::tuple{"at", &a.at, true},
+        std::tuple{"note", &a.note, false}}) {
+    *field = o.String(key, "");
+    if (!required && field->empty() && !o.Has(key)) continue;
+    o.Require(!field->empty() && field->size() <= kMaxInstructionBytes, key,
+              "must be 1 to " + std::to_string(kMaxInstructionBytes) + " bytes of text");
+  }
+  o.RejectUnknown();
+  r.approval = a;
+}
+
 void ParseInstructions(const JsonObject& o, Recipe& r) {
   for (auto [key, text] :
        {std::pair{"fail", &r.instructions.fail}, std::pair{"error", &r.instructions.error},
@@ -303,6 +321,7 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
     if (root.Has("masks")) ParseMasks(root.Raw("masks"), "/masks", r);
     if (auto c = root.OptionalObject("conditions")) ParseConditions(*c, r);
     if (auto i = root.OptionalObject("instructions")) ParseInstructions(*i, r);
+    if (auto a = root.OptionalObject("approval")) ParseApproval(*a, r);
     root.RejectUnknown();
     r.source = j;
     r.hash = CanonicalHash(j);
@@ -313,6 +332,13 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
 }
 
 Recipe LoadRecipe(const std::string& path) { return ParseRecipe(io::ReadJsonFile(path), path); }
+
+std::string Recipe::WhyNotApproved() const {
+  if (Approved()) return "";
+  return "recipe " + id + " v" + std::to_string(version) + " is a proposal (" + approval->by +
+         ", " + approval->at +
+         "): an engineer approves it first (POST /api/recipe/approve or eol recipe-approve)";
+}
 
 // The emitting half of the field list above: every key ParseRecipe reads, in its schema.
 namespace {
@@ -405,6 +431,10 @@ nlohmann::json RecipeToJson(const Recipe& r) {
       {"masks", masks},
       {"instructions", InstructionsJson(r.instructions)}};
   if (r.conditions.enabled) j["conditions"] = ConditionsJson(r.conditions);
+  if (r.approval) {
+    j["approval"] = {{"state", r.approval->state}, {"by", r.approval->by}, {"at", r.approval->at}};
+    if (!r.approval->note.empty()) j["approval"]["note"] = r.approval->note;
+  }
   return j;
 }
 

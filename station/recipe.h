@@ -30,6 +30,7 @@
 
 #include <cstddef>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,20 @@ struct OperatorInstructions {
   bool operator==(const OperatorInstructions&) const = default;
 };
 
+// Who stands behind the limits (issue 12). A recipe `eol teach` writes is a proposal; the
+// station refuses to test with it (at start and on PUT /api/recipe) until an engineer
+// approves it: POST /api/recipe/approve (engineer token) or `eol recipe-approve` (both
+// audited). A recipe without "approval" was written by hand and counts as approved.
+//   "approval": {"state": "proposed" | "approved", "by": text, "at": ISO 8601, "note": text}
+// "by" and "at" are required; each text is 1 to kMaxInstructionBytes bytes.
+struct RecipeApproval {
+  std::string state;  // "proposed" or "approved"
+  std::string by;     // the teaching tool, or the approving engineer (token or --by name)
+  std::string at;
+  std::string note;   // optional
+  bool operator==(const RecipeApproval&) const = default;
+};
+
 struct Recipe {
   std::string id;
   int version = 0;
@@ -100,6 +115,11 @@ struct Recipe {
   std::vector<analysis::CurveMask> masks;
   ConditionWindows conditions;
   OperatorInstructions instructions;
+  std::optional<RecipeApproval> approval;
+
+  bool Approved() const { return !approval || approval->state == "approved"; }
+  // Empty when Approved(); else why the station refuses it, naming how to approve it.
+  std::string WhyNotApproved() const;
 
   // Every declared measurement: the scalar limits, then one per mask.
   std::vector<analysis::MeasurementSpec> Specs() const;

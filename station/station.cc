@@ -51,6 +51,8 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
     : config_(std::move(config)) {
   recipe_ =
       std::make_shared<const Recipe>(LoadRecipeOrLastGood(config_.recipe_path, &recipe_problem_));
+  if (recipe_problem_.empty() && !recipe_->Approved())
+    recipe_problem_ = recipe_->WhyNotApproved() + "; tests are refused until then";
   if (!recipe_problem_.empty()) spdlog::error("{}", recipe_problem_);
   spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_->id, recipe_->version, config_.recipe_path,
                recipe_->hash.substr(0, 12));
@@ -145,6 +147,8 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   } catch (const io::ConfigError& e) {
     return refused(RecipeChange::Kind::kInvalid, e.what());
   }
+  if (!next->Approved())
+    return refused(RecipeChange::Kind::kNotApproved, "PUT /api/recipe: " + next->WhyNotApproved());
   // Everything the new recipe needs is built before anything is renamed, audited or swapped:
   // a recipe whose excitation cannot be designed leaves the station as it was.
   analysis::Excitation designed;

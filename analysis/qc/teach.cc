@@ -35,7 +35,7 @@ SideWeights DesignWeights(const std::string& name) {
   namespace n = names;
   const double p = kPlausibilityWeight;
   if (name == n::kResonanceFHz) return {0.30, p, true, false};
-  if (name == n::kFitChi2PerDof) return {p, 0.25, false, true};
+  if (name == n::kFitChi2PerDof) return {p, 0.35, false, true};
   if (name == n::kResonanceQ) return {0.05, p, true, false};
   if (name == n::kMotionalResidueOhmPerS) return {p, kResidueWeight, false, true};
   return {kOtherWeight, kOtherWeight, true, true};

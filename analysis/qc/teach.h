@@ -23,7 +23,7 @@
 //                                           independent generator, all ten bonds at losses of
 //                                           0.85-0.94, 29 of 80 rejected with it, 18 without
 //                                           (independent_population_test part 4)
-//   fit_chi2_per_dof   hi           0.25    a soft magnet's local mode is a peak the one-mode
+//   fit_chi2_per_dof   hi           0.35    a soft magnet's local mode is a peak the one-mode
 //                                           model cannot follow; it only raises chi2
 //   Re Z mask max      hi           0.20    (all segments together) an extra motional peak
 //                                           outside the resonance band only adds Re Z

@@ -11,7 +11,8 @@ namespace eol::station::http {
 
 // GET /api/status, GET /api/events, GET /metrics, GET / and /static (station/http/board_routes.cc)
 void AddBoardRoutes(httplib::Server& s, ApiContext& c);
-// GET /api/recipe, PUT /api/recipe, GET /api/recipe/audit (station/http/recipe_routes.cc)
+// GET /api/recipe, PUT /api/recipe, GET /api/recipe/audit, POST /api/recipe/approve
+// (station/http/recipe_routes.cc)
 void AddRecipeRoutes(httplib::Server& s, ApiContext& c);
 // GET /api/units/{serial}, GET /api/tests/{id}, GET /api/tests, POST /api/tests
 void AddTestRoutes(httplib::Server& s, ApiContext& c);

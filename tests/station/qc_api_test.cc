@@ -126,14 +126,22 @@ TEST_F(QcApi, EngineersTeachFromStoredUnitsAndTheProposalIsAValidNextVersion) {
   }
   EXPECT_TRUE(saw_f0);
   EXPECT_GT(taught["units_needed"].get<int>(), 8);
-  // Nothing changed yet; PUT makes it the recipe in use, and the next test is judged with it.
+  // Nothing changed yet. The taught recipe is a proposal: PUT refuses it; an engineer's
+  // approval makes it the recipe in use, and the next test is judged with it.
   EXPECT_EQ(nlohmann::json::parse(http_->Get("/api/recipe")->body)["version"], 1);
+  EXPECT_EQ(taught["recipe"]["approval"]["state"], "proposed");
   res = http_->Put("/api/recipe", Bearer(kEngineer), taught["recipe"].dump(), "application/json");
   ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 409) << res->body;
+  res = http_->Post("/api/recipe/approve", Bearer(kEngineer),
+                    nlohmann::json{{"recipe", taught["recipe"]}}.dump(), "application/json");
+  ASSERT_TRUE(res);
   ASSERT_EQ(res->status, 200) << res->body;
+  const auto approved = nlohmann::json::parse(res->body);
   const auto in_use = nlohmann::json::parse(http_->Get("/api/recipe")->body);
   EXPECT_EQ(in_use["version"], 2);
-  EXPECT_EQ(in_use["hash"], taught["recipe_hash"]);
+  EXPECT_EQ(in_use["hash"], approved["hash"]);
+  EXPECT_NE(in_use["hash"], taught["recipe_hash"]) << "the approval is part of the recipe";
   EXPECT_EQ(Test("AFTER-TEACH"), "PASS");
 }
 
