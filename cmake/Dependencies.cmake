@@ -10,6 +10,7 @@ find_package(ZLIB REQUIRED)       # compressed raw curves in the store
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 pkg_check_modules(MODBUS REQUIRED IMPORTED_TARGET libmodbus)
+pkg_check_modules(MOSQUITTO REQUIRED IMPORTED_TARGET libmosquitto)  # results to the MES (MQTT)
 pkg_check_modules(SNDFILE REQUIRED IMPORTED_TARGET sndfile)  # WAV recordings (station/files)
 # cpp-httplib 0.11 is compiled; its .pc carries the defines that fix its class layout.
 pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)

@@ -122,6 +122,30 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       p->RejectUnknown();
       c.plc = s;
     }
+    if (auto m = root.OptionalObject("mqtt")) {
+      MqttConfig q;
+      std::string why;
+      m->Require(ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &why), "url", why);
+      q.topic_prefix = m->String("topic_prefix", q.topic_prefix);
+      m->Require(!q.topic_prefix.empty() &&
+                     q.topic_prefix.find_first_of("#+") == std::string::npos &&
+                     q.topic_prefix.back() != '/',
+                 "topic_prefix", "must be a topic without wildcards or a trailing '/'");
+      q.client_id = m->String("client_id", q.client_id);
+      q.username = m->String("username", q.username);
+      q.password = m->String("password", q.password);
+      q.keepalive_s = m->Integer("keepalive_s", q.keepalive_s);
+      q.reconnect_s = m->Number("reconnect_s", q.reconnect_s);
+      m->Require(q.keepalive_s >= 5 && q.keepalive_s <= 3600, "keepalive_s",
+                 "must be in [5, 3600] s");
+      m->Require(q.reconnect_s >= 0.05 && q.reconnect_s <= 600, "reconnect_s",
+                 "must be in [0.05, 600] s");
+      m->Require(!m->Has("tls"), "tls",
+                 "is not supported by this version (use mqtt:// on a "
+                 "trusted network, or a local bridge)");
+      m->RejectUnknown();
+      c.mqtt = q;
+    }
     root.RejectUnknown();
     return c;
   } catch (const io::ConfigError& e) {

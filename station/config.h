@@ -20,6 +20,10 @@
 //   "plc": {"listen": "0.0.0.0", "port": 502, "unit_id": 1, "max_clients": 8,
 //           "map": {"serial": 100, ...}}         optional: the line PLC's handshake, served
 //                                                when the block is there (station/plc/)
+//   "mqtt": {"url": "mqtt://host:1883", "topic_prefix": "plant/eol", "client_id": "",
+//            "username": "", "password": "", "keepalive_s": 30, "reconnect_s": 1}
+//                                                optional: results and status to the MES
+//                                                (station/mqtt_publisher.h); no TLS yet
 // }
 #pragma once
 
@@ -29,6 +33,7 @@
 #include <string_view>
 #include <vector>
 
+#include "station/mqtt_publisher.h"
 #include "station/plc/plc_server.h"
 
 namespace eol::station {
@@ -77,6 +82,8 @@ struct StationConfig {
   nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}
   // Plant integration (issue 15): the line PLC's handshake; nullopt without a "plc" block.
   std::optional<plc::PlcServerSettings> plc;
+  // Plant integration: results to the MES over MQTT; nullopt without an "mqtt" block.
+  std::optional<MqttConfig> mqtt;
 };
 
 // Throws io::ConfigError naming the file and the JSON path.

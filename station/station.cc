@@ -44,6 +44,7 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
 
 Station::~Station() {
   if (plc_) plc_->Stop();
+  if (mqtt_) mqtt_->Stop();
   if (http_) http_->Stop();
   if (drivers_.fixture) drivers_.fixture->Disconnect();
   if (drivers_.daq) drivers_.daq->Disconnect();
@@ -253,5 +254,13 @@ void Station::StartPlc() {
 }
 
 int Station::plc_port() const { return plc_ ? plc_->port() : 0; }
+
+void Station::StartMqtt() {
+  if (!config_.mqtt || mqtt_) return;
+  mqtt_ = std::make_unique<MqttPublisher>(
+      *config_.mqtt, config_.station_id, config_.db_path,
+      [this] { return board_->Snapshot()["state"].get<std::string>(); });
+  mqtt_->Start();
+}
 
 }  // namespace eol::station

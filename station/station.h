@@ -72,6 +72,9 @@ class Station {
   // address when it cannot listen.
   void StartPlc();
   int plc_port() const;
+  // Publishes every stored record and the station's status over MQTT
+  // (station/mqtt_publisher.h) when the config has an "mqtt" block.
+  void StartMqtt();
 
  private:
   StationConfig config_;
@@ -83,6 +86,7 @@ class Station {
   std::unique_ptr<Sequencer> sequencer_;
   std::unique_ptr<HttpApi> http_;
   std::unique_ptr<plc::PlcServer> plc_;
+  std::unique_ptr<MqttPublisher> mqtt_;
 
   std::mutex queue_mu_;
   std::condition_variable queue_cv_;

@@ -31,7 +31,8 @@ int RunStation(const std::string& config_path, std::string web_root) {
   Station station(LoadStationConfig(config_path));
   if (web_root.empty()) web_root = DefaultWebRoot();
   station.StartHttp(web_root);
-  station.StartPlc();  // when the config has a "plc" block
+  station.StartPlc();   // when the config has a "plc" block
+  station.StartMqtt();  // when the config has an "mqtt" block
   std::cout << "eol station: " << station.config().station_id << " ready, recipe "
             << station.recipe()->id << " v" << station.recipe()->version << ", http://"
             << station.config().http_listen << ":" << station.http_port() << "/";
