@@ -54,7 +54,11 @@ class Broker {
   Broker(std::string dir, int port) : dir_(std::move(dir)), port_(port) {
     std::ofstream(dir_ + "/mosquitto.conf")
         << "listener " << port_ << " 127.0.0.1\nallow_anonymous true\npersistence true\n"
-        << "persistence_location " << dir_ << "/\n";
+        << "persistence_location " << dir_
+        << "/\n"
+        // The MES's session queues the whole replay while it reconnects (mosquitto drops
+        // QoS 1 messages beyond 1000 queued per client by default).
+        << "max_queued_messages 100000\n";
   }
   ::testing::AssertionResult Start() {
     if (access(kMosquitto, X_OK) != 0)
@@ -228,7 +232,7 @@ TEST_F(MqttResultsTest, ABrokerOutageInTheMiddleOfARunLosesNothingAndKeepsTheOrd
   const std::size_t total = 3 + 3 + kBacklog + 3;
   int duplicates = 0;
   const std::vector<std::int64_t> ids = WaitResults(total, &duplicates);
-  ASSERT_EQ(ids.size(), total) << "results lost";
+  ASSERT_EQ(ids.size(), total) << "results lost; broker: " << broker_.output();
   // Store order (ids grow with the outbox here), each record once at least.
   std::vector<std::int64_t> stored;
   for (const auto& e : reader->OutboxAfterCursor("nobody", 10000)) stored.push_back(e.test_id);
