@@ -37,7 +37,9 @@ ImpedanceAnalysis AnalyzeImpedance(const Frf& z, const ResonanceFitOptions& opti
 ImpedanceAnalysis AnalyzeRecording(const Recording& recording,
                                    const std::vector<std::size_t>& lines,
                                    const ImpedanceAnalysisOptions& options) {
-  const FrfSummary frf = EstimatePeriodicFrf(recording, lines, options.frf);
+  const FrfSummary frf = options.frf_method == FrfMethod::kTransientLpm
+                             ? EstimateTransientFrf(recording, lines, options.lpm)
+                             : EstimatePeriodicFrf(recording, lines, options.frf);
   if (!frf.usable) {
     ImpedanceAnalysis a;
     a.frf = frf;

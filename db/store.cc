@@ -1,11 +1,18 @@
 #include "db/store.h"
 
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <sys/file.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 #include <stdexcept>
 #include <string_view>
@@ -509,18 +516,84 @@ std::vector<TestRecord> ReadTests(sqlite3* db, const std::string& path, Statemen
 
 }  // namespace
 
+namespace {
+
+// The URI a kReadOnly store opens. A WAL database opened read-only makes SQLite create
+// "-wal" and "-shm" beside it and leave them; while a writer has the file open they exist
+// already and "mode=ro" shares them. Without a "-wal" no connection has it open (the last one
+// to close removes it), so the file is opened "immutable": no lock and no file is created. A
+// station that starts writing during such a read may make that read fail; it cannot make it
+// write.
+std::string ReadOnlyUri(const std::string& path) {
+  std::string uri = "file:";
+  for (const char ch : path) {
+    if (ch == '%' || ch == '?' || ch == '#') {
+      char esc[4];
+      std::snprintf(esc, sizeof esc, "%%%02X", static_cast<unsigned char>(ch));
+      uri += esc;
+    } else {
+      uri += ch;
+    }
+  }
+  std::error_code ec;
+  const bool writer_open = std::filesystem::exists(path + "-wal", ec);
+  return uri + (writer_open ? "?mode=ro" : "?immutable=1");
+}
+
+}  // namespace
+
 Store::Store(std::string path) : path_(std::move(path)) {}
 
-Store::~Store() { sqlite3_close_v2(db_); }
+Store::~Store() {
+  sqlite3_close_v2(db_);
+  if (lock_fd_ >= 0) ::close(lock_fd_);
+}
 
 std::unique_ptr<Store> Store::Open(const std::string& path, Role role) {
   std::unique_ptr<Store> store(new Store(path));
-  const int rc = sqlite3_open_v2(path.c_str(), &store->db_,
-                                 SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  if (role == Role::kReadOnly) {
+    // sqlite3_open_v2 would name a missing file "unable to open database file".
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+      throw StoreError(Message(path, "open read-only", "no such file"));
+  }
+  if (role == Role::kWriter && path != ":memory:" && !path.empty()) {
+    const std::string lock_path = path + ".lock";
+    store->lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+    if (store->lock_fd_ < 0)
+      throw StoreError(
+          Message(path, "lock", "cannot open " + lock_path + ": " + std::strerror(errno)));
+    if (::flock(store->lock_fd_, LOCK_EX | LOCK_NB) != 0)
+      throw StoreError(Message(path, "lock",
+                               errno == EWOULDBLOCK
+                                   ? "another station holds " + lock_path +
+                                         " (one station per database; stop the other first)"
+                                   : "cannot lock " + lock_path + ": " + std::strerror(errno)));
+  }
+  const int rc = role == Role::kReadOnly
+                     ? sqlite3_open_v2(ReadOnlyUri(path).c_str(), &store->db_,
+                                       SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr)
+                     : sqlite3_open_v2(path.c_str(), &store->db_,
+                                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
   if (rc != SQLITE_OK) {
     const std::string detail =
         store->db_ != nullptr ? sqlite3_errmsg(store->db_) : sqlite3_errstr(rc);
     throw StoreError(Message(path, "open", detail + " (sqlite code " + std::to_string(rc) + ")"));
+  }
+  if (role == Role::kReadOnly) {
+    sqlite3_extended_result_codes(store->db_, 1);
+    sqlite3_busy_timeout(store->db_, kBusyTimeoutMs);
+    const std::string op = "open read-only (read the schema version)";
+    const std::int64_t version = PragmaInt(store->db_, path, "PRAGMA user_version", op);
+    CheckSchemaVersion(store->db_, path, version);
+    if (version != kSchemaVersion)
+      throw StoreError(Message(path, "open read-only",
+                               version == 0
+                                   ? std::string("not an EOL test store (no schema)")
+                                   : "schema version " + std::to_string(version) +
+                                         ", this software reads " + std::to_string(kSchemaVersion) +
+                                         "; let `eol station` migrate it first"));
+    return store;
   }
   // SQLite falls back to read-only when the file is write-protected; the station must write.
   if (sqlite3_db_readonly(store->db_, "main") == 1)

@@ -104,10 +104,16 @@ class Store {
  public:
   static constexpr int kSchemaVersion = 5;
 
-  // kWriter: the station's one connection; recovers unfinished tests as ABORTED.
+  // kWriter: the station's one connection; recovers unfinished tests as ABORTED. It holds an
+  // exclusive flock on "<path>.lock" (created 0600 beside the file) for as long as it is open:
+  // a second writer, e.g. a second `eol station` on the same database, gets a StoreError
+  // before it can recover (abort) the first one's running test.
   // kReader: further connections (the HTTP API, queries, exports) that must never touch a
   // test another connection is running; they migrate a new file but recover nothing.
-  enum class Role { kWriter, kReader };
+  // kReadOnly: a reader that never writes (queries, exports, stats): it opens an existing
+  // store read-only, so it works on a file it may not write (a copy, a read-only share) and
+  // never creates or migrates one; a missing file or another schema version is a StoreError.
+  enum class Role { kWriter, kReader, kReadOnly };
 
   static std::unique_ptr<Store> Open(const std::string& path, Role role = Role::kWriter);
   ~Store();
@@ -167,6 +173,7 @@ class Store {
   std::string path_;
   sqlite3* db_ = nullptr;
   int aborted_on_open_ = 0;
+  int lock_fd_ = -1;  // kWriter: "<path>.lock", flock'ed exclusively while the store is open
 };
 
 }  // namespace eol::db

@@ -82,6 +82,7 @@ void to_json(nlohmann::json& j, const TestRecord& r) {
        {"fit", r.fit},
        {"curves", r.curves},
        {"trace", r.trace},
+       {"cycle_s", r.cycle_s},
        {"kind", r.kind},
        {"self_check", r.self_check},
        {"operator_id", r.work.operator_id},
@@ -111,6 +112,7 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   r.fit = j.value("fit", nlohmann::json::object());
   r.curves = j.value("curves", std::vector<Curve>{});
   r.trace = j.value("trace", std::vector<StateEntry>{});
+  r.cycle_s = j.value("cycle_s", std::map<std::string, double>{});
   r.kind = j.value("kind", RecordKind::kProduction);
   r.self_check = j.value("self_check", nlohmann::json::object());
   r.work.operator_id = j.value("operator_id", "");

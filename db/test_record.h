@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -82,6 +83,11 @@ struct TestRecord {
   nlohmann::json fit = nlohmann::json::object();  // the fit summary
   std::vector<Curve> curves;
   std::vector<StateEntry> trace;
+  // Where the test's time went, seconds per step (station/cycle_time.h: "interlocks",
+  // "clamp", "excitation", "analysis", ..., and "total"), summed from the trace. The stored
+  // record has the steps up to the store (its own store and publish cannot be in it); the
+  // record RunTest returns has them all, "total" being serial received -> verdict published.
+  std::map<std::string, double> cycle_s;
 
   RecordKind kind = RecordKind::kProduction;
   // For a self-check: {"master": "good" | "limit", "passed": bool, "detail": "..."}; the store

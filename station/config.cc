@@ -1,5 +1,7 @@
 #include "station/config.h"
 
+#include <arpa/inet.h>
+
 #include <filesystem>
 
 #include "drivers/io/json_config.h"
@@ -7,6 +9,15 @@
 
 namespace eol::station {
 namespace {
+
+// 127.0.0.0/8, ::1 and "localhost": addresses only this host can reach.
+bool IsLoopback(const std::string& host) {
+  if (host == "localhost") return true;
+  in_addr v4{};
+  if (inet_pton(AF_INET, host.c_str(), &v4) == 1) return (ntohl(v4.s_addr) >> 24) == 127;
+  in6_addr v6{};
+  return inet_pton(AF_INET6, host.c_str(), &v6) == 1 && IN6_IS_ADDR_LOOPBACK(&v6);
+}
 
 std::string Resolve(const std::string& base_dir, const std::string& p) {
   if (p.empty() || std::filesystem::path(p).is_absolute() || base_dir.empty()) return p;
@@ -29,6 +40,17 @@ std::optional<Role> ParseRole(std::string_view text) {
   for (Role r : {Role::kOperator, Role::kEngineer})
     if (text == ToString(r)) return r;
   return std::nullopt;
+}
+
+std::string SimulationReason(const StationConfig& config) {
+  std::string why;
+  for (const char* part : {"fixture", "daq"}) {
+    if (!config.drivers.contains(part) || !config.drivers.at(part).is_object()) continue;
+    const std::string driver = config.drivers.at(part).value("driver", "");
+    if (driver == "sim" || driver == "replay")
+      why += (why.empty() ? "" : ", ") + std::string(part) + " driver '" + driver + "'";
+  }
+  return why;
 }
 
 StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,
@@ -63,18 +85,26 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
         }
       }
       http->RejectUnknown();
+      // Without tokens anyone who reaches the port may start tests: only this host may.
+      if (c.tokens.empty() && !IsLoopback(c.http_listen))
+        throw io::ConfigError(http->PathOf("listen") + ": \"" + c.http_listen +
+                              "\" listens beyond this host, which needs \"tokens\" (none are "
+                              "configured); listen on 127.0.0.1 or configure tokens");
     }
     if (auto s = root.OptionalObject("safety")) {
       c.safety.watchdog_period_ms = s->Number("watchdog_period_ms", c.safety.watchdog_period_ms);
       c.safety.heartbeat_timeout_ms =
           s->Number("heartbeat_timeout_ms", c.safety.heartbeat_timeout_ms);
       c.safety.poll_period_ms = s->Number("poll_period_ms", c.safety.poll_period_ms);
+      c.safety.safe_state_retry_s = s->Number("safe_state_retry_s", c.safety.safe_state_retry_s);
       s->Require(c.safety.watchdog_period_ms >= 1 && c.safety.watchdog_period_ms <= 50,
                  "watchdog_period_ms", "must be in [1, 50] ms (the reaction target is 50 ms)");
       s->Require(c.safety.heartbeat_timeout_ms >= 600, "heartbeat_timeout_ms",
                  "must be at least 600 ms (the heartbeat increments every 500 ms)");
       s->Require(c.safety.poll_period_ms >= 1 && c.safety.poll_period_ms <= 500, "poll_period_ms",
                  "must be in [1, 500] ms");
+      s->Require(c.safety.safe_state_retry_s >= 0 && c.safety.safe_state_retry_s <= 60,
+                 "safe_state_retry_s", "must be in [0, 60] s");
       s->RejectUnknown();
     }
     c.serial_from_stdin = root.Bool("serial_from_stdin", false);

@@ -8,11 +8,13 @@
 //            "tokens": [{"name": "line1-operator", "role": "operator", "token": "..."},
 //                       {"name": "qe-anna", "role": "engineer", "token": "..."}]},
 //     Reads need no token. With tokens configured, starting a test needs an operator or
-//     engineer token; changing the recipe always needs an engineer token.
+//     engineer token; changing the recipe always needs an engineer token. Listening beyond
+//     loopback (anything but 127.0.0.0/8, ::1, localhost) needs tokens: refused otherwise.
 //   "fixture": {"driver": "sim" | ...},              see drivers/factory/factory.h
 //   "daq": {"driver": "sim" | ...},
 //   "sim": {...},                                    the simulated bench, when a driver is sim
-//   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500},
+//   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500, "poll_period_ms": 10,
+//              "safe_state_retry_s": 3},
 //   "serial_from_stdin": false,                      a scanner typing serials into stdin
 //                                                    (its line format: station/test_request.h)
 //   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
@@ -42,6 +44,7 @@ struct SafetyOptions {
   double watchdog_period_ms = 5.0;     // interlock poll period during excitation
   double heartbeat_timeout_ms = 1500;  // controller heartbeat must change within this
   double poll_period_ms = 10.0;        // clamp/release confirmation polling
+  double safe_state_retry_s = 3.0;     // on a fault, excitation off and unclamp retried this long
 };
 
 // What a token may do. Operators start tests; engineers also change and teach recipes.
@@ -85,6 +88,11 @@ struct StationConfig {
   // Plant integration: results to the MES over MQTT; nullopt without an "mqtt" block.
   std::optional<MqttConfig> mqtt;
 };
+
+// Non-empty when the station runs on simulators or recorded data rather than a real fixture
+// and DAQ ("fixture driver 'sim'", "daq driver 'replay'"): its records are no production
+// results, and the page and every record say SIMULATION.
+std::string SimulationReason(const StationConfig& config);
 
 // Throws io::ConfigError naming the file and the JSON path.
 StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,

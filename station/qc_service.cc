@@ -35,11 +35,7 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
 
 json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOptions& o) {
   json limits = json::array(), stats = json::array(), masks = json::array();
-  for (const auto& l : s.limits)
-    limits.push_back({{"name", l.name},
-                      {"lo", l.limit.lo ? json(*l.limit.lo) : json(nullptr)},
-                      {"hi", l.limit.hi ? json(*l.limit.hi) : json(nullptr)},
-                      {"marginal", l.limit.marginal}});
+  for (const auto& l : s.limits) limits.push_back(LimitJson(l));
   for (const auto& t : s.statistics)
     stats.push_back({{"name", t.name}, {"centre", t.centre}, {"scale", t.scale}});
   for (const auto& m : s.masks) masks.push_back(MaskJson(m));

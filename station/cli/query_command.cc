@@ -1,12 +1,19 @@
-// `eol query --db FILE --serial SN [--json]`: the traceable history of one serial number,
-// with who tested it and for which order.
+// `eol query --db FILE --serial SN [--json] [--plot FILE [--test ID] [--recipe FILE]]`: the
+// traceable history of one serial number, with who tested it and for which order. --plot
+// draws the stored curve of its newest test (or --test ID) with the fitted model, the
+// resonance window it was judged against and, given the recipe file of the record's hash,
+// the masks (station/curve_chart.h).
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <iostream>
 
 #include "db/store.h"
+#include "drivers/io/chart.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/curve_chart.h"
+#include "station/recipe.h"
 #include "station/serial_number.h"
 
 namespace eol::station::cli {
@@ -17,13 +24,73 @@ struct QueryArgs {
   std::string serial;
   bool json = false;
   bool curves = false;
+  std::string plot;
+  long long test_id = 0;
+  std::string recipe;
 };
+
+const db::Curve* FindCurve(const db::TestRecord& t, const std::string& name) {
+  for (const db::Curve& c : t.curves)
+    if (c.name == name) return &c;
+  return nullptr;
+}
+
+std::vector<std::complex<double>> Values(const db::Curve& c) {
+  std::vector<std::complex<double>> v;
+  for (std::size_t i = 0; i < c.re.size() && i < c.im.size(); ++i) v.emplace_back(c.re[i], c.im[i]);
+  return v;
+}
+
+void WritePlot(const QueryArgs& a, const std::vector<db::TestRecord>& tests) {
+  const db::TestRecord* t = &tests.front();
+  if (a.test_id != 0) {
+    t = nullptr;
+    for (const db::TestRecord& r : tests)
+      if (r.id == a.test_id) t = &r;
+    if (!t)
+      throw std::runtime_error("--test: " + a.serial + " has no test #" +
+                               std::to_string(a.test_id));
+  }
+  const db::Curve* measured = FindCurve(*t, "impedance");
+  if (!measured)
+    throw std::runtime_error("--plot: test #" + std::to_string(t->id) +
+                             " stored no impedance curve (outcome " +
+                             analysis::ToString(t->outcome) + ")");
+  CurvePlot p;
+  p.title = "eol query " + a.serial + " test #" + std::to_string(t->id) + " " + t->started_at +
+            " - recipe " + t->recipe_id + " v" + std::to_string(t->recipe_version) + ": " +
+            analysis::ToString(t->outcome);
+  p.freq_hz = measured->freq_hz;
+  p.measured = Values(*measured);
+  if (const db::Curve* model = FindCurve(*t, "model")) {
+    p.model_freq_hz = model->freq_hz;
+    p.model = Values(*model);
+  }
+  for (const analysis::Measurement& m : t->measurements)
+    if (m.name == "resonance_f_hz") {
+      p.resonance_window = m.limit;
+      if (std::isfinite(m.value)) p.f0_hz = m.value;
+    }
+  for (const analysis::Reason& r : t->reasons) p.notes.push_back(r.text);
+  if (!a.recipe.empty()) {
+    const Recipe recipe = LoadRecipe(a.recipe);
+    if (recipe.hash == t->recipe_hash)
+      p.masks = recipe.masks;
+    else
+      p.notes.push_back("masks not drawn: " + a.recipe + " is not the recipe of this test");
+  } else {
+    p.notes.push_back("masks not drawn: give --recipe FILE of this test's recipe");
+  }
+  io::WriteChart(a.plot, CurveChart(p));
+}
 
 int RunQuery(const QueryArgs& a) {
   std::string why;
   if (!ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
-  auto store = db::Store::Open(a.db, db::Store::Role::kReader);
-  const std::vector<db::TestRecord> tests = store->TestsOfSerial(a.serial, a.curves);
+  auto store = db::Store::Open(a.db, db::Store::Role::kReadOnly);
+  const std::vector<db::TestRecord> tests =
+      store->TestsOfSerial(a.serial, a.curves || !a.plot.empty());
+  if (!a.plot.empty() && !tests.empty()) WritePlot(a, tests);
   if (a.json) {
     nlohmann::json list = nlohmann::json::array();
     for (const auto& t : tests) list.push_back(t);
@@ -67,7 +134,7 @@ void AddQueryCommand(CLI::App& app) {
   auto args = std::make_shared<QueryArgs>();
   CLI::App* cmd = app.add_subcommand(
       "query",
-      "Show every test of a serial number, newest first, with measurements, limits, verdict,\n"
+      "Show every test of a serial number, newest first, with measurements, limits, outcome,\n"
       "reasons and recipe hash. Exit code 1 when the serial has no tests.");
   cmd->add_option("--db", args->db, "SQLite file of the station")
       ->required()
@@ -75,6 +142,13 @@ void AddQueryCommand(CLI::App& app) {
   cmd->add_option("--serial", args->serial, "Serial number")->required();
   cmd->add_flag("--json", args->json, "One JSON object: {serial, latest, tests}");
   cmd->add_flag("--curves", args->curves, "With --json: include the raw curves");
+  cmd->add_option("--plot", args->plot,
+                  "Write the stored |Z| and Re Z of the newest test with the fitted model and\n"
+                  "its limits (SVG, or PNG for .png)");
+  cmd->add_option("--test", args->test_id, "With --plot: this test id instead of the newest");
+  cmd->add_option("--recipe", args->recipe,
+                  "With --plot: the recipe file of the test (its masks are drawn when its hash\n"
+                  "is the test's)");
   cmd->callback([args] { RunGuarded("query", [&] { return RunQuery(*args); }); });
 }
 

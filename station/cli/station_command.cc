@@ -7,8 +7,10 @@
 #include <spdlog/spdlog.h>
 
 #include <iostream>
+#include <memory>
 #include <thread>
 
+#include "drivers/io/json_config.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/data_files.h"
@@ -20,6 +22,8 @@
 namespace eol::station::cli {
 namespace {
 
+constexpr int kExitConfigError = 78;  // EX_CONFIG (sysexits.h)
+
 int RunStation(const std::string& config_path, std::string web_root) {
   // Block the stop signals in every thread; one thread waits for them with sigwait.
   sigset_t stop_signals;
@@ -28,19 +32,36 @@ int RunStation(const std::string& config_path, std::string web_root) {
   sigaddset(&stop_signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
-  Station station(LoadStationConfig(config_path));
+  std::unique_ptr<Station> made;
+  try {
+    made = std::make_unique<Station>(LoadStationConfig(config_path));
+  } catch (const io::ConfigError& e) {
+    // Restarting cannot fix a file: the unit's RestartPreventExitStatus names this code.
+    std::cerr << "eol station: configuration error: " << e.what() << " (exit " << kExitConfigError
+              << ": fix the file, then start the station again)" << std::endl;
+    return kExitConfigError;
+  }
+  Station& station = *made;
   if (web_root.empty()) web_root = DefaultWebRoot();
   station.StartHttp(web_root);
   station.StartPlc();   // when the config has a "plc" block
   station.StartMqtt();  // when the config has an "mqtt" block
-  std::cout << "eol station: " << station.config().station_id << " ready, recipe "
+  // "ready" only when the fixture and the DAQ answered; otherwise the daemon is up (the API
+  // answers, each test retries the drivers) and says what is missing.
+  const nlohmann::json board = station.board().Snapshot();
+  const std::string readiness =
+      station.ready() ? "ready" : "up, NOT READY (" + board.value("not_ready_reason", "") + ")";
+  const std::string simulation = board.value("simulation", "");
+  std::cout << "eol station: " << station.config().station_id << " " << readiness << ", recipe "
             << station.recipe()->id << " v" << station.recipe()->version << ", http://"
             << station.config().http_listen << ":" << station.http_port() << "/";
   if (station.config().plc)
     std::cout << ", plc modbus://" << station.config().plc->listen << ":" << station.plc_port();
-  std::cout << std::endl;
+  std::cout << (simulation.empty() ? "" : ", SIMULATION (" + simulation + ")") << std::endl;
 
-  NotifyReady("testing " + station.recipe()->id + " v" + std::to_string(station.recipe()->version));
+  NotifyReady((station.ready() ? "testing " : "NOT READY, testing ") + station.recipe()->id + " v" +
+              std::to_string(station.recipe()->version) +
+              (simulation.empty() ? "" : " in SIMULATION"));
   std::thread signal_thread([&] {
     int sig = 0;
     sigwait(&stop_signals, &sig);

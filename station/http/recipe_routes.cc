@@ -72,9 +72,9 @@ HttpReply RecipeChangeReply(const RecipeChange& change) {
 }
 
 void AddRecipeRoutes(httplib::Server& s, ApiContext& c) {
-  s.Get("/api/recipe", Bind(c, GetRecipe));
-  s.Put("/api/recipe", Bind(c, PutRecipe));
-  s.Get("/api/recipe/audit", Bind(c, GetAudit));
+  Route(s, c, "GET", "/api/recipe", GetRecipe);
+  Route(s, c, "PUT", "/api/recipe", PutRecipe);
+  Route(s, c, "GET", "/api/recipe/audit", GetAudit);
 }
 
 }  // namespace eol::station::http

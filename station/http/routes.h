@@ -15,7 +15,8 @@ void AddBoardRoutes(httplib::Server& s, ApiContext& c);
 void AddRecipeRoutes(httplib::Server& s, ApiContext& c);
 // GET /api/units/{serial}, GET /api/tests/{id}, GET /api/tests, POST /api/tests
 void AddTestRoutes(httplib::Server& s, ApiContext& c);
-// GET /api/stats, GET /api/detectability, POST /api/teach (station/http/qc_routes.cc)
+// GET /api/stats, GET /api/charts/{measurement}.svg, GET /api/detectability, POST /api/teach
+// (station/http/qc_routes.cc)
 void AddQcRoutes(httplib::Server& s, ApiContext& c);
 
 // kChanged: 200 with {id, version, hash, path, previous: {version, hash, kept_as}};

@@ -17,28 +17,11 @@
 #include <utility>
 #include <vector>
 
+#include "drivers/fixture/modbus_link.h"
 #include "station/serial_number.h"
 
 namespace eol::station::plc {
 namespace {
-
-// The function codes of a plain handshake; the others (mask write, read/write multiple) get
-// "illegal function", so no request can change a table behind the handshake's back.
-bool Supported(int function) {
-  switch (function) {
-    case MODBUS_FC_READ_COILS:
-    case MODBUS_FC_READ_DISCRETE_INPUTS:
-    case MODBUS_FC_READ_HOLDING_REGISTERS:
-    case MODBUS_FC_READ_INPUT_REGISTERS:
-    case MODBUS_FC_WRITE_SINGLE_COIL:
-    case MODBUS_FC_WRITE_SINGLE_REGISTER:
-    case MODBUS_FC_WRITE_MULTIPLE_COILS:
-    case MODBUS_FC_WRITE_MULTIPLE_REGISTERS:
-      return true;
-    default:
-      return false;
-  }
-}
 
 struct Range {
   int start = 0;
@@ -203,7 +186,7 @@ void PlcServer::Handle(const std::uint8_t* request, int length) {
     modbus_reply_exception(ctx_, request, MODBUS_EXCEPTION_GATEWAY_TARGET);
     return;
   }
-  if (!Supported(function)) {
+  if (!drivers::IsPlainModbusFunction(function)) {
     modbus_reply_exception(ctx_, request, MODBUS_EXCEPTION_ILLEGAL_FUNCTION);
     return;
   }

@@ -141,7 +141,16 @@ TEST_F(QcApi, DetectabilityReportsEveryDefectClassAndRejectsBadParameters) {
   auto res = http_->Get("/api/detectability?k_fixture=abc");
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 400);
-  EXPECT_NE(res->body.find("k_fixture must be a positive number"), std::string::npos);
+  EXPECT_NE(res->body.find("k_fixture must be a number in [0.1, 10000000.0], got 'abc'"),
+            std::string::npos)
+      << res->body;
+  // Out of range is the client's error, not the station's (this used to be a 500).
+  for (const char* q : {"k_fixture=1e308", "k_fixture=-1", "limit_sigmas=1e308",
+                        "required_sigmas=nan", "k_fixture=864abc"}) {
+    res = http_->Get(std::string("/api/detectability?") + q);
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 400) << q << ": " << res->body;
+  }
 
   res = http_->Get("/api/detectability?k_fixture=864");
   ASSERT_TRUE(res);

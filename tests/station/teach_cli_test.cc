@@ -33,7 +33,7 @@ std::string Simulated(const eol::testing::TempDir& dir, const std::string& name,
   const std::string out = dir / name;
   const CliRun r =
       Eol({"simulate", "--motor", kMotor, "--out", out, "--defect", defect, "--seed",
-           std::to_string(seed), "--model", "steady_state", "--noise-v",
+           std::to_string(seed), "--recipe", kRecipe, "--model", "steady_state", "--noise-v",
            std::to_string(2e-3 * noise_scale), "--noise-a", std::to_string(1e-3 * noise_scale)});
   EXPECT_EQ(r.code, 0) << r.out;
   return out;
@@ -127,7 +127,7 @@ TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
   EXPECT_GT(j["units_needed"].get<int>(), 6);
 }
 
-// `eol export --format json` records: PASS production records of this recipe are golden
+// `eol export --format records` records: PASS production records of this recipe are golden
 // units; a FAIL, ERROR or ABORTED record, a master's self-check and a record of another recipe
 // hash are refused, naming the record.
 TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
@@ -188,6 +188,37 @@ TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("SN4 was tested with recipe hash abc123, not " + hash), std::string::npos)
       << r.out;
+}
+
+// Known-bad units (`--bad`): one with every magnet poorly cemented is caught by the limits the
+// budget sets; a unit an engineer marked bad that measures like the good ones passes any limit
+// within the budget, and teach says so by name (text and JSON). The even split has no share to
+// move and refuses known-bad units.
+TEST_F(TeachCli, KnownBadUnitsAreReportedWithTheirEscapes) {
+  const std::string caught = Simulated(dir_, "bad-all-soft.csv", 997, "all_soft", 1.0);
+  const std::string hidden = Simulated(dir_, "bad-hidden.csv", 996, "none", 1.0);
+  std::vector<std::string> args = TeachArgs(dir_ / "kb.json");
+  args.insert(args.end(), {"--bad", caught, hidden, "--json"});
+  CliRun r = Eol(args, false);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("known_bad")) << r.out;
+  EXPECT_EQ(j["known_bad"]["units"], 2);
+  EXPECT_EQ(j["known_bad"]["escapes"], nlohmann::json::array({hidden})) << r.out;
+  EXPECT_NE(
+      j["message"].get<std::string>().find("no bound within the budget catches them: " + hidden),
+      std::string::npos)
+      << r.out;
+  std::vector<std::string> text = TeachArgs(dir_ / "kb-text.json");
+  text.insert(text.end(), {"--bad", caught, hidden});
+  r = Eol(text);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("known-bad unit passes: " + hidden), std::string::npos) << r.out;
+  std::vector<std::string> even = TeachArgs(dir_ / "kb-even.json");
+  even.insert(even.end(), {"--bad", caught, "--allocation", "even"});
+  r = Eol(even);
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("known-bad units need allocation physics"), std::string::npos) << r.out;
 }
 
 TEST_F(TeachCli, ErrorsNameTheFile) {
