@@ -5,11 +5,14 @@
 // daemon killed with SIGKILL leaves its last will "offline".
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <pwd.h>
+#include <sys/stat.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -48,10 +51,25 @@ int FreePort() {
   return ntohs(a.sin_port);
 }
 
-// mosquitto on 127.0.0.1:port with persistence in `dir` (what it holds survives a restart).
+// mosquitto on 127.0.0.1:port with persistence in `dir` (what it holds survives a restart:
+// the MES's persistent session with its subscription and queued messages).
+//
+// Started as root, mosquitto drops its privileges to the `mosquitto` user after reading its
+// config, and writes its persistence file as that user. In the test's own directory (root's,
+// 0700) its save on SIGTERM failed ("Error saving in-memory database ... Permission denied"),
+// the restarted broker had no session for the MES, and what the station published before the
+// MES had subscribed again went to nobody, acknowledged. So the broker's directory belongs to
+// the user it runs as, and Stop() checks that the save worked.
 class Broker {
  public:
-  Broker(std::string dir, int port) : dir_(std::move(dir)), port_(port) {
+  Broker(std::string dir, int port) : dir_(std::move(dir) + "/broker"), port_(port) {
+    std::filesystem::create_directory(dir_);
+    if (geteuid() == 0) {
+      if (const passwd* pw = getpwnam("mosquitto")) {
+        chmod(std::filesystem::path(dir_).parent_path().c_str(), 0711);
+        if (chown(dir_.c_str(), pw->pw_uid, pw->pw_gid) != 0) ADD_FAILURE() << "chown " << dir_;
+      }
+    }
     std::ofstream(dir_ + "/mosquitto.conf")
         << "listener " << port_ << " 127.0.0.1\nallow_anonymous true\npersistence true\n"
         << "persistence_location " << dir_
@@ -72,8 +90,14 @@ class Broker {
       return ::testing::AssertionFailure() << "mosquitto did not start: " << process_->output();
     return ::testing::AssertionSuccess();
   }
+  // SIGTERM: mosquitto saves its sessions to persistence_location, then exits. A failed
+  // save fails the test: the next start would have lost the sessions.
   void Stop() {
-    if (process_) process_->Stop(SIGTERM, 10s);
+    if (!process_) return;
+    process_->Stop(SIGTERM, 10s);
+    EXPECT_EQ(process_->output().find("Error saving"), std::string::npos) << process_->output();
+    EXPECT_TRUE(std::filesystem::exists(dir_ + "/mosquitto.db"))
+        << "mosquitto saved no persistence file: " << process_->output();
     process_.reset();
   }
   int port() const { return port_; }
@@ -232,10 +256,17 @@ TEST_F(MqttResultsTest, ABrokerOutageInTheMiddleOfARunLosesNothingAndKeepsTheOrd
   const std::size_t total = 3 + 3 + kBacklog + 3;
   int duplicates = 0;
   const std::vector<std::int64_t> ids = WaitResults(total, &duplicates);
-  ASSERT_EQ(ids.size(), total) << "results lost; broker: " << broker_.output();
   // Store order (ids grow with the outbox here), each record once at least.
   std::vector<std::int64_t> stored;
   for (const auto& e : reader->OutboxAfterCursor("nobody", 10000)) stored.push_back(e.test_id);
+  if (ids.size() != total) {
+    const std::set<std::int64_t> got(ids.begin(), ids.end());
+    std::ostringstream missing;
+    for (const std::int64_t id : stored)
+      if (!got.count(id)) missing << " " << id << " (" << reader->Test(id, false)->serial << ")";
+    FAIL() << ids.size() << " of " << total << " results received; lost:" << missing.str()
+           << "\nbroker: " << broker_.output();
+  }
   EXPECT_EQ(ids, stored) << "order or content differs from the outbox";
   // The payload is the stored record.
   const auto messages = Messages(*subscriber_);
