@@ -3,6 +3,7 @@
 #include <arpa/inet.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "drivers/io/json_config.h"
 #include "station/serial_number.h"
@@ -155,7 +156,9 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
     if (auto m = root.OptionalObject("mqtt")) {
       MqttConfig q;
       std::string why;
-      m->Require(ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &why), "url", why);
+      bool tls = false;
+      m->Require(ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &tls, &why), "url",
+                 why);
       q.topic_prefix = m->String("topic_prefix", q.topic_prefix);
       m->Require(!q.topic_prefix.empty() &&
                      q.topic_prefix.find_first_of("#+") == std::string::npos &&
@@ -170,9 +173,29 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
                  "must be in [5, 3600] s");
       m->Require(q.reconnect_s >= 0.05 && q.reconnect_s <= 600, "reconnect_s",
                  "must be in [0.05, 600] s");
-      m->Require(!m->Has("tls"), "tls",
-                 "is not supported by this version (use mqtt:// on a "
-                 "trusted network, or a local bridge)");
+      if (auto t = m->OptionalObject("tls")) {
+        m->Require(tls, "tls", "needs an mqtts:// url (this one is plain mqtt://)");
+        MqttTls s;
+        // Each named file must be readable now: a typo is a config error, not an outage.
+        const auto file = [&](const std::string& key) {
+          const std::string path = Resolve(base_dir, t->String(key, ""));
+          if (path.empty()) return path;
+          std::ifstream probe(path);
+          t->Require(probe.good(), key, "cannot read the file " + path);
+          return path;
+        };
+        s.ca_file = file("ca_file");
+        s.cert_file = file("cert_file");
+        s.key_file = file("key_file");
+        s.insecure = t->Bool("insecure", s.insecure);
+        t->Require(s.cert_file.empty() == s.key_file.empty(),
+                   s.cert_file.empty() ? "cert_file" : "key_file",
+                   "cert_file and key_file go together (a client certificate and its key)");
+        t->RejectUnknown();
+        q.tls = s;
+      } else if (tls) {
+        q.tls = MqttTls{};  // the system's CAs, host name checked
+      }
       m->RejectUnknown();
       c.mqtt = q;
     }

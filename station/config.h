@@ -22,10 +22,14 @@
 //   "plc": {"listen": "0.0.0.0", "port": 502, "unit_id": 1, "max_clients": 8,
 //           "map": {"serial": 100, ...}}         optional: the line PLC's handshake, served
 //                                                when the block is there (station/plc/)
-//   "mqtt": {"url": "mqtt://host:1883", "topic_prefix": "plant/eol", "client_id": "",
-//            "username": "", "password": "", "keepalive_s": 30, "reconnect_s": 1}
+//   "mqtt": {"url": "mqtt://host:1883" | "mqtts://host:8883", "topic_prefix": "plant/eol",
+//            "client_id": "", "username": "", "password": "", "keepalive_s": 30,
+//            "reconnect_s": 1,
+//            "tls": {"ca_file": "ca.crt", "cert_file": "", "key_file": "", "insecure": false}}
 //                                                optional: results and status to the MES
-//                                                (station/mqtt_publisher.h); no TLS yet
+//                                                (station/mqtt_publisher.h); "tls" only with
+//                                                mqtts:// (without it: the system's CAs);
+//                                                each named file must be readable
 // }
 #pragma once
 

@@ -16,6 +16,7 @@ namespace {
 
 constexpr const char* kConsumer = "mqtt";
 constexpr const char* kOffline = "offline";
+constexpr const char* kSystemCaDir = "/etc/ssl/certs";
 
 void InitLibraryOnce() {
   static std::once_flag once;
@@ -24,19 +25,19 @@ void InitLibraryOnce() {
 
 }  // namespace
 
-bool ParseMqttUrl(const std::string& url, std::string* host, int* port, std::string* why) {
-  const std::string scheme = "mqtt://";
+bool ParseMqttUrl(const std::string& url, std::string* host, int* port, bool* tls,
+                  std::string* why) {
+  *tls = url.rfind("mqtts://", 0) == 0;
+  const std::string scheme = *tls ? "mqtts://" : "mqtt://";
   if (url.rfind(scheme, 0) != 0) {
-    *why = url.rfind("mqtts://", 0) == 0
-               ? "mqtts:// (TLS) is not supported by this version; use mqtt://"
-               : "must start with mqtt:// (got '" + url + "')";
+    *why = "must start with mqtt:// or mqtts:// (got '" + url + "')";
     return false;
   }
   std::string rest = url.substr(scheme.size());
   if (!rest.empty() && rest.back() == '/') rest.pop_back();
   const std::size_t colon = rest.rfind(':');
   *host = colon == std::string::npos ? rest : rest.substr(0, colon);
-  *port = 1883;
+  *port = *tls ? 8883 : 1883;
   if (colon != std::string::npos) {
     const std::string digits = rest.substr(colon + 1);
     if (digits.empty() || digits.size() > 5 ||
@@ -93,6 +94,15 @@ void MqttPublisher::Start() {
     check(mosquitto_username_pw_set(mosq_, config_.username.c_str(),
                                     config_.password.empty() ? nullptr : config_.password.c_str()),
           "username");
+  if (config_.tls) {
+    const MqttTls& t = *config_.tls;
+    const auto opt = [](const std::string& s) { return s.empty() ? nullptr : s.c_str(); };
+    // Without a ca_file, the system's CA directory (libmosquitto 2.0.11 needs one of both).
+    check(mosquitto_tls_set(mosq_, opt(t.ca_file), t.ca_file.empty() ? kSystemCaDir : nullptr,
+                            opt(t.cert_file), opt(t.key_file), nullptr),
+          "tls (ca_file, cert_file, key_file)");
+    check(mosquitto_tls_insecure_set(mosq_, t.insecure), "tls (insecure)");
+  }
   mosquitto_connect_callback_set(mosq_, &MqttPublisher::OnConnect);
   mosquitto_disconnect_callback_set(mosq_, &MqttPublisher::OnDisconnect);
   mosquitto_publish_callback_set(mosq_, &MqttPublisher::OnPublish);
@@ -233,6 +243,16 @@ void MqttPublisher::Run() {
       connected_ = false;
       outage_logged_ = true;
       in_flight_.reset();
+    }
+  }
+  // An acknowledged record whose cursor write the stop overtook: written now, so that the next
+  // start does not send it again.
+  if (in_flight_ && in_flight_->acked) {
+    try {
+      store->AdvanceOutboxCursor(kConsumer, in_flight_->outbox_id);
+      ++published_;
+    } catch (const std::exception& e) {
+      spdlog::error("mqtt: outbox: {}", e.what());
     }
   }
   if (connected_) {

@@ -12,6 +12,10 @@
 //                                  last will, and the message of a clean stop, is the plain
 //                                  text "offline".
 //
+// Transport: plain TCP for mqtt://, TLS for mqtts:// (MqttTls: the broker's certificate is
+// checked against ca_file or the system's CAs, and its host name unless insecure; a client
+// certificate when the broker asks for one).
+//
 // Delivery: one thread reads the outbox (db/store.h) after the cursor "mqtt", publishes one
 // record at a time and advances the cursor only when the broker has acknowledged it
 // (PUBACK), so a broker outage of any length, or a station restart, loses nothing and
@@ -35,9 +39,22 @@ struct mosquitto;
 
 namespace eol::station {
 
+// TLS towards the broker (libmosquitto's mosquitto_tls_set over OpenSSL), on with an
+// "mqtts://" URL. Paths are absolute once the config is parsed (relative ones are relative to
+// the config file), and each named file was readable then.
+struct MqttTls {
+  std::string ca_file;    // PEM CA certificate(s) the broker's certificate must chain to;
+                          // empty: the system's CA directory /etc/ssl/certs
+  std::string cert_file;  // client certificate (PEM), with key_file, when the broker asks
+  std::string key_file;   // its private key (PEM, unencrypted)
+  bool insecure = false;  // true: do not check the broker's host name against its
+                          // certificate (the chain is still checked). Test rigs only.
+};
+
 struct MqttConfig {
-  std::string host;  // from "url": "mqtt://host:port"
-  int port = 1883;
+  std::string host;  // from "url": "mqtt://host:port" or "mqtts://host:port"
+  int port = 1883;   // 8883 by default for mqtts://
+  std::optional<MqttTls> tls;  // on for mqtts://
   std::string topic_prefix = "plant/eol";
   std::string client_id;  // empty: "eol-<station_id>"
   std::string username;   // empty: no authentication
@@ -46,8 +63,10 @@ struct MqttConfig {
   double reconnect_s = 1.0;  // pause between attempts while the broker is away
 };
 
-// "mqtt://host:port" (port optional, 1883) into host and port; false with the reason.
-bool ParseMqttUrl(const std::string& url, std::string* host, int* port, std::string* why);
+// "mqtt://host:port" (port optional, 1883) or "mqtts://host:port" (8883) into host and port
+// and whether TLS is asked for; false with the reason.
+bool ParseMqttUrl(const std::string& url, std::string* host, int* port, bool* tls,
+                  std::string* why);
 
 class MqttPublisher {
  public:

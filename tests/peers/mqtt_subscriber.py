@@ -8,6 +8,7 @@ when the broker goes and comes back. Prints one JSON line per event, flushed:
   {"event": "connected"}
   {"event": "message", "topic": ..., "retain": bool, "payload": text, "t": unix seconds}
 Runs until it is stopped (SIGTERM). Usage: mqtt_subscriber.py --port P --topic 'plant/#'
+[--cafile CA.crt] (TLS, the broker's certificate checked against CA.crt)
 """
 
 import argparse
@@ -29,9 +30,12 @@ def main():
     p.add_argument("--port", type=int, required=True)
     p.add_argument("--topic", required=True)
     p.add_argument("--client-id", default="eol-test-mes")
+    p.add_argument("--cafile", default="")
     args = p.parse_args()
 
     client = mqtt.Client(client_id=args.client_id, clean_session=False)
+    if args.cafile:
+        client.tls_set(ca_certs=args.cafile)
 
     def on_connect(c, userdata, flags, rc):
         if rc == 0:

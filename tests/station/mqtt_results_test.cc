@@ -14,6 +14,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -62,7 +63,12 @@ int FreePort() {
 // the user it runs as, and Stop() checks that the save worked.
 class Broker {
  public:
-  Broker(std::string dir, int port) : dir_(std::move(dir) + "/broker"), port_(port) {
+  // `listener_extra`: lines after the listener (its TLS files; "BROKER" stands for dir()),
+  // given a prepare step that writes files into dir() first (they are given to the broker's
+  // user too).
+  Broker(std::string dir, int port, std::string listener_extra = "",
+         const std::function<void(const std::string&)>& prepare = {})
+      : dir_(std::move(dir) + "/broker"), port_(port) {
     std::filesystem::create_directory(dir_);
     if (geteuid() == 0) {
       if (const passwd* pw = getpwnam("mosquitto")) {
@@ -70,8 +76,16 @@ class Broker {
         if (chown(dir_.c_str(), pw->pw_uid, pw->pw_gid) != 0) ADD_FAILURE() << "chown " << dir_;
       }
     }
+    if (prepare) prepare(dir_);
+    for (std::size_t at; (at = listener_extra.find("BROKER")) != std::string::npos;)
+      listener_extra.replace(at, 6, dir_);
+    if (geteuid() == 0)
+      if (const passwd* pw = getpwnam("mosquitto"))
+        for (const auto& f : std::filesystem::directory_iterator(dir_))
+          if (chown(f.path().c_str(), pw->pw_uid, pw->pw_gid) != 0) ADD_FAILURE() << f.path();
     std::ofstream(dir_ + "/mosquitto.conf")
-        << "listener " << port_ << " 127.0.0.1\nallow_anonymous true\npersistence true\n"
+        << "listener " << port_ << " 127.0.0.1\n" << listener_extra
+        << "allow_anonymous true\npersistence true\n"
         << "persistence_location " << dir_
         << "/\n"
         // The MES's session queues the whole replay while it reconnects (mosquitto drops
@@ -101,6 +115,7 @@ class Broker {
     process_.reset();
   }
   int port() const { return port_; }
+  const std::string& dir() const { return dir_; }
   std::string output() {
     if (!process_) return "";
     process_->WaitFor([](const std::string&) { return false; }, 50ms);
@@ -324,6 +339,135 @@ TEST_F(MqttResultsTest, ADaemonKilledLeavesItsLastWillOfflineRetained) {
       [](const std::string& o) { return o.find("\"payload\": \"offline\"") != std::string::npos; },
       20s))
       << late.output();
+}
+
+// A test CA and a server certificate for 127.0.0.1 and localhost, made by openssl now.
+void MakeCertificates(const std::string& dir, const std::string& ca_name) {
+  const auto run = [](std::vector<std::string> argv) {
+    ChildProcess p(argv);
+    const auto rc = p.Wait(60s);
+    ASSERT_TRUE(rc && *rc == 0) << argv[1] << ": " << p.output();
+  };
+  const std::string openssl = "/usr/bin/openssl";
+  std::ofstream(dir + "/san.cnf") << "subjectAltName=IP:127.0.0.1,DNS:localhost\n";
+  run({openssl, "req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1",
+       "-nodes", "-keyout", dir + "/" + ca_name + ".key", "-out", dir + "/" + ca_name + ".crt",
+       "-days", "2", "-subj", "/CN=eol test " + ca_name});
+  run({openssl, "req", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes",
+       "-keyout", dir + "/server.key", "-out", dir + "/server.csr", "-subj", "/CN=localhost"});
+  run({openssl, "x509", "-req", "-in", dir + "/server.csr", "-CA", dir + "/" + ca_name + ".crt",
+       "-CAkey", dir + "/" + ca_name + ".key", "-CAcreateserial", "-out", dir + "/server.crt",
+       "-days", "2", "-extfile", dir + "/san.cnf"});
+}
+
+class MqttTlsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_EQ(access("/usr/bin/openssl", X_OK), 0) << "openssl is a declared test dependency";
+    ASSERT_TRUE(broker_.Start());
+  }
+  MqttConfig Config(const std::string& ca_file) {
+    MqttConfig c;
+    c.host = "127.0.0.1";
+    c.port = port_;
+    c.reconnect_s = 0.2;
+    c.tls = MqttTls{ca_file, "", "", false};
+    return c;
+  }
+  eol::testing::TempDir dir_;
+  const int port_ = FreePort();
+  Broker broker_{dir_.path(), port_,
+                 "cafile BROKER/ca.crt\ncertfile BROKER/server.crt\nkeyfile BROKER/server.key\n",
+                 [](const std::string& d) { MakeCertificates(d, "ca"); }};
+};
+
+TEST_F(MqttTlsTest, ResultsGoOverTlsCheckedAgainstTheConfiguredCa) {
+  const std::string ca = broker_.dir() + "/ca.crt";
+  ChildProcess mes({kPython, std::string(EOL_SOURCE_DIR) + "/tests/peers/mqtt_subscriber.py",
+                    "--port", std::to_string(port_), "--topic", "plant/eol/#", "--cafile", ca});
+  ASSERT_TRUE(mes.WaitFor(
+      [](const std::string& o) { return o.find("\"subscribed\"") != std::string::npos; }, 20s))
+      << mes.output() << "\nbroker: " << broker_.output();
+  const std::string db_path = dir_ / "tls.sqlite";
+  {
+    auto store = db::Store::Open(db_path);
+    db::TestRecord r;
+    r.serial = "TLS-1";
+    r.station_id = "tls-1";
+    r.recipe_id = "r";
+    r.recipe_hash = std::string(64, 'b');
+    r.started_at = r.finished_at = "2026-01-01T00:00:00.000Z";
+    r.outcome = analysis::Outcome::kPass;
+    store->Insert(r);
+  }
+  MqttPublisher publisher(Config(ca), "tls-1", db_path, [] { return std::string("idle"); });
+  publisher.Start();
+  EXPECT_TRUE(mes.WaitFor(
+      [](const std::string& o) { return o.find("TLS-1") != std::string::npos; }, 30s))
+      << mes.output() << "\nbroker: " << broker_.output();
+  EXPECT_TRUE(publisher.connected());
+  auto reader = db::Store::Open(db_path, db::Store::Role::kReader);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (reader->OutboxPending("mqtt") > 0 && std::chrono::steady_clock::now() - t0 < 10s)
+    std::this_thread::sleep_for(10ms);
+  EXPECT_EQ(reader->OutboxPending("mqtt"), 0) << "acknowledged over TLS";
+  publisher.Stop();
+
+  // A broker whose certificate does not chain to the configured CA: never connected, the
+  // record stays in the outbox.
+  const std::string other = dir_ / "other";
+  std::filesystem::create_directory(other);
+  MakeCertificates(other, "other-ca");
+  {
+    auto store = db::Store::Open(db_path);
+    db::TestRecord r = store->Tests(db::TestQuery{}).front();
+    r.serial = "TLS-2";
+    store->Insert(r);
+  }
+  MqttPublisher wrong(Config(other + "/other-ca.crt"), "tls-1", db_path,
+                      [] { return std::string("idle"); });
+  wrong.Start();
+  std::this_thread::sleep_for(2s);
+  EXPECT_FALSE(wrong.connected());
+  wrong.Stop();
+  EXPECT_EQ(reader->OutboxPending("mqtt"), 1) << "TLS-2 waits for a broker it can trust";
+  EXPECT_EQ(mes.output().find("TLS-2"), std::string::npos);
+}
+
+TEST(MqttTlsConfigTest, TheConfigNamesTheFieldOfAMissingFileOrAMismatch) {
+  eol::testing::TempDir dir;
+  std::ofstream(dir / "ca.crt") << "-----BEGIN CERTIFICATE-----\n";
+  const auto parse = [&](const nlohmann::json& mqtt) {
+    nlohmann::json j = StationJson(dir / "x.sqlite", 1883);
+    j["mqtt"] = mqtt;
+    try {
+      ParseStationConfig(j, "test", dir.path());
+      return std::string();
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+  };
+  EXPECT_EQ(parse({{"url", "mqtts://broker:8883"}, {"tls", {{"ca_file", "ca.crt"}}}}), "");
+  const std::string missing =
+      parse({{"url", "mqtts://broker"}, {"tls", {{"ca_file", "/nonexistent/ca.crt"}}}});
+  EXPECT_NE(missing.find("/mqtt/tls/ca_file"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("/nonexistent/ca.crt"), std::string::npos) << missing;
+  const std::string key = parse({{"url", "mqtts://broker"},
+                                 {"tls", {{"ca_file", "ca.crt"}, {"cert_file", "ca.crt"}}}});
+  EXPECT_NE(key.find("/mqtt/tls/key_file"), std::string::npos) << key;
+  const std::string plain = parse({{"url", "mqtt://broker"}, {"tls", {{"ca_file", "ca.crt"}}}});
+  EXPECT_NE(plain.find("/mqtt/tls"), std::string::npos) << plain;
+  EXPECT_NE(plain.find("mqtts://"), std::string::npos) << plain;
+  const std::string unknown =
+      parse({{"url", "mqtts://broker"}, {"tls", {{"ca_file", "ca.crt"}, {"verify", false}}}});
+  EXPECT_NE(unknown.find("/mqtt/tls/verify"), std::string::npos) << unknown;
+  // mqtts:// alone: the system's CAs, port 8883.
+  nlohmann::json j = StationJson(dir / "x.sqlite", 1883);
+  j["mqtt"] = {{"url", "mqtts://broker"}};
+  const StationConfig c = ParseStationConfig(j, "test", dir.path());
+  ASSERT_TRUE(c.mqtt && c.mqtt->tls);
+  EXPECT_EQ(c.mqtt->port, 8883);
+  EXPECT_EQ(c.mqtt->tls->ca_file, "");
 }
 
 }  // namespace
