@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "drivers/io/json_config.h"
+#include "station/central/pg.h"
 #include "station/serial_number.h"
 
 namespace eol::station {
@@ -157,8 +158,7 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       MqttConfig q;
       std::string why;
       bool tls = false;
-      m->Require(ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &tls, &why), "url",
-                 why);
+      m->Require(ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &tls, &why), "url", why);
       q.topic_prefix = m->String("topic_prefix", q.topic_prefix);
       m->Require(!q.topic_prefix.empty() &&
                      q.topic_prefix.find_first_of("#+") == std::string::npos &&
@@ -198,6 +198,28 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       }
       m->RejectUnknown();
       c.mqtt = q;
+    }
+    if (auto p = root.OptionalObject("central")) {
+      central::CentralConfig q;
+      q.postgres = p->RequiredString("postgres");
+      // Not Require: its "(got ...)" would print the password.
+      if (q.postgres.rfind("postgresql://", 0) != 0 && q.postgres.rfind("postgres://", 0) != 0)
+        throw io::ConfigError(p->PathOf("postgres") +
+                              ": must be a URI postgresql://user@host:port/db (got '" +
+                              central::RedactUrl(q.postgres) + "')");
+      q.batch = p->Integer("batch", q.batch);
+      q.retry_min_s = p->Number("retry_min_s", q.retry_min_s);
+      q.retry_max_s = p->Number("retry_max_s", q.retry_max_s);
+      q.connect_timeout_s = p->Integer("connect_timeout_s", q.connect_timeout_s);
+      p->Require(q.batch >= 1 && q.batch <= 10000, "batch", "must be in [1, 10000]");
+      p->Require(q.retry_min_s >= 0.01 && q.retry_min_s <= 3600, "retry_min_s",
+                 "must be in [0.01, 3600] s");
+      p->Require(q.retry_max_s >= q.retry_min_s && q.retry_max_s <= 3600, "retry_max_s",
+                 "must be in [retry_min_s, 3600] s");
+      p->Require(q.connect_timeout_s >= 1 && q.connect_timeout_s <= 600, "connect_timeout_s",
+                 "must be in [1, 600] s");
+      p->RejectUnknown();
+      c.central = q;
     }
     root.RejectUnknown();
     return c;

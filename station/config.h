@@ -30,6 +30,10 @@
 //                                                (station/mqtt_publisher.h); "tls" only with
 //                                                mqtts:// (without it: the system's CAs);
 //                                                each named file must be readable
+//   "central": {"postgres": "postgresql://eol@db.plant:5432/plant", "batch": 200,
+//               "retry_min_s": 0.5, "retry_max_s": 30, "connect_timeout_s": 5}
+//                                                optional: every stored record into the
+//                                                plant's PostgreSQL (station/central/)
 // }
 #pragma once
 
@@ -39,6 +43,7 @@
 #include <string_view>
 #include <vector>
 
+#include "station/central/central_replicator.h"
 #include "station/mqtt_publisher.h"
 #include "station/plc/plc_server.h"
 
@@ -91,6 +96,8 @@ struct StationConfig {
   std::optional<plc::PlcServerSettings> plc;
   // Plant integration: results to the MES over MQTT; nullopt without an "mqtt" block.
   std::optional<MqttConfig> mqtt;
+  // Plant integration: the central PostgreSQL record; nullopt without a "central" block.
+  std::optional<central::CentralConfig> central;
 };
 
 // Non-empty when the station runs on simulators or recorded data rather than a real fixture

@@ -52,8 +52,8 @@ struct MqttTls {
 };
 
 struct MqttConfig {
-  std::string host;  // from "url": "mqtt://host:port" or "mqtts://host:port"
-  int port = 1883;   // 8883 by default for mqtts://
+  std::string host;            // from "url": "mqtt://host:port" or "mqtts://host:port"
+  int port = 1883;             // 8883 by default for mqtts://
   std::optional<MqttTls> tls;  // on for mqtts://
   std::string topic_prefix = "plant/eol";
   std::string client_id;  // empty: "eol-<station_id>"

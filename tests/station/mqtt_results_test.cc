@@ -5,10 +5,10 @@
 // daemon killed with SIGKILL leaves its last will "offline".
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <pwd.h>
-#include <sys/stat.h>
 #include <netinet/in.h>
+#include <pwd.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -84,8 +84,8 @@ class Broker {
         for (const auto& f : std::filesystem::directory_iterator(dir_))
           if (chown(f.path().c_str(), pw->pw_uid, pw->pw_gid) != 0) ADD_FAILURE() << f.path();
     std::ofstream(dir_ + "/mosquitto.conf")
-        << "listener " << port_ << " 127.0.0.1\n" << listener_extra
-        << "allow_anonymous true\npersistence true\n"
+        << "listener " << port_ << " 127.0.0.1\n"
+        << listener_extra << "allow_anonymous true\npersistence true\n"
         << "persistence_location " << dir_
         << "/\n"
         // The MES's session queues the whole replay while it reconnects (mosquitto drops
@@ -402,8 +402,8 @@ TEST_F(MqttTlsTest, ResultsGoOverTlsCheckedAgainstTheConfiguredCa) {
   }
   MqttPublisher publisher(Config(ca), "tls-1", db_path, [] { return std::string("idle"); });
   publisher.Start();
-  EXPECT_TRUE(mes.WaitFor(
-      [](const std::string& o) { return o.find("TLS-1") != std::string::npos; }, 30s))
+  EXPECT_TRUE(
+      mes.WaitFor([](const std::string& o) { return o.find("TLS-1") != std::string::npos; }, 30s))
       << mes.output() << "\nbroker: " << broker_.output();
   EXPECT_TRUE(publisher.connected());
   auto reader = db::Store::Open(db_path, db::Store::Role::kReader);
@@ -452,8 +452,8 @@ TEST(MqttTlsConfigTest, TheConfigNamesTheFieldOfAMissingFileOrAMismatch) {
       parse({{"url", "mqtts://broker"}, {"tls", {{"ca_file", "/nonexistent/ca.crt"}}}});
   EXPECT_NE(missing.find("/mqtt/tls/ca_file"), std::string::npos) << missing;
   EXPECT_NE(missing.find("/nonexistent/ca.crt"), std::string::npos) << missing;
-  const std::string key = parse({{"url", "mqtts://broker"},
-                                 {"tls", {{"ca_file", "ca.crt"}, {"cert_file", "ca.crt"}}}});
+  const std::string key =
+      parse({{"url", "mqtts://broker"}, {"tls", {{"ca_file", "ca.crt"}, {"cert_file", "ca.crt"}}}});
   EXPECT_NE(key.find("/mqtt/tls/key_file"), std::string::npos) << key;
   const std::string plain = parse({{"url", "mqtt://broker"}, {"tls", {{"ca_file", "ca.crt"}}}});
   EXPECT_NE(plain.find("/mqtt/tls"), std::string::npos) << plain;
