@@ -26,5 +26,6 @@ void AddProductionBenchCommand(CLI::App& app);
 void AddHttpBenchCommand(CLI::App& app);
 void AddCycleBenchCommand(CLI::App& app);
 void AddPodCommand(CLI::App& app);
+void AddPlantBenchCommand(CLI::App& app);
 
 }  // namespace eol::station::cli
