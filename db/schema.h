@@ -128,4 +128,24 @@ ALTER TABLE tests ADD COLUMN order_number TEXT NOT NULL DEFAULT '';
 CREATE INDEX tests_order_started ON tests(order_number, started_at);
 )sql";
 
+// Version 4 -> 5: the outbox of finished records for the publishers (MQTT, ...).
+//
+// outbox: one row per finished record, written in the record's own transaction (and for a
+//   test recovered as ABORTED, in the recovery's), so a record is never stored without its
+//   row. AUTOINCREMENT: ids only grow, even if old rows are pruned, so a cursor stays valid.
+//   Records stored before version 5 have no row and are not published.
+// outbox_cursors: per consumer ('mqtt'), the id of the newest row it has delivered (acknowledged
+//   by the broker); the consumer reads the rows after it, in id order.
+inline constexpr const char kSchemaV5[] = R"sql(
+CREATE TABLE outbox (
+  id         INTEGER PRIMARY KEY AUTOINCREMENT,
+  test_id    INTEGER NOT NULL REFERENCES tests(id) ON DELETE CASCADE,
+  created_at TEXT    NOT NULL
+);
+CREATE TABLE outbox_cursors (
+  consumer TEXT    PRIMARY KEY,
+  last_id  INTEGER NOT NULL
+);
+)sql";
+
 }  // namespace eol::db::schema

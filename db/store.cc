@@ -183,8 +183,12 @@ void MigrateTo4(sqlite3* db, const std::string& path) {
   Exec(db, path, schema::kSchemaV4, "migrate the schema to version 4");
 }
 
-constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {&MigrateTo1, &MigrateTo2,
-                                                                      &MigrateTo3, &MigrateTo4};
+void MigrateTo5(sqlite3* db, const std::string& path) {
+  Exec(db, path, schema::kSchemaV5, "migrate the schema to version 5");
+}
+
+constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {
+    &MigrateTo1, &MigrateTo2, &MigrateTo3, &MigrateTo4, &MigrateTo5};
 
 std::int64_t PragmaInt(sqlite3* db, const std::string& path, const char* sql,
                        const std::string& op) {
@@ -253,16 +257,29 @@ void Migrate(sqlite3* db, const std::string& path) {
 }
 
 int AbortUnfinished(sqlite3* db, const std::string& path) {
+  // The recovered records go to the outbox with them, in one transaction.
+  Transaction tx(db, path, "open (mark unfinished tests ABORTED)");
+  const std::string now = UtcNowIso8601();
+  {
+    Statement o(db, path,
+                "INSERT INTO outbox (test_id, created_at) "
+                "SELECT id, ?1 FROM tests WHERE outcome = 'RUNNING' ORDER BY id",
+                "open (queue the aborted tests in the outbox)");
+    o.BindText(1, now);
+    o.Run();
+  }
   Statement s(db, path,
               "UPDATE tests SET outcome = 'ABORTED', finished_at = ?1, reasons = ?2 "
               "WHERE outcome = 'RUNNING'",
               "open (mark unfinished tests ABORTED)");
-  s.BindText(1, UtcNowIso8601());
+  s.BindText(1, now);
   s.BindText(2, nlohmann::json::array(
                     {analysis::Reason{analysis::ReasonCode::kAborted, kInterruptedReason}})
                     .dump());
   s.Run();
-  return sqlite3_changes(db);
+  const int changed = sqlite3_changes(db);
+  tx.Commit();
+  return changed;
 }
 
 // ---- Writing -----------------------------------------------------------------------------
@@ -379,6 +396,14 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
     sc.BindInt(6, c["passed"].get<bool>() ? 1 : 0);
     sc.BindText(7, c.value("detail", ""));
     sc.Run();
+  }
+
+  {
+    Statement o(db, path, "INSERT INTO outbox (test_id, created_at) VALUES (?1, ?2)",
+                op + " (queue in the outbox)");
+    o.BindInt(1, record.id);
+    o.BindText(2, record.finished_at);
+    o.Run();
   }
 
   const std::string curves_op = op + " (write curves)";
@@ -809,6 +834,47 @@ std::vector<RecipeAudit> Store::AuditLog(int limit) {
     out.push_back(a);
   }
   return out;
+}
+
+// ---- Outbox ------------------------------------------------------------------------------
+
+std::vector<OutboxEntry> Store::OutboxAfterCursor(const std::string& consumer, int limit) {
+  Statement s(db_, path_,
+              "SELECT id, test_id, created_at FROM outbox WHERE id > "
+              "coalesce((SELECT last_id FROM outbox_cursors WHERE consumer = ?1), 0) "
+              "ORDER BY id LIMIT ?2",
+              "read the outbox of '" + consumer + "'");
+  s.BindText(1, consumer);
+  s.BindInt(2, std::clamp(limit, 1, kMaxQueryLimit));
+  std::vector<OutboxEntry> out;
+  while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Text(2)});
+  return out;
+}
+
+void Store::AdvanceOutboxCursor(const std::string& consumer, std::int64_t id) {
+  Statement s(db_, path_,
+              "INSERT INTO outbox_cursors (consumer, last_id) VALUES (?1, ?2) "
+              "ON CONFLICT (consumer) DO UPDATE SET last_id = max(last_id, excluded.last_id)",
+              "advance the outbox cursor of '" + consumer + "' to " + std::to_string(id));
+  s.BindText(1, consumer);
+  s.BindInt(2, id);
+  s.Run();
+}
+
+std::int64_t Store::OutboxCursor(const std::string& consumer) {
+  Statement s(db_, path_, "SELECT last_id FROM outbox_cursors WHERE consumer = ?1",
+              "read the outbox cursor of '" + consumer + "'");
+  s.BindText(1, consumer);
+  return s.Step() ? s.Int(0) : 0;
+}
+
+std::int64_t Store::OutboxPending(const std::string& consumer) {
+  Statement s(db_, path_,
+              "SELECT count(*) FROM outbox WHERE id > "
+              "coalesce((SELECT last_id FROM outbox_cursors WHERE consumer = ?1), 0)",
+              "count the outbox of '" + consumer + "'");
+  s.BindText(1, consumer);
+  return s.Step() ? s.Int(0) : 0;
 }
 
 }  // namespace eol::db

@@ -9,6 +9,9 @@
 // - FinishTest() writes the whole record in one transaction and returns only once it is
 //   committed durably: the verdict may be published after it returns, never before.
 // - Retests: a test of a serial that already has tests links to the first one (retest_of).
+// - Outbox (schema v5): every finished record, and every test recovered as ABORTED, gets an
+//   outbox row in the same transaction; publishers read the rows after their own cursor, in
+//   order, and advance it only once delivered: an outage of any length loses nothing.
 // - All SQL is parameterised. Errors throw StoreError naming the file and the operation.
 // Not thread-safe: one Store per thread (SQLite connections are cheap).
 #pragma once
@@ -90,9 +93,16 @@ struct MeasurementRow {
   std::optional<double> hi;
 };
 
+// One row of the outbox: the record of test `test_id`, to be delivered in `id` order.
+struct OutboxEntry {
+  std::int64_t id = 0;
+  std::int64_t test_id = 0;
+  std::string created_at;  // ISO 8601 UTC, when the record was stored
+};
+
 class Store {
  public:
-  static constexpr int kSchemaVersion = 4;
+  static constexpr int kSchemaVersion = 5;
 
   // kWriter: the station's one connection; recovers unfinished tests as ABORTED. It holds an
   // exclusive flock on "<path>.lock" (created 0600 beside the file) for as long as it is open:
@@ -143,6 +153,15 @@ class Store {
   // Every measurement row of finished PASS/FAIL/ERROR tests matching the query, in test order
   // (started_at, id), at most 1,000,000 rows.
   std::vector<MeasurementRow> MeasurementRows(const MeasurementQuery& query);
+
+  // The outbox rows after `consumer`'s cursor, oldest first, at most `limit` (1..10000).
+  std::vector<OutboxEntry> OutboxAfterCursor(const std::string& consumer, int limit);
+  // Moves `consumer`'s cursor to `id` (the row just delivered); a cursor never moves back.
+  void AdvanceOutboxCursor(const std::string& consumer, std::int64_t id);
+  // The id of the newest row `consumer` has delivered (0: none).
+  std::int64_t OutboxCursor(const std::string& consumer);
+  // Rows after `consumer`'s cursor.
+  std::int64_t OutboxPending(const std::string& consumer);
 
   // SQLite's own consistency check: "ok" or the first problem it finds.
   std::string IntegrityCheck();

@@ -3,8 +3,10 @@
 #include <arpa/inet.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "drivers/io/json_config.h"
+#include "station/central/pg.h"
 #include "station/serial_number.h"
 
 namespace eol::station {
@@ -151,6 +153,73 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       if (p->Has("map")) s.map = plc::ParsePlcMap(p->Raw("map"), p->PathOf("map"));
       p->RejectUnknown();
       c.plc = s;
+    }
+    if (auto m = root.OptionalObject("mqtt")) {
+      MqttConfig q;
+      std::string why;
+      bool tls = false;
+      m->Require(ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &tls, &why), "url", why);
+      q.topic_prefix = m->String("topic_prefix", q.topic_prefix);
+      m->Require(!q.topic_prefix.empty() &&
+                     q.topic_prefix.find_first_of("#+") == std::string::npos &&
+                     q.topic_prefix.back() != '/',
+                 "topic_prefix", "must be a topic without wildcards or a trailing '/'");
+      q.client_id = m->String("client_id", q.client_id);
+      q.username = m->String("username", q.username);
+      q.password = m->String("password", q.password);
+      q.keepalive_s = m->Integer("keepalive_s", q.keepalive_s);
+      q.reconnect_s = m->Number("reconnect_s", q.reconnect_s);
+      m->Require(q.keepalive_s >= 5 && q.keepalive_s <= 3600, "keepalive_s",
+                 "must be in [5, 3600] s");
+      m->Require(q.reconnect_s >= 0.05 && q.reconnect_s <= 600, "reconnect_s",
+                 "must be in [0.05, 600] s");
+      if (auto t = m->OptionalObject("tls")) {
+        m->Require(tls, "tls", "needs an mqtts:// url (this one is plain mqtt://)");
+        MqttTls s;
+        // Each named file must be readable now: a typo is a config error, not an outage.
+        const auto file = [&](const std::string& key) {
+          const std::string path = Resolve(base_dir, t->String(key, ""));
+          if (path.empty()) return path;
+          std::ifstream probe(path);
+          t->Require(probe.good(), key, "cannot read the file " + path);
+          return path;
+        };
+        s.ca_file = file("ca_file");
+        s.cert_file = file("cert_file");
+        s.key_file = file("key_file");
+        s.insecure = t->Bool("insecure", s.insecure);
+        t->Require(s.cert_file.empty() == s.key_file.empty(),
+                   s.cert_file.empty() ? "cert_file" : "key_file",
+                   "cert_file and key_file go together (a client certificate and its key)");
+        t->RejectUnknown();
+        q.tls = s;
+      } else if (tls) {
+        q.tls = MqttTls{};  // the system's CAs, host name checked
+      }
+      m->RejectUnknown();
+      c.mqtt = q;
+    }
+    if (auto p = root.OptionalObject("central")) {
+      central::CentralConfig q;
+      q.postgres = p->RequiredString("postgres");
+      // Not Require: its "(got ...)" would print the password.
+      if (q.postgres.rfind("postgresql://", 0) != 0 && q.postgres.rfind("postgres://", 0) != 0)
+        throw io::ConfigError(p->PathOf("postgres") +
+                              ": must be a URI postgresql://user@host:port/db (got '" +
+                              central::RedactUrl(q.postgres) + "')");
+      q.batch = p->Integer("batch", q.batch);
+      q.retry_min_s = p->Number("retry_min_s", q.retry_min_s);
+      q.retry_max_s = p->Number("retry_max_s", q.retry_max_s);
+      q.connect_timeout_s = p->Integer("connect_timeout_s", q.connect_timeout_s);
+      p->Require(q.batch >= 1 && q.batch <= 10000, "batch", "must be in [1, 10000]");
+      p->Require(q.retry_min_s >= 0.01 && q.retry_min_s <= 3600, "retry_min_s",
+                 "must be in [0.01, 3600] s");
+      p->Require(q.retry_max_s >= q.retry_min_s && q.retry_max_s <= 3600, "retry_max_s",
+                 "must be in [retry_min_s, 3600] s");
+      p->Require(q.connect_timeout_s >= 1 && q.connect_timeout_s <= 600, "connect_timeout_s",
+                 "must be in [1, 600] s");
+      p->RejectUnknown();
+      c.central = q;
     }
     root.RejectUnknown();
     return c;

@@ -22,6 +22,18 @@
 //   "plc": {"listen": "0.0.0.0", "port": 502, "unit_id": 1, "max_clients": 8,
 //           "map": {"serial": 100, ...}}         optional: the line PLC's handshake, served
 //                                                when the block is there (station/plc/)
+//   "mqtt": {"url": "mqtt://host:1883" | "mqtts://host:8883", "topic_prefix": "plant/eol",
+//            "client_id": "", "username": "", "password": "", "keepalive_s": 30,
+//            "reconnect_s": 1,
+//            "tls": {"ca_file": "ca.crt", "cert_file": "", "key_file": "", "insecure": false}}
+//                                                optional: results and status to the MES
+//                                                (station/mqtt_publisher.h); "tls" only with
+//                                                mqtts:// (without it: the system's CAs);
+//                                                each named file must be readable
+//   "central": {"postgres": "postgresql://eol@db.plant:5432/plant", "batch": 200,
+//               "retry_min_s": 0.5, "retry_max_s": 30, "connect_timeout_s": 5}
+//                                                optional: every stored record into the
+//                                                plant's PostgreSQL (station/central/)
 // }
 #pragma once
 
@@ -31,6 +43,8 @@
 #include <string_view>
 #include <vector>
 
+#include "station/central/central_replicator.h"
+#include "station/mqtt_publisher.h"
 #include "station/plc/plc_server.h"
 
 namespace eol::station {
@@ -80,6 +94,10 @@ struct StationConfig {
   nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}
   // Plant integration (issue 15): the line PLC's handshake; nullopt without a "plc" block.
   std::optional<plc::PlcServerSettings> plc;
+  // Plant integration: results to the MES over MQTT; nullopt without an "mqtt" block.
+  std::optional<MqttConfig> mqtt;
+  // Plant integration: the central PostgreSQL record; nullopt without a "central" block.
+  std::optional<central::CentralConfig> central;
 };
 
 // Non-empty when the station runs on simulators or recorded data rather than a real fixture

@@ -66,7 +66,10 @@ struct HttpOptions {
   std::string db_path;
   // Empty: starting tests needs no token. Recipe changes always need an engineer token.
   std::vector<ApiToken> tokens;
-  std::string web_root;       // folder of the operator page; empty: built-in fallback page
+  std::string web_root;  // folder of the operator page; empty: built-in fallback page
+  // The central record's URI (station/central/): GET /api/units/{serial}?scope=plant reads
+  // it; empty: that scope answers 400.
+  std::string central_postgres;
   http::ServerLimits limits;  // workers, streams, deadlines (station/http/server.h)
 };
 

@@ -99,6 +99,8 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
 
 Station::~Station() {
   if (plc_) plc_->Stop();
+  if (mqtt_) mqtt_->Stop();
+  if (central_) central_->Stop();
   if (http_) http_->Stop();
   if (drivers_.fixture) drivers_.fixture->Disconnect();
   if (drivers_.daq) drivers_.daq->Disconnect();
@@ -111,6 +113,7 @@ void Station::StartHttp(const std::string& web_root) {
   o.db_path = config_.db_path;
   o.tokens = config_.tokens;
   o.web_root = web_root;
+  if (config_.central) o.central_postgres = config_.central->postgres;
   HttpHandlers h;
   h.start_test = [this](const TestRequest& r, std::string* why) { return Enqueue(r, why); };
   h.recipe = [this] {
@@ -268,6 +271,11 @@ LiveMetrics Station::LiveValues() {
   m.recipe_id = r->id;
   m.recipe_hash = r->hash;
   m.software_version = SoftwareVersion();
+  if (central_) {
+    const central::CentralStatus c = central_->status();
+    m.central_connected = c.connected;
+    if (c.backlog >= 0) m.central_backlog = c.backlog;
+  }
   return m;
 }
 
@@ -424,5 +432,20 @@ void Station::StartPlc() {
 }
 
 int Station::plc_port() const { return plc_ ? plc_->port() : 0; }
+
+void Station::StartMqtt() {
+  if (!config_.mqtt || mqtt_) return;
+  mqtt_ = std::make_unique<MqttPublisher>(
+      *config_.mqtt, config_.station_id, config_.db_path,
+      [this] { return board_->Snapshot()["state"].get<std::string>(); });
+  mqtt_->Start();
+}
+
+void Station::StartCentral() {
+  if (!config_.central || central_) return;
+  central_ = std::make_unique<central::CentralReplicator>(*config_.central, config_.db_path,
+                                                          config_.station_id);
+  central_->Start();
+}
 
 }  // namespace eol::station

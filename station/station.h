@@ -79,6 +79,12 @@ class Station {
   // address when it cannot listen.
   void StartPlc();
   int plc_port() const;
+  // Publishes every stored record and the station's status over MQTT
+  // (station/mqtt_publisher.h) when the config has an "mqtt" block.
+  void StartMqtt();
+  // Replicates every stored record into the plant's central PostgreSQL record
+  // (station/central/central_replicator.h) when the config has a "central" block.
+  void StartCentral();
 
  private:
   StationConfig config_;
@@ -93,6 +99,8 @@ class Station {
   std::unique_ptr<Sequencer> sequencer_;
   std::unique_ptr<HttpApi> http_;
   std::unique_ptr<plc::PlcServer> plc_;
+  std::unique_ptr<MqttPublisher> mqtt_;
+  std::unique_ptr<central::CentralReplicator> central_;
   StationMetrics metrics_;
 
   std::mutex queue_mu_;

@@ -77,6 +77,15 @@ StationMetrics::StationMetrics()
                        "Free space of the file system holding the database.")),
       db_size_(Gauge(*registry_, "eol_db_size_bytes",
                      "Size of the database files (main, WAL, shared memory).")),
+      central_backlog_(prometheus::BuildGauge()
+                           .Name("eol_central_backlog_records")
+                           .Help("Stored records not yet in the central PostgreSQL record.")
+                           .Register(*registry_)),
+      central_connected_(prometheus::BuildGauge()
+                             .Name("eol_central_connected")
+                             .Help("1 when the last attempt to replicate to the central "
+                                   "record worked.")
+                             .Register(*registry_)),
       last_resonance_(prometheus::BuildGauge()
                           .Name("eol_last_resonance_hz")
                           .Help("Resonance of the last tested unit.")
@@ -130,6 +139,10 @@ std::string StationMetrics::Render(const LiveMetrics& live) {
     if (!ec) disk_free_.Set(static_cast<double>(space.available));
     db_size_.Set(static_cast<double>(FileSize(db) + FileSize(live.db_path + "-wal") +
                                      FileSize(live.db_path + "-shm")));
+  }
+  if (live.central_backlog) {
+    central_backlog_.Add({}).Set(static_cast<double>(*live.central_backlog));
+    central_connected_.Add({}).Set(live.central_connected ? 1 : 0);
   }
   if (info_gauge_ != nullptr) info_.Remove(info_gauge_);
   info_gauge_ = &info_.Add({{"station_id", live.station_id},

@@ -13,6 +13,9 @@
 //   eol_testing, eol_ready, eol_lockout, eol_simulation      gauges 0/1
 //   eol_queue_length                       gauge    serials waiting
 //   eol_disk_free_bytes, eol_db_size_bytes gauges   of the database's file system and files
+//   eol_central_backlog_records            gauge    stored records not yet in the central
+//                                                    PostgreSQL record (absent without one)
+//   eol_central_connected                  gauge    0/1, the replicator's last attempt worked
 //   eol_last_resonance_hz                  gauge    resonance of the last unit (absent before)
 //   eol_info{station_id,recipe_id,recipe_hash,software_version}  gauge 1
 // Thread-safe: tests are counted from the sequencer's thread while the API scrapes.
@@ -41,9 +44,11 @@ struct LiveMetrics {
   bool locked_out = false;
   bool simulation = false;
   std::size_t queue_length = 0;
-  std::uint64_t fixture_errors = 0;  // cumulative (drivers::Fixture::failures)
-  std::uint64_t watchdog_trips = 0;  // cumulative (Sequencer::watchdog_trips)
-  std::string db_path;               // disk free and size from here ("" : not reported)
+  std::uint64_t fixture_errors = 0;             // cumulative (drivers::Fixture::failures)
+  std::uint64_t watchdog_trips = 0;             // cumulative (Sequencer::watchdog_trips)
+  std::string db_path;                          // disk free and size from here ("" : not reported)
+  std::optional<std::int64_t> central_backlog;  // with a central record (Station::StartCentral)
+  bool central_connected = false;
   std::string station_id, recipe_id, recipe_hash, software_version;
 };
 
@@ -76,6 +81,8 @@ class StationMetrics {
   prometheus::Gauge& queue_;
   prometheus::Gauge& disk_free_;
   prometheus::Gauge& db_size_;
+  prometheus::Family<prometheus::Gauge>& central_backlog_;
+  prometheus::Family<prometheus::Gauge>& central_connected_;
   prometheus::Family<prometheus::Gauge>& last_resonance_;
   prometheus::Family<prometheus::Gauge>& info_;
   prometheus::Gauge* info_gauge_ = nullptr;  // the label set shown now

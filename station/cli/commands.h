@@ -27,5 +27,6 @@ void AddHttpBenchCommand(CLI::App& app);
 void AddCycleBenchCommand(CLI::App& app);
 void AddPodCommand(CLI::App& app);
 void AddRecipeApproveCommand(CLI::App& app);
+void AddPlantBenchCommand(CLI::App& app);
 
 }  // namespace eol::station::cli

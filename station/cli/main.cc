@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   eol::station::cli::AddCycleBenchCommand(app);
   eol::station::cli::AddPodCommand(app);
   eol::station::cli::AddRecipeApproveCommand(app);
+  eol::station::cli::AddPlantBenchCommand(app);
   // Default files (recipe, operator page, SciPy peer) come from the working directory or the
   // installed program's prefix, never from the machine the program was built on.
   const std::string defaults =

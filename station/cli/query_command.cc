@@ -1,5 +1,7 @@
-// `eol query --db FILE --serial SN [--json] [--plot FILE [--test ID] [--recipe FILE]]`: the
-// traceable history of one serial number, with who tested it and for which order. --plot
+// `eol query --db FILE | --central URL --serial SN [--json] [--plot FILE [--test ID]
+// [--recipe FILE]]`: the traceable history of one serial number, with who tested it and for
+// which order; from one station's file, or plant-wide from the central PostgreSQL record
+// (station/central/), with the same record fields. --plot
 // draws the stored curve of its newest test (or --test ID) with the fitted model, the
 // resonance window it was judged against and, given the recipe file of the record's hash,
 // the masks (station/curve_chart.h).
@@ -10,6 +12,8 @@
 
 #include "db/store.h"
 #include "drivers/io/chart.h"
+#include "station/central/central_record.h"
+#include "station/central/pg.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/curve_chart.h"
@@ -21,6 +25,7 @@ namespace {
 
 struct QueryArgs {
   std::string db;
+  std::string central;
   std::string serial;
   bool json = false;
   bool curves = false;
@@ -87,9 +92,17 @@ void WritePlot(const QueryArgs& a, const std::vector<db::TestRecord>& tests) {
 int RunQuery(const QueryArgs& a) {
   std::string why;
   if (!ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
-  auto store = db::Store::Open(a.db, db::Store::Role::kReadOnly);
-  const std::vector<db::TestRecord> tests =
-      store->TestsOfSerial(a.serial, a.curves || !a.plot.empty());
+  if (a.db.empty() == a.central.empty())
+    throw std::runtime_error("give --db FILE (one station) or --central URL (the plant), one");
+  const bool curves = a.curves || !a.plot.empty();
+  std::vector<db::TestRecord> tests;
+  if (!a.central.empty()) {
+    auto pg = central::PgConnection::Connect(a.central, 10, "query");
+    tests = central::CentralTestsOfSerial(*pg, a.serial, curves);
+  } else {
+    tests = db::Store::Open(a.db, db::Store::Role::kReadOnly)->TestsOfSerial(a.serial, curves);
+  }
+  const std::string source = a.central.empty() ? a.db : central::RedactUrl(a.central);
   if (!a.plot.empty() && !tests.empty()) WritePlot(a, tests);
   if (a.json) {
     nlohmann::json list = nlohmann::json::array();
@@ -102,13 +115,14 @@ int RunQuery(const QueryArgs& a) {
     return tests.empty() ? 1 : 0;
   }
   if (tests.empty()) {
-    std::cout << a.serial << ": no tests in " << a.db << "\n";
+    std::cout << a.serial << ": no tests in " << source << "\n";
     return 1;
   }
   std::cout << a.serial << ": " << tests.size() << " test(s), latest "
             << analysis::ToString(tests.front().outcome) << "\n";
   for (const auto& t : tests) {
-    std::printf("  #%-6lld %s  %-7s recipe %s v%d (%s)%s\n", static_cast<long long>(t.id),
+    std::printf("  %s#%-6lld %s  %-7s recipe %s v%d (%s)%s\n",
+                a.central.empty() ? "" : (t.station_id + " ").c_str(), static_cast<long long>(t.id),
                 t.started_at.c_str(), analysis::ToString(t.outcome), t.recipe_id.c_str(),
                 t.recipe_version, t.recipe_hash.substr(0, 12).c_str(),
                 t.retest_of ? (" retest of #" + std::to_string(*t.retest_of)).c_str() : "");
@@ -136,9 +150,10 @@ void AddQueryCommand(CLI::App& app) {
       "query",
       "Show every test of a serial number, newest first, with measurements, limits, outcome,\n"
       "reasons and recipe hash. Exit code 1 when the serial has no tests.");
-  cmd->add_option("--db", args->db, "SQLite file of the station")
-      ->required()
-      ->check(CLI::ExistingFile);
+  cmd->add_option("--db", args->db, "SQLite file of the station")->check(CLI::ExistingFile);
+  cmd->add_option("--central", args->central,
+                  "Plant-wide instead of --db: the central PostgreSQL record's URI\n"
+                  "(postgresql://user@host:port/db), every station's tests");
   cmd->add_option("--serial", args->serial, "Serial number")->required();
   cmd->add_flag("--json", args->json, "One JSON object: {serial, latest, tests}");
   cmd->add_flag("--curves", args->curves, "With --json: include the raw curves");

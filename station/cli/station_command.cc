@@ -44,7 +44,9 @@ int RunStation(const std::string& config_path, std::string web_root) {
   Station& station = *made;
   if (web_root.empty()) web_root = DefaultWebRoot();
   station.StartHttp(web_root);
-  station.StartPlc();  // when the config has a "plc" block
+  station.StartPlc();      // when the config has a "plc" block
+  station.StartMqtt();     // when the config has an "mqtt" block
+  station.StartCentral();  // when the config has a "central" block
   // "ready" only when the fixture and the DAQ answered; otherwise the daemon is up (the API
   // answers, each test retries the drivers) and says what is missing.
   const nlohmann::json board = station.board().Snapshot();

@@ -1,6 +1,8 @@
 // Tests: start one, read the stored ones by serial, by id, or by query.
 #include <charconv>
 
+#include "station/central/central_record.h"
+#include "station/central/pg.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
 #include "station/serial_number.h"
@@ -15,18 +17,34 @@ ApiError BadRequest(std::string code, std::string message) {
   return {ApiErrorKind::kBadRequest, std::move(code), std::move(message)};
 }
 
+// scope=station (the default): this station's store. scope=plant: every station's tests
+// from the central record (station/central/), each with its station_id; the same record
+// fields. 400 without a central record configured, 503 when it cannot be read now.
 void GetUnit(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   const std::string serial = req.matches[1];
   std::string why;
   if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
+  const std::string scope = req.has_param("scope") ? req.get_param_value("scope") : "station";
+  if (scope != "station" && scope != "plant")
+    return Send(res, BadRequest("bad_scope", "scope must be station or plant"));
   std::vector<db::TestRecord> tests;
-  {
+  if (scope == "plant") {
+    if (c.options.central_postgres.empty())
+      return Send(res, BadRequest("bad_scope",
+                                  "scope=plant needs a \"central\" block in the station config"));
+    try {
+      auto pg = central::PgConnection::Connect(c.options.central_postgres, 5, "api");
+      tests = central::CentralTestsOfSerial(*pg, serial, false);
+    } catch (const central::PgError& e) {
+      return Send(res, ApiError{ApiErrorKind::kUnavailable, "central_unavailable", e.what()});
+    }
+  } else {
     std::lock_guard<std::mutex> lock(c.db_mu);
     tests = c.db->TestsOfSerial(serial, false);
   }
   nlohmann::json list = nlohmann::json::array();
   for (const auto& t : tests) list.push_back(t);
-  Send(res, HttpReply{200, {{"serial", serial}, {"tests", list}}});
+  Send(res, HttpReply{200, {{"serial", serial}, {"scope", scope}, {"tests", list}}});
 }
 
 void GetTest(ApiContext& c, const httplib::Request& req, httplib::Response& res) {

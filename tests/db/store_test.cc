@@ -167,9 +167,9 @@ TEST_F(StoreTest, OpenCreatesTheSchemaWithWalAndVersion) {
   EXPECT_EQ(raw.Column("PRAGMA journal_mode"), std::vector<std::string>{"wal"});
   EXPECT_EQ(raw.Column("PRAGMA user_version"),
             std::vector<std::string>{std::to_string(Store::kSchemaVersion)});
-  EXPECT_EQ(
-      raw.Column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
-      (std::vector<std::string>{"curves", "measurements", "recipe_audit", "self_checks", "tests"}));
+  EXPECT_EQ(raw.Column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
+            (std::vector<std::string>{"curves", "measurements", "outbox", "outbox_cursors",
+                                      "recipe_audit", "self_checks", "sqlite_sequence", "tests"}));
   const auto indexes = raw.Column("SELECT name FROM sqlite_schema WHERE type = 'index'");
   for (const char* name : {"tests_serial_started", "tests_started", "measurements_name"})
     EXPECT_NE(std::find(indexes.begin(), indexes.end(), name), indexes.end()) << name;
