@@ -26,6 +26,7 @@ struct ApproveArgs {
   std::string by;
   std::string note;
   std::string db;
+  bool json = false;
 };
 
 int RunApprove(const ApproveArgs& a) {
@@ -62,6 +63,19 @@ int RunApprove(const ApproveArgs& a) {
     if (!f) throw std::runtime_error(tmp + ": writing failed");
   }
   std::filesystem::rename(tmp, out);
+  if (a.json) {
+    std::cout << nlohmann::json{{"id", checked.id},
+                                {"version", checked.version},
+                                {"hash", checked.hash},
+                                {"proposal_hash", proposal.hash},
+                                {"path", out},
+                                {"by", a.by},
+                                {"at", entry.at},
+                                {"db", a.db}}
+                     .dump()
+              << std::endl;
+    return 0;
+  }
   std::cout << "approved " << checked.id << " v" << checked.version << " by " << a.by << ": "
             << out << ", sha256 " << checked.hash << " (proposal " << proposal.hash
             << "); audited in " << a.db << "\n";
@@ -88,6 +102,7 @@ void AddRecipeApproveCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--note", args->note, "Why it is approved (evidence, ticket)");
   cmd->add_option("--out", args->out, "Write the approved recipe here (default: over --recipe)");
+  cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args] { RunGuarded("recipe-approve", [&] { return RunApprove(*args); }); });
 }
 
