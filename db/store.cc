@@ -673,6 +673,12 @@ std::vector<TestRecord> Store::Tests(const TestQuery& query) {
   if (serial_i) sql += " AND serial = ?" + std::to_string(serial_i);
   const int order_i = query.order_number ? ++n : 0;
   if (order_i) sql += " AND order_number = ?" + std::to_string(order_i);
+  const int after_i = query.after ? ++n : 0;
+  if (after_i) {
+    ++n;  // the id's parameter
+    sql += " AND (started_at < ?" + std::to_string(after_i) + " OR (started_at = ?" +
+           std::to_string(after_i) + " AND id < ?" + std::to_string(after_i + 1) + "))";
+  }
   const int limit_i = ++n;
   sql += " ORDER BY started_at DESC, id DESC LIMIT ?" + std::to_string(limit_i);
 
@@ -682,6 +688,10 @@ std::vector<TestRecord> Store::Tests(const TestQuery& query) {
   if (outcome_i) s.BindText(outcome_i, analysis::ToString(*query.outcome));
   if (serial_i) s.BindText(serial_i, *query.serial);
   if (order_i) s.BindText(order_i, *query.order_number);
+  if (after_i) {
+    s.BindText(after_i, query.after->first);
+    s.BindInt(after_i + 1, query.after->second);
+  }
   s.BindInt(limit_i, std::clamp(query.limit, 1, kMaxQueryLimit));
   return ReadTests(db_, path_, s, query.with_curves);
 }

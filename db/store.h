@@ -21,6 +21,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "db/test_record.h"
@@ -40,6 +41,9 @@ struct TestQuery {
   std::optional<analysis::Outcome> outcome;
   std::optional<std::string> serial;
   std::optional<std::string> order_number;  // schema v4
+  // Keyset paging in the result's order (started_at DESC, id DESC): only tests after this
+  // (started_at, id) in that order; give the last test of the previous page.
+  std::optional<std::pair<std::string, std::int64_t>> after;
   int limit = 100;
   bool with_curves = false;
 };

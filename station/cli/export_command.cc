@@ -31,6 +31,8 @@ struct ExportArgs {
   std::string format = "csv";
   std::string out;
   int limit = 10000;
+  bool all = false;  // every test, in pages of page_size (keyset paging), memory bounded
+  int page_size = 10000;
   bool schema = false;
   bool json = false;  // --json: --format json
 };
@@ -72,9 +74,8 @@ int RunExport(ExportArgs a) {
   if (!a.to.empty()) q.to = IsoOption("--to", a.to);
   if (!a.order.empty()) q.order_number = a.order;
   if (!a.outcome.empty()) q.outcome = analysis::ParseOutcome(a.outcome);
-  q.limit = a.limit;
+  q.limit = a.all ? a.page_size : a.limit;
   q.with_curves = a.format == "records";
-  const std::vector<db::TestRecord> tests = store->Tests(q);
   std::ofstream file;
   if (!a.out.empty()) {
     file.open(a.out, std::ios::binary);
@@ -82,36 +83,38 @@ int RunExport(ExportArgs a) {
   }
   std::ostream& out = a.out.empty() ? std::cout : file;
   std::map<std::string, int> undeclared;  // measurement name -> tests that carry it
+  std::int64_t done = 0;
   {
     Progress progress("export");
-    const auto total = static_cast<std::int64_t>(tests.size());
-    std::int64_t done = 0;
-    if (a.format == "records") {
-      nlohmann::json list = nlohmann::json::array();
+    if (a.format == "csv") out << db::ExportCsvHeader(columns);
+    if (a.format != "csv") out << "[";
+    // One page (all of it without --all); with --all the next page starts after the last
+    // test written, so a store of any size is written page_size tests at a time.
+    for (;;) {
+      const std::vector<db::TestRecord> tests = store->Tests(q);
+      const std::int64_t total = a.all ? -1 : static_cast<std::int64_t>(tests.size());
       for (const auto& t : tests) {
-        list.push_back(t);
+        if (a.format == "records") {
+          out << (done == 0 ? "\n" : ",\n") << nlohmann::json(t).dump(1);
+        } else {
+          for (const std::string& n : db::ExportUndeclared(columns, t)) ++undeclared[n];
+          if (a.format == "csv")
+            out << db::ExportCsvRow(columns, t);
+          else
+            out << (done == 0 ? "\n" : ",\n") << db::ExportJsonRow(columns, t).dump();
+        }
         progress.Update("tests", ++done, total);
       }
-      out << list.dump(1) << "\n";
-    } else {
-      if (a.format == "csv") out << db::ExportCsvHeader(columns);
-      if (a.format == "json") out << "[";
-      for (const auto& t : tests) {
-        for (const std::string& n : db::ExportUndeclared(columns, t)) ++undeclared[n];
-        if (a.format == "csv")
-          out << db::ExportCsvRow(columns, t);
-        else
-          out << (done == 0 ? "\n" : ",\n") << db::ExportJsonRow(columns, t).dump();
-        progress.Update("tests", ++done, total);
-      }
-      if (a.format == "json") out << "\n]\n";
+      if (!a.all || static_cast<int>(tests.size()) < q.limit) break;
+      q.after = std::pair{tests.back().started_at, tests.back().id};
     }
+    if (a.format != "csv") out << "\n]\n";
   }
   out.flush();
   if (!out) throw std::runtime_error("export: writing failed");
-  std::cerr << "eol export: " << tests.size() << " test(s)";
-  if (static_cast<int>(tests.size()) == a.limit)
-    std::cerr << " (the --limit; narrow the range or raise --limit for more)";
+  std::cerr << "eol export: " << done << " test(s)";
+  if (!a.all && done == a.limit)
+    std::cerr << " (the --limit; narrow the range, raise --limit or give --all for more)";
   std::cerr << "\n";
   for (const auto& [name, n] : undeclared)
     std::cerr << "eol export: measurement " << name << " of " << n
@@ -151,6 +154,12 @@ void AddExportCommand(CLI::App& app) {
   cmd->add_flag("--json", args->json, "The same as --format json");
   cmd->add_option("--out", args->out, "Output file (default: stdout)");
   cmd->add_option("--limit", args->limit, "At most this many tests")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000));
+  cmd->add_flag("--all", args->all,
+                "Every test that matches, read --page-size at a time (memory stays bounded)")
+      ->excludes("--limit");
+  cmd->add_option("--page-size", args->page_size, "With --all: tests read at a time")
       ->capture_default_str()
       ->check(CLI::Range(1, 10000));
   cmd->add_flag("--schema", args->schema,

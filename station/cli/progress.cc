@@ -31,7 +31,9 @@ std::string Progress::Duration(double s) {
 std::string Progress::Line(std::string_view command, std::string_view phase, std::int64_t done,
                            std::int64_t total, double elapsed_s) {
   std::string line = "eol " + std::string(command) + ": " + std::string(phase) + "  " +
-                     std::to_string(done) + "/" + std::to_string(total);
+                     std::to_string(done);
+  if (total < 0) return line + "  " + Duration(elapsed_s);  // the total is not known
+  line += "/" + std::to_string(total);
   if (total > 0) line += "  " + std::to_string(100 * done / total) + "%";
   line += "  " + Duration(elapsed_s);
   if (done >= total)
@@ -51,7 +53,8 @@ void Progress::Update(std::string_view phase, std::int64_t done, std::int64_t to
     if (drawn_) std::fputs("\n", stderr);  // the finished phase's line stays
     phase_ = std::string(phase);
     phase_start_ = now;
-  } else if (done > 1 && done < total && now - last_draw_ < std::chrono::milliseconds(100)) {
+  } else if (done > 1 && (total < 0 || done < total) &&
+             now - last_draw_ < std::chrono::milliseconds(100)) {
     return;
   }
   last_draw_ = now;

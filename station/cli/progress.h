@@ -29,7 +29,8 @@ class Progress {
 
   bool drawing() const { return drawing_; }
 
-  // `done` of `total` of `phase`; thread-safe. A new phase name restarts the clock of the ETA.
+  // `done` of `total` of `phase` (total < 0: not known, no percentage or ETA); thread-safe.
+  // A new phase name restarts the clock of the ETA.
   // Redraws at most 10 times a second, and always at a phase's start, its first finished item
   // (the first ETA) and its end.
   void Update(std::string_view phase, std::int64_t done, std::int64_t total);

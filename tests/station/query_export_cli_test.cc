@@ -1,6 +1,8 @@
 // `eol query` and `eol export` on a real store, through the binary.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -102,6 +104,46 @@ TEST_F(QueryExportTest, ExportCsvHasOneRowPerTestAndQuotesReasons) {
   while (std::getline(in, line)) ++rows;
   EXPECT_EQ(rows, 3);
   EXPECT_NE(r.out.find("\"resonance_f_hz = 352 Hz, below 370, \"\"low\"\"\""), std::string::npos);
+}
+
+// --all reads the store a page at a time, each page after the last test written (keyset
+// paging on started_at, then id): with pages of 4 over 23 more tests, seven of them started in
+// the same millisecond, every test comes exactly once and in the order one large page gives.
+TEST_F(QueryExportTest, ExportAllPagesThroughEveryTestOnceInOrder) {
+  {
+    auto store = db::Store::Open(db_);
+    for (int i = 0; i < 23; ++i) {
+      const std::string t = i < 7 ? "2026-11-22T10:00:00.000Z"
+                                  : "2026-11-22T11:" + std::string(i < 10 ? "0" : "") +
+                                        std::to_string(i) + ":00.000Z";
+      db::TestRecord r = Record("PG-" + std::to_string(i), t, analysis::Outcome::kPass, 390.0 + i);
+      store->Insert(r);
+    }
+  }
+  auto ids = [](const std::string& out) {
+    std::vector<std::int64_t> v;
+    for (const auto& t : nlohmann::json::parse(out)) v.push_back(t["id"].get<std::int64_t>());
+    return v;
+  };
+  const CliRun one = Eol({"export", "--db", db_, "--format", "json", "--limit", "1000"});
+  ASSERT_EQ(one.code, 0) << one.out;
+  const CliRun paged =
+      Eol({"export", "--db", db_, "--format", "json", "--all", "--page-size", "4"});
+  ASSERT_EQ(paged.code, 0) << paged.out;
+  const std::vector<std::int64_t> want = ids(one.out), got = ids(paged.out);
+  EXPECT_EQ(want.size(), 26u);
+  EXPECT_EQ(got, want);
+  for (const char* format : {"csv", "records"}) {
+    const CliRun all = Eol({"export", "--db", db_, "--format", format, "--all", "--page-size", "5"});
+    ASSERT_EQ(all.code, 0) << all.out;
+    if (std::string(format) == "records") {
+      EXPECT_EQ(ids(all.out), want);
+    } else {
+      EXPECT_EQ(std::count(all.out.begin(), all.out.end(), '\n'), 27) << "header + 26 rows";
+    }
+  }
+  EXPECT_NE(Eol({"export", "--db", db_, "--all", "--limit", "5"}).code, 0)
+      << "--all and --limit exclude each other";
 }
 
 TEST_F(QueryExportTest, ExportJsonBySerialAndTimeRange) {
