@@ -7,11 +7,7 @@
 // plant-wide with the fields of their station-local forms.
 #include "station/central/central_record.h"
 
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -28,8 +24,11 @@
 #include "station/central/pg.h"
 #include "station/config.h"
 #include "station/station.h"
+#include "tests/support/central_counts.h"
 #include "tests/support/child_process.h"
+#include "tests/support/free_port.h"
 #include "tests/support/postgres_server.h"
+#include "tests/support/wait_until.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -38,24 +37,13 @@ namespace eol::station::central {
 namespace {
 
 using namespace std::chrono_literals;
+using eol::testing::CentralCounts;
 using eol::testing::ChildProcess;
+using eol::testing::FreePort;
 using eol::testing::PostgresServer;
+using eol::testing::StationIds;
 using eol::testing::TempDir;
-
-int FreePort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
-      getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
-    close(fd);
-    return 0;
-  }
-  close(fd);
-  return ntohs(a.sin_port);
-}
+using eol::testing::WaitUntil;
 
 // A finished record as a station stores it: measurements, reasons, who/what, a raw curve.
 db::TestRecord Record(const std::string& station, const std::string& serial, int n) {
@@ -97,35 +85,6 @@ CentralConfig Fast(const std::string& url) {
   c.connect_timeout_s = 2;
   c.idle_poll_s = 0.02;
   return c;
-}
-
-// (station_id, test_id) -> how many rows the central `tests` table holds.
-std::map<std::pair<std::string, std::int64_t>, int> CentralCounts(const std::string& url) {
-  auto pg = PgConnection::Connect(url, 5, "test");
-  const PgResult r = pg->Exec(
-      "SELECT station_id, test_id, count(*) FROM tests GROUP BY station_id, test_id", {}, "count");
-  std::map<std::pair<std::string, std::int64_t>, int> out;
-  for (int i = 0; i < r.rows(); ++i)
-    out[{r.Text(i, 0), std::stoll(r.Text(i, 1))}] = std::stoi(r.Text(i, 2));
-  return out;
-}
-
-// Every test id the station's SQLite holds.
-std::set<std::int64_t> StationIds(const std::string& db_path) {
-  auto store = db::Store::Open(db_path, db::Store::Role::kReader);
-  db::TestQuery q;
-  q.limit = 10000;
-  std::set<std::int64_t> ids;
-  for (const db::TestRecord& r : store->Tests(q)) ids.insert(r.id);
-  return ids;
-}
-
-// Waits until `done()` or `timeout`; returns done().
-template <typename F>
-bool WaitUntil(F done, std::chrono::milliseconds timeout) {
-  const auto end = std::chrono::steady_clock::now() + timeout;
-  while (!done() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(20ms);
-  return done();
 }
 
 class CentralRecordTest : public ::testing::Test {

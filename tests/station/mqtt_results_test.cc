@@ -3,12 +3,7 @@
 // python3-paho-mqtt, tests/peers/mqtt_subscriber.py) in a persistent session. The broker is
 // stopped and restarted in the middle of a run: nothing is lost, the order is kept, and a
 // daemon killed with SIGKILL leaves its last will "offline".
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <pwd.h>
-#include <sys/socket.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -25,147 +20,21 @@
 #include "db/store.h"
 #include "station/station.h"
 #include "tests/support/child_process.h"
-#include "tests/support/station_ready.h"
+#include "tests/support/free_port.h"
+#include "tests/support/mosquitto_broker.h"
+#include "tests/support/mqtt_mes.h"
 
 namespace eol::station {
 namespace {
 
 using namespace std::chrono_literals;
 using eol::testing::ChildProcess;
-
-constexpr const char* kMosquitto = "/usr/sbin/mosquitto";
-constexpr const char* kPython = "/usr/bin/python3";
-
-// A port nobody listens on now (the kernel's pick; the broker binds it right after).
-int FreePort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
-      getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
-    close(fd);
-    return 0;
-  }
-  close(fd);
-  return ntohs(a.sin_port);
-}
-
-// mosquitto on 127.0.0.1:port with persistence in `dir` (what it holds survives a restart:
-// the MES's persistent session with its subscription and queued messages).
-//
-// Started as root, mosquitto drops its privileges to the `mosquitto` user after reading its
-// config, and writes its persistence file as that user. In the test's own directory (root's,
-// 0700) its save on SIGTERM failed ("Error saving in-memory database ... Permission denied"),
-// the restarted broker had no session for the MES, and what the station published before the
-// MES had subscribed again went to nobody, acknowledged. So the broker's directory belongs to
-// the user it runs as, and Stop() checks that the save worked.
-class Broker {
- public:
-  // `listener_extra`: lines after the listener (its TLS files; "BROKER" stands for dir()),
-  // given a prepare step that writes files into dir() first (they are given to the broker's
-  // user too).
-  Broker(std::string dir, int port, std::string listener_extra = "",
-         const std::function<void(const std::string&)>& prepare = {})
-      : dir_(std::move(dir) + "/broker"), port_(port) {
-    std::filesystem::create_directory(dir_);
-    if (geteuid() == 0) {
-      if (const passwd* pw = getpwnam("mosquitto")) {
-        chmod(std::filesystem::path(dir_).parent_path().c_str(), 0711);
-        if (chown(dir_.c_str(), pw->pw_uid, pw->pw_gid) != 0) ADD_FAILURE() << "chown " << dir_;
-      }
-    }
-    if (prepare) prepare(dir_);
-    for (std::size_t at; (at = listener_extra.find("BROKER")) != std::string::npos;)
-      listener_extra.replace(at, 6, dir_);
-    if (geteuid() == 0)
-      if (const passwd* pw = getpwnam("mosquitto"))
-        for (const auto& f : std::filesystem::directory_iterator(dir_))
-          if (chown(f.path().c_str(), pw->pw_uid, pw->pw_gid) != 0) ADD_FAILURE() << f.path();
-    std::ofstream(dir_ + "/mosquitto.conf")
-        << "listener " << port_ << " 127.0.0.1\n"
-        << listener_extra << "allow_anonymous true\npersistence true\n"
-        << "persistence_location " << dir_
-        << "/\n"
-        // The MES's session queues the whole replay while it reconnects (mosquitto drops
-        // QoS 1 messages beyond 1000 queued per client by default).
-        << "max_queued_messages 100000\n";
-  }
-  ::testing::AssertionResult Start() {
-    if (access(kMosquitto, X_OK) != 0)
-      return ::testing::AssertionFailure()
-             << kMosquitto << " not found: mosquitto is a declared test dependency "
-             << "(apt-get install mosquitto)";
-    process_ = std::make_unique<ChildProcess>(
-        std::vector<std::string>{kMosquitto, "-c", dir_ + "/mosquitto.conf"});
-    if (!process_->WaitFor(
-            [](const std::string& o) { return o.find(" running") != std::string::npos; }, 10s))
-      return ::testing::AssertionFailure() << "mosquitto did not start: " << process_->output();
-    return ::testing::AssertionSuccess();
-  }
-  // SIGTERM: mosquitto saves its sessions to persistence_location, then exits. A failed
-  // save fails the test: the next start would have lost the sessions.
-  void Stop() {
-    if (!process_) return;
-    process_->Stop(SIGTERM, 10s);
-    EXPECT_EQ(process_->output().find("Error saving"), std::string::npos) << process_->output();
-    EXPECT_TRUE(std::filesystem::exists(dir_ + "/mosquitto.db"))
-        << "mosquitto saved no persistence file: " << process_->output();
-    process_.reset();
-  }
-  int port() const { return port_; }
-  const std::string& dir() const { return dir_; }
-  std::string output() {
-    if (!process_) return "";
-    process_->WaitFor([](const std::string&) { return false; }, 50ms);
-    return process_->output();
-  }
-
- private:
-  std::string dir_;
-  int port_;
-  std::unique_ptr<ChildProcess> process_;
-};
-
-// The MES: every message it received, parsed from its output.
-struct Received {
-  std::string topic;
-  std::string payload;
-  double t = 0;  // unix seconds, when it arrived
-};
-
-std::vector<Received> Messages(ChildProcess& sub) {
-  sub.WaitFor([](const std::string&) { return false; }, 20ms);  // read what is there
-  std::vector<Received> out;
-  std::istringstream in(sub.output());
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line.front() != '{') continue;
-    const auto j = nlohmann::json::parse(line, nullptr, false);
-    if (j.is_discarded() || j.value("event", "") != "message") continue;
-    out.push_back({j["topic"], j["payload"], j["t"]});
-  }
-  return out;
-}
-
-// Test ids of the result messages, first arrivals in arrival order, and how many repeated.
-std::vector<std::int64_t> ResultIds(const std::vector<Received>& all, const std::string& topic,
-                                    int* duplicates) {
-  std::vector<std::int64_t> ids;
-  std::set<std::int64_t> seen;
-  *duplicates = 0;
-  for (const Received& m : all) {
-    if (m.topic != topic) continue;
-    const auto j = nlohmann::json::parse(m.payload);
-    const std::int64_t id = j.at("id");
-    if (seen.insert(id).second)
-      ids.push_back(id);
-    else
-      ++*duplicates;
-  }
-  return ids;
-}
+using eol::testing::FreePort;
+using eol::testing::MesArgv;
+using eol::testing::Messages;
+using eol::testing::MosquittoBroker;
+using eol::testing::Received;
+using eol::testing::ResultIds;
 
 double UnixNow() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -190,11 +59,8 @@ class MqttResultsTest : public ::testing::Test {
   void SetUp() override {
     ASSERT_GT(port_, 0);
     ASSERT_TRUE(broker_.Start());
-    subscriber_ = std::make_unique<ChildProcess>(std::vector<std::string>{
-        kPython, std::string(EOL_SOURCE_DIR) + "/tests/peers/mqtt_subscriber.py", "--port",
-        std::to_string(port_), "--topic", "plant/eol/#"});
-    ASSERT_TRUE(subscriber_->WaitFor(
-        [](const std::string& o) { return o.find("\"subscribed\"") != std::string::npos; }, 20s))
+    subscriber_ = std::make_unique<ChildProcess>(MesArgv(port_, "plant/eol/#"));
+    ASSERT_TRUE(eol::testing::WaitSubscribed(*subscriber_, 20s))
         << "the subscriber (python3-paho-mqtt) did not subscribe: " << subscriber_->output();
   }
   void TearDown() override {
@@ -216,7 +82,7 @@ class MqttResultsTest : public ::testing::Test {
 
   eol::testing::TempDir dir_;
   const int port_ = FreePort();
-  Broker broker_{dir_.path(), port_};
+  MosquittoBroker broker_{dir_.path(), port_};
   std::unique_ptr<ChildProcess> subscriber_;
 };
 
@@ -332,9 +198,7 @@ TEST_F(MqttResultsTest, ADaemonKilledLeavesItsLastWillOfflineRetained) {
     std::this_thread::sleep_for(20ms);
   EXPECT_EQ(status().back(), "offline") << "no last will after SIGKILL";
   // Retained: a client that subscribes now still reads it.
-  ChildProcess late({kPython, std::string(EOL_SOURCE_DIR) + "/tests/peers/mqtt_subscriber.py",
-                     "--port", std::to_string(port_), "--topic", "plant/eol/mq-1/status",
-                     "--client-id", "late-reader"});
+  ChildProcess late(MesArgv(port_, "plant/eol/mq-1/status", {"--client-id", "late-reader"}));
   EXPECT_TRUE(late.WaitFor(
       [](const std::string& o) { return o.find("\"payload\": \"offline\"") != std::string::npos; },
       20s))
@@ -376,17 +240,16 @@ class MqttTlsTest : public ::testing::Test {
   }
   eol::testing::TempDir dir_;
   const int port_ = FreePort();
-  Broker broker_{dir_.path(), port_,
-                 "cafile BROKER/ca.crt\ncertfile BROKER/server.crt\nkeyfile BROKER/server.key\n",
-                 [](const std::string& d) { MakeCertificates(d, "ca"); }};
+  MosquittoBroker broker_{
+      dir_.path(), port_,
+      "cafile BROKER/ca.crt\ncertfile BROKER/server.crt\nkeyfile BROKER/server.key\n",
+      [](const std::string& d) { MakeCertificates(d, "ca"); }};
 };
 
 TEST_F(MqttTlsTest, ResultsGoOverTlsCheckedAgainstTheConfiguredCa) {
   const std::string ca = broker_.dir() + "/ca.crt";
-  ChildProcess mes({kPython, std::string(EOL_SOURCE_DIR) + "/tests/peers/mqtt_subscriber.py",
-                    "--port", std::to_string(port_), "--topic", "plant/eol/#", "--cafile", ca});
-  ASSERT_TRUE(mes.WaitFor(
-      [](const std::string& o) { return o.find("\"subscribed\"") != std::string::npos; }, 20s))
+  ChildProcess mes(MesArgv(port_, "plant/eol/#", {"--cafile", ca}));
+  ASSERT_TRUE(eol::testing::WaitSubscribed(mes, 20s))
       << mes.output() << "\nbroker: " << broker_.output();
   const std::string db_path = dir_ / "tls.sqlite";
   {
