@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "drivers/io/json_config.h"
-#include "station/central/pg.h"
+#include "station/plant_urls.h"
 #include "station/serial_number.h"
 
 namespace eol::station {

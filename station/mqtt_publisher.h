@@ -35,6 +35,8 @@
 #include <string>
 #include <thread>
 
+#include "station/plant_urls.h"  // ParseMqttUrl
+
 struct mosquitto;
 
 namespace eol::station {
@@ -62,11 +64,6 @@ struct MqttConfig {
   int keepalive_s = 30;
   double reconnect_s = 1.0;  // pause between attempts while the broker is away
 };
-
-// "mqtt://host:port" (port optional, 1883) or "mqtts://host:port" (8883) into host and port
-// and whether TLS is asked for; false with the reason.
-bool ParseMqttUrl(const std::string& url, std::string* host, int* port, bool* tls,
-                  std::string* why);
 
 class MqttPublisher {
  public:

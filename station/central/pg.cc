@@ -2,8 +2,6 @@
 
 #include <libpq-fe.h>
 
-#include <regex>
-
 namespace eol::station::central {
 namespace {
 
@@ -14,12 +12,6 @@ std::string Trim(std::string s) {
 }
 
 }  // namespace
-
-std::string RedactUrl(const std::string& url) {
-  static const std::regex kUserinfo(R"(^([A-Za-z][A-Za-z0-9+.-]*://[^:/@]*):[^@]*@)");
-  static const std::regex kPasswordKey(R"((password\s*=\s*)\S+)");
-  return std::regex_replace(std::regex_replace(url, kUserinfo, "$1:***@"), kPasswordKey, "$1***");
-}
 
 PgResult::PgResult(pg_result* r) : r_(r) {}
 PgResult::~PgResult() { PQclear(r_); }

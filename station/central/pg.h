@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "station/plant_urls.h"  // RedactUrl
+
 struct pg_conn;    // libpq's PGconn
 struct pg_result;  // libpq's PGresult
 
@@ -22,10 +24,6 @@ class PgError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
-
-// "postgresql://user:secret@host:5432/db" -> "postgresql://user:***@host:5432/db": what the
-// logs and error messages show.
-std::string RedactUrl(const std::string& url);
 
 // The rows of one statement's result. Values are libpq's text format.
 class PgResult {
