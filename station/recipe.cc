@@ -237,9 +237,8 @@ void ParseApproval(const JsonObject& o, Recipe& r) {
   a.state = o.String("state", "");
   o.Require(a.state == "proposed" || a.state == "approved", "state",
             "must be \"proposed\" or \"approved\"");
-  for (auto [key, field, required] :
-       {std::tuple{"by", &a.by, true}, std::tuple{"at", &a.at, true},
-        std::tuple{"note", &a.note, false}}) {
+  for (auto [key, field, required] : {std::tuple{"by", &a.by, true}, std::tuple{"at", &a.at, true},
+                                      std::tuple{"note", &a.note, false}}) {
     *field = o.String(key, "");
     if (!required && field->empty() && !o.Has(key)) continue;
     o.Require(!field->empty() && field->size() <= kMaxInstructionBytes, key,

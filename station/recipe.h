@@ -78,7 +78,7 @@ struct RecipeApproval {
   std::string state;  // "proposed" or "approved"
   std::string by;     // the teaching tool, or the approving engineer (token or --by name)
   std::string at;
-  std::string note;   // optional
+  std::string note;  // optional
   bool operator==(const RecipeApproval&) const = default;
 };
 

@@ -30,8 +30,8 @@ std::string Progress::Duration(double s) {
 
 std::string Progress::Line(std::string_view command, std::string_view phase, std::int64_t done,
                            std::int64_t total, double elapsed_s) {
-  std::string line = "eol " + std::string(command) + ": " + std::string(phase) + "  " +
-                     std::to_string(done);
+  std::string line =
+      "eol " + std::string(command) + ": " + std::string(phase) + "  " + std::to_string(done);
   if (total < 0) return line + "  " + Duration(elapsed_s);  // the total is not known
   line += "/" + std::to_string(total);
   if (total > 0) line += "  " + std::to_string(100 * done / total) + "%";

@@ -64,21 +64,17 @@ int RunApprove(const ApproveArgs& a) {
   }
   std::filesystem::rename(tmp, out);
   if (a.json) {
-    std::cout << nlohmann::json{{"id", checked.id},
-                                {"version", checked.version},
-                                {"hash", checked.hash},
-                                {"proposal_hash", proposal.hash},
-                                {"path", out},
-                                {"by", a.by},
-                                {"at", entry.at},
-                                {"db", a.db}}
+    std::cout << nlohmann::json{{"id", checked.id},     {"version", checked.version},
+                                {"hash", checked.hash}, {"proposal_hash", proposal.hash},
+                                {"path", out},          {"by", a.by},
+                                {"at", entry.at},       {"db", a.db}}
                      .dump()
               << std::endl;
     return 0;
   }
-  std::cout << "approved " << checked.id << " v" << checked.version << " by " << a.by << ": "
-            << out << ", sha256 " << checked.hash << " (proposal " << proposal.hash
-            << "); audited in " << a.db << "\n";
+  std::cout << "approved " << checked.id << " v" << checked.version << " by " << a.by << ": " << out
+            << ", sha256 " << checked.hash << " (proposal " << proposal.hash << "); audited in "
+            << a.db << "\n";
   return 0;
 }
 

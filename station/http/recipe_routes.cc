@@ -1,8 +1,7 @@
 // The recipe in use: read it, change it (engineers; audited), and read the audit log.
+#include "db/clock.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
-
-#include "db/clock.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -41,9 +40,8 @@ void ApproveRecipe(ApiContext& c, const httplib::Request& req, httplib::Response
   if (!recipe.contains("approval") || !recipe.at("approval").is_object() ||
       recipe.at("approval").value("state", "") != "proposed")
     return bad("/recipe/approval/state: is not \"proposed\": only a proposal is approved");
-  nlohmann::json approval = {{"state", "approved"},
-                             {"by", std::get<ApiToken>(who).name},
-                             {"at", db::UtcNowIso8601()}};
+  nlohmann::json approval = {
+      {"state", "approved"}, {"by", std::get<ApiToken>(who).name}, {"at", db::UtcNowIso8601()}};
   if (b.contains("note")) {
     if (!b.at("note").is_string()) return bad("/note: must be text");
     approval["note"] = b.at("note");

@@ -138,8 +138,8 @@ TEST(RotorChain, ResidueRisesWithSoftBondsAndIgnoresTheClamp) {
   const MotionalImpedance clamp = first(stiff_clamp);
   const double df_soft = 1.0 - soft.f0_hz / g.f0_hz;
   const double da_soft = soft.ResidueOhmPerS() / g.ResidueOhmPerS() - 1.0;
-  EXPECT_GT(df_soft, 0.05);               // 390 -> 366 Hz
-  EXPECT_GT(da_soft, 8.0 * df_soft);      // +73 %
+  EXPECT_GT(df_soft, 0.05);           // 390 -> 366 Hz
+  EXPECT_GT(da_soft, 8.0 * df_soft);  // +73 %
   const double df_clamp = clamp.f0_hz / g.f0_hz - 1.0;
   const double da_clamp = std::abs(clamp.ResidueOhmPerS() / g.ResidueOhmPerS() - 1.0);
   EXPECT_GT(df_clamp, 0.03);

@@ -166,9 +166,9 @@ TEST_F(IndependentPopulation, ResidueCatchesSofterBondsThanTheResonanceAlone) {
   ASSERT_EQ(limits.size() + 1, before) << "the shipped recipe must declare the residue";
   const std::string without = (dir() / "without_residue.json").string();
   std::ofstream(without) << recipe.dump(2);
-  const std::vector<std::string> sweep = {"--seeds", "404", "--good", "0", "--one-soft", "0",
-                                          "--three-soft", "0", "--all-soft", "80",
-                                          "--loss-lo", "0.85", "--loss-hi", "0.94"};
+  const std::vector<std::string> sweep = {
+      "--seeds", "404",        "--good", "0",         "--one-soft", "0",         "--three-soft",
+      "0",       "--all-soft", "80",     "--loss-lo", "0.85",       "--loss-hi", "0.94"};
   const nlohmann::json with_j = Rejects("with", sweep);
   const nlohmann::json without_j = Rejects("without", sweep, without);
   ASSERT_TRUE(with_j.is_object() && without_j.is_object());

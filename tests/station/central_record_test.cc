@@ -202,10 +202,9 @@ TEST_F(CentralRecordTest, EightStationsAndAServerStoppedMidRunLoseAndDuplicateNo
   EXPECT_EQ(row.IsNull(0, 5), want.reasons.empty());
   EXPECT_EQ(std::stod(row.Text(0, 6)), want.measurements[0].value);
   EXPECT_EQ(row.Text(0, 7), "100");
-  std::cout << "[ figures  ] " << kStations << " stations, " << expected
-            << " records; outage " << outage_s
-            << " s after the stations met it; the backlog then drained in " << replay_s << " s; " << again
-            << " sent again and found there\n";
+  std::cout << "[ figures  ] " << kStations << " stations, " << expected << " records; outage "
+            << outage_s << " s after the stations met it; the backlog then drained in " << replay_s
+            << " s; " << again << " sent again and found there\n";
 }
 
 TEST_F(CentralRecordTest, AStationStoppedMidReplicationOrWithoutItsCursorResumesExactlyOnce) {

@@ -2,7 +2,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -134,7 +133,8 @@ TEST_F(QueryExportTest, ExportAllPagesThroughEveryTestOnceInOrder) {
   EXPECT_EQ(want.size(), 26u);
   EXPECT_EQ(got, want);
   for (const char* format : {"csv", "records"}) {
-    const CliRun all = Eol({"export", "--db", db_, "--format", format, "--all", "--page-size", "5"});
+    const CliRun all =
+        Eol({"export", "--db", db_, "--format", format, "--all", "--page-size", "5"});
     ASSERT_EQ(all.code, 0) << all.out;
     if (std::string(format) == "records") {
       EXPECT_EQ(ids(all.out), want);

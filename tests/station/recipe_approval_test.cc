@@ -40,18 +40,19 @@ nlohmann::json Proposal(int version) {
 }
 
 void WriteStationConfig(const eol::testing::TempDir& dir, const std::string& recipe) {
-  std::ofstream(dir / "station.json") << nlohmann::json{
-      {"station_id", "approval"},
-      {"recipe", recipe},
-      {"db", "s.sqlite"},
-      {"http",
-       {{"listen", "127.0.0.1"},
-        {"port", 0},
-        {"tokens",
-         {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
-          {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
-      {"fixture", {{"driver", "sim"}}},
-      {"daq", {{"driver", "sim"}, {"time_scale", 0.0}}}}.dump();
+  std::ofstream(dir / "station.json")
+      << nlohmann::json{{"station_id", "approval"},
+                        {"recipe", recipe},
+                        {"db", "s.sqlite"},
+                        {"http",
+                         {{"listen", "127.0.0.1"},
+                          {"port", 0},
+                          {"tokens",
+                           {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
+                            {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
+                        {"fixture", {{"driver", "sim"}}},
+                        {"daq", {{"driver", "sim"}, {"time_scale", 0.0}}}}
+             .dump();
 }
 
 httplib::Headers With(const char* token) {
@@ -100,8 +101,9 @@ TEST(RecipeApproval, StationRefusesProposalsUntilAnEngineerApprovesOverTheApi) {
   const nlohmann::json approve = {{"recipe", Proposal(3)}, {"note", "population run 12"}};
   res = http.Post("/api/recipe/approve", With(kOperator), approve.dump(), "application/json");
   EXPECT_EQ(res->status, 403) << res->body;
-  res = http.Post("/api/recipe/approve", With(kEngineer),
-                  nlohmann::json{{"recipe", io::ReadJsonFile(kShipped)}}.dump(), "application/json");
+  res =
+      http.Post("/api/recipe/approve", With(kEngineer),
+                nlohmann::json{{"recipe", io::ReadJsonFile(kShipped)}}.dump(), "application/json");
   EXPECT_EQ(res->status, 400) << res->body;
   EXPECT_NE(res->body.find("only a proposal is approved"), std::string::npos) << res->body;
 
@@ -135,9 +137,9 @@ TEST(RecipeApproval, TaughtRecipeIsAProposalApprovedOnTheCommandLine) {
     rec.serial = "SN" + std::to_string(i);
     rec.outcome = analysis::Outcome::kPass;
     rec.recipe_hash = hash;
-    const double values[] = {389.0 + 0.7 * (i % 5),         50.0 + (i % 3),
-                             0.5 + 0.002 * (i % 4),         2e-3 * (1.0 + 0.01 * (i % 2)),
-                             1.0 + 0.02 * (i % 3),          25.7 + 0.3 * (i % 4)};
+    const double values[] = {389.0 + 0.7 * (i % 5), 50.0 + (i % 3),
+                             0.5 + 0.002 * (i % 4), 2e-3 * (1.0 + 0.01 * (i % 2)),
+                             1.0 + 0.02 * (i % 3),  25.7 + 0.3 * (i % 4)};
     for (int k = 0; k < 6; ++k) {
       analysis::Measurement m;
       m.name = names[k];

@@ -134,16 +134,16 @@ TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
   const std::string hash = station::LoadRecipe(kRecipe).hash;
   auto records = [&](auto spoil) {
     nlohmann::json list = nlohmann::json::array();
-    const char* names[] = {"resonance_f_hz", "resonance_q", "winding_r_ohm", "winding_l_h",
-                           "fit_chi2_per_dof", "motional_residue_ohm_per_s"};
+    const char* names[] = {"resonance_f_hz", "resonance_q",      "winding_r_ohm",
+                           "winding_l_h",    "fit_chi2_per_dof", "motional_residue_ohm_per_s"};
     for (int i = 0; i < 10; ++i) {
       db::TestRecord r;
       r.serial = "SN" + std::to_string(i);
       r.outcome = analysis::Outcome::kPass;
       r.recipe_hash = hash;
-      const double values[] = {390.0 + 0.7 * (i % 5) - 1.4, 50.0 + (i % 3), 0.5 + 0.002 * (i % 4),
-                               2e-3 * (1.0 + 0.01 * (i % 2)), 1.0 + 0.02 * (i % 3),
-                               25.7 + 0.3 * (i % 4)};
+      const double values[] = {390.0 + 0.7 * (i % 5) - 1.4, 50.0 + (i % 3),
+                               0.5 + 0.002 * (i % 4),       2e-3 * (1.0 + 0.01 * (i % 2)),
+                               1.0 + 0.02 * (i % 3),        25.7 + 0.3 * (i % 4)};
       for (int k = 0; k < 6; ++k) {
         analysis::Measurement m;
         m.name = names[k];
