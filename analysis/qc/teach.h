@@ -21,7 +21,7 @@
 //                                           twelve times faster than f0 falls and hardly moves
 //                                           with the clamp (motor_model.h). Evidence: on the
 //                                           independent generator, all ten bonds at losses of
-//                                           0.85-0.94, 29 of 80 rejected with it, 18 without
+//                                           0.85-0.94, 29 of 80 rejected with it, 19 without
 //                                           (independent_population_test part 4)
 //   fit_chi2_per_dof   hi           0.35    a soft magnet's local mode is a peak the one-mode
 //                                           model cannot follow; it only raises chi2
