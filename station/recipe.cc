@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <tuple>
 
 #include "analysis/qc/measurement_names.h"
@@ -331,6 +333,18 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
 }
 
 Recipe LoadRecipe(const std::string& path) { return ParseRecipe(io::ReadJsonFile(path), path); }
+
+void WriteRecipeFile(const std::string& path, const nlohmann::json& j) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error(tmp + ": cannot be written");
+    out << j.dump(2) << "\n";
+    out.flush();
+    if (!out) throw std::runtime_error(tmp + ": writing failed");
+  }
+  std::filesystem::rename(tmp, path);
+}
 
 std::string Recipe::WhyNotApproved() const {
   if (Approved()) return "";

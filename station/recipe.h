@@ -130,6 +130,10 @@ struct Recipe {
 // Throws io::ConfigError with "<source>: <json path>: <rule>".
 Recipe ParseRecipe(const nlohmann::json& j, const std::string& source);
 Recipe LoadRecipe(const std::string& path);
+// Writes a recipe's JSON (2-space indent) to `path` through `path`.tmp and a rename, so a
+// reader never sees half a file (atomic on one file system). Throws std::runtime_error naming
+// the file when it cannot be written.
+void WriteRecipeFile(const std::string& path, const nlohmann::json& j);
 
 // The recipe as JSON in the schema ParseRecipe reads (every key, defaults written out), so
 // that ParseRecipe(RecipeToJson(r)) gives r back (tests/station/recipe_test.cc). Used for

@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
-#include <fstream>
 #include <thread>
 
 #include "analysis/text.h"
@@ -181,14 +180,7 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
                         (path.stem().string() + ".v" + std::to_string(current->version) + ".json");
   try {
     if (!fs::exists(kept)) fs::copy_file(path, kept);
-    const fs::path tmp = path.string() + ".tmp";
-    {
-      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      out << j.dump(2) << "\n";
-      out.flush();
-      if (!out) throw std::runtime_error(tmp.string() + ": cannot be written");
-    }
-    fs::rename(tmp, path);  // atomic on one file system
+    WriteRecipeFile(path.string(), j);
   } catch (const std::exception& e) {
     return refused(RecipeChange::Kind::kIoError, e.what());
   }

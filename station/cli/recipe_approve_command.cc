@@ -6,7 +6,6 @@
 // recipe's hashes. While a station holds the database, approve over its API instead
 // (POST /api/recipe/approve). Exit: 0 approved, 2 usage, file or database error.
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -54,15 +53,7 @@ int RunApprove(const ApproveArgs& a) {
   entry.new_hash = checked.hash;
   entry.path = std::filesystem::absolute(out).string();
   store->AppendAudit(entry);
-  const std::string tmp = out + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw std::runtime_error(tmp + ": cannot be written");
-    f << j.dump(2) << "\n";
-    f.flush();
-    if (!f) throw std::runtime_error(tmp + ": writing failed");
-  }
-  std::filesystem::rename(tmp, out);
+  WriteRecipeFile(out, j);
   if (a.json) {
     std::cout << nlohmann::json{{"id", checked.id},     {"version", checked.version},
                                 {"hash", checked.hash}, {"proposal_hash", proposal.hash},

@@ -6,7 +6,6 @@
 // (ParseRecipe) before it is written, and an existing file is never overwritten without
 // --force. Exit: 0 written, 1 nothing could be learned (reason on stderr), 2 usage/file error.
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -38,15 +37,7 @@ void WriteNew(const std::string& path, const json& j, bool force) {
     throw std::runtime_error(path +
                              " exists: refusing to overwrite it (choose another --out, or "
                              "--force)");
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw std::runtime_error(tmp + ": cannot be written");
-    f << j.dump(2) << "\n";
-    f.flush();
-    if (!f) throw std::runtime_error(tmp + ": writing failed");
-  }
-  std::filesystem::rename(tmp, path);
+  WriteRecipeFile(path, j);
 }
 
 int RunTeach(const TeachArgs& a) {

@@ -12,6 +12,7 @@
 
 #include "tests/support/child_process.h"
 #include "tests/support/station_ready.h"
+#include "tests/support/token_station.h"
 
 namespace eol {
 namespace {
@@ -33,23 +34,12 @@ class QcApi : public ::testing::Test {
   void SetUp() override {
     std::filesystem::copy_file(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json",
                                dir_ / "pmsm-10pole.json");
-    std::ofstream(dir_ / "station.json")
-        << nlohmann::json{{"station_id", "qc-api"},
-                          {"recipe", "pmsm-10pole.json"},
-                          {"db", "s.sqlite"},
-                          {"http",
-                           {{"listen", "127.0.0.1"},
-                            {"port", 0},
-                            {"tokens",
-                             {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
-                              {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
-                          {"fixture", {{"driver", "sim"}}},
-                          {"daq", {{"driver", "sim"}}},
-                          {"sim",
-                           {{"clamp_close_s", 0.02},
-                            {"clamp_open_s", 0.02},
-                            {"population", {{"defect_share", 0.0}, {"seed", 5}}}}}}
-               .dump();
+    nlohmann::json config =
+        testing::TokenStationConfig("qc-api", "pmsm-10pole.json", kOperator, kEngineer);
+    config["sim"] = {{"clamp_close_s", 0.02},
+                     {"clamp_open_s", 0.02},
+                     {"population", {{"defect_share", 0.0}, {"seed", 5}}}};
+    std::ofstream(dir_ / "station.json") << config.dump();
     station_ = std::make_unique<ChildProcess>(
         std::vector<std::string>{EOL_BINARY, "station", "--config", dir_ / "station.json"});
     ASSERT_TRUE(

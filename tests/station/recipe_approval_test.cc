@@ -16,7 +16,9 @@
 #include "station/recipe.h"
 #include "tests/support/child_process.h"
 #include "tests/support/eol_cli.h"
+#include "tests/support/pass_records.h"
 #include "tests/support/station_ready.h"
+#include "tests/support/token_station.h"
 
 // After Eigen (through station/recipe.h): <resolv.h> defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -40,19 +42,9 @@ nlohmann::json Proposal(int version) {
 }
 
 void WriteStationConfig(const eol::testing::TempDir& dir, const std::string& recipe) {
-  std::ofstream(dir / "station.json")
-      << nlohmann::json{{"station_id", "approval"},
-                        {"recipe", recipe},
-                        {"db", "s.sqlite"},
-                        {"http",
-                         {{"listen", "127.0.0.1"},
-                          {"port", 0},
-                          {"tokens",
-                           {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
-                            {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
-                        {"fixture", {{"driver", "sim"}}},
-                        {"daq", {{"driver", "sim"}, {"time_scale", 0.0}}}}
-             .dump();
+  nlohmann::json config = testing::TokenStationConfig("approval", recipe, kOperator, kEngineer);
+  config["daq"]["time_scale"] = 0.0;
+  std::ofstream(dir / "station.json") << config.dump();
 }
 
 httplib::Headers With(const char* token) {
@@ -129,25 +121,7 @@ TEST(RecipeApproval, TaughtRecipeIsAProposalApprovedOnTheCommandLine) {
   eol::testing::TempDir dir;
   // Ten PASS records of the shipped recipe, as `eol export --format records` writes them.
   const std::string hash = station::LoadRecipe(kShipped).hash;
-  nlohmann::json list = nlohmann::json::array();
-  const char* names[] = {"resonance_f_hz", "resonance_q",      "winding_r_ohm",
-                         "winding_l_h",    "fit_chi2_per_dof", "motional_residue_ohm_per_s"};
-  for (int i = 0; i < 10; ++i) {
-    db::TestRecord rec;
-    rec.serial = "SN" + std::to_string(i);
-    rec.outcome = analysis::Outcome::kPass;
-    rec.recipe_hash = hash;
-    const double values[] = {389.0 + 0.7 * (i % 5), 50.0 + (i % 3),
-                             0.5 + 0.002 * (i % 4), 2e-3 * (1.0 + 0.01 * (i % 2)),
-                             1.0 + 0.02 * (i % 3),  25.7 + 0.3 * (i % 4)};
-    for (int k = 0; k < 6; ++k) {
-      analysis::Measurement m;
-      m.name = names[k];
-      m.value = values[k];
-      rec.measurements.push_back(m);
-    }
-    list.push_back(rec);
-  }
+  const nlohmann::json list = testing::PassRecords(hash, 10);
   std::ofstream(dir / "records.json") << list.dump(1);
   const std::string taught = dir / "taught.json";
   auto r = testing::RunEol({"teach", "--recipe", kShipped, "--out", taught, "--allow-few-units",

@@ -12,6 +12,7 @@
 #include "db/test_record.h"
 #include "station/recipe.h"
 #include "tests/support/eol_cli.h"
+#include "tests/support/pass_records.h"
 
 namespace eol {
 namespace {
@@ -133,26 +134,9 @@ TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
 TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
   const std::string hash = station::LoadRecipe(kRecipe).hash;
   auto records = [&](auto spoil) {
-    nlohmann::json list = nlohmann::json::array();
-    const char* names[] = {"resonance_f_hz", "resonance_q",      "winding_r_ohm",
-                           "winding_l_h",    "fit_chi2_per_dof", "motional_residue_ohm_per_s"};
-    for (int i = 0; i < 10; ++i) {
-      db::TestRecord r;
-      r.serial = "SN" + std::to_string(i);
-      r.outcome = analysis::Outcome::kPass;
-      r.recipe_hash = hash;
-      const double values[] = {390.0 + 0.7 * (i % 5) - 1.4, 50.0 + (i % 3),
-                               0.5 + 0.002 * (i % 4),       2e-3 * (1.0 + 0.01 * (i % 2)),
-                               1.0 + 0.02 * (i % 3),        25.7 + 0.3 * (i % 4)};
-      for (int k = 0; k < 6; ++k) {
-        analysis::Measurement m;
-        m.name = names[k];
-        m.value = values[k];
-        r.measurements.push_back(m);
-      }
-      if (i == 4) spoil(r);
-      list.push_back(r);
-    }
+    std::vector<db::TestRecord> units = testing::PassRecords(hash, 10);
+    spoil(units[4]);
+    const nlohmann::json list = units;
     const std::string path = dir_ / "export.json";
     std::ofstream(path) << list.dump(1);
     return path;
