@@ -34,6 +34,7 @@
 //                               engineer token when tokens are configured)
 //   GET  /metrics               Prometheus text: tests by outcome, state, last resonance
 //   GET  /                      the operator page (station/web)
+//   GET  /engineer              the engineer page (station/web/engineer.html)
 //
 // Errors are JSON {"error": {"code": "...", "message": "..."}} with a fitting HTTP status.
 // Reads need no token; request bodies are limited to 64 KiB (4 MiB for the figure uploads). Reads

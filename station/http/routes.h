@@ -9,7 +9,8 @@
 
 namespace eol::station::http {
 
-// GET /api/status, GET /api/events, GET /metrics, GET / and /static (station/http/board_routes.cc)
+// GET /api/status, GET /api/events, GET /metrics, GET /, GET /engineer and /static
+// (station/http/board_routes.cc)
 void AddBoardRoutes(httplib::Server& s, ApiContext& c);
 // GET /api/recipe, PUT /api/recipe, GET /api/recipe/audit, POST /api/recipe/approve
 // (station/http/recipe_routes.cc)
