@@ -40,7 +40,7 @@ await runCheck(out, async browser => {
   out.curve_note = await page.textContent("#curve-note");
   for (const [w, h] of [[1280, 800], [1920, 1080]]) {
     await page.setViewportSize({ width: w, height: h });
-    const path = `${artifacts}/operator-pairs-${w}x${h}.png`;
+    const path = `${artifacts}/phase-pairs-${w}x${h}.png`;
     await page.screenshot({ path, fullPage: true });
     out.screenshots.push(path);
     out.sizes[`${w}x${h}`] = {
