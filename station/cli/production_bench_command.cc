@@ -10,9 +10,9 @@
 #include "analysis/bench/production_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/cli/pod_svg.h"
 #include "station/cli/progress.h"
 #include "station/data_files.h"
+#include "station/pod_chart.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {
