@@ -12,6 +12,11 @@
 namespace eol::analysis {
 namespace {
 
+// The hidden classes drawn: the first eight EffectKinds, the library as it was when the
+// README's figures were measured (coupled_inertia is benched by the independent generator,
+// tests/peers/independent_gap_cases.py), so a seed keeps drawing the same cases.
+constexpr int kBenchEffectKinds = 8;
+
 using Cplx = std::complex<double>;
 using Rng = std::mt19937_64;
 
@@ -71,6 +76,7 @@ AppliedEffect DrawEffect(EffectKind kind, const NominalNetwork& n, const std::ve
     }
     case EffectKind::kStrayCapacitance:
     case EffectKind::kSkinEffect:
+    case EffectKind::kCoupledInertia:  // not drawn: see kBenchEffectKinds
     case EffectKind::kAdhesiveCreep:
       make = [](double x) { return std::vector<double>{x}; };
       log = kind == EffectKind::kStrayCapacitance;
@@ -158,7 +164,7 @@ GapBenchCase RunCase(const GapBenchOptions& o, const Excitation& ex, int index,
   const std::vector<double> sigma0 =
       ExpectedLineSigma([&](double x) { return truth_nominal.At(x); }, ex, mo);
 
-  const int cls = std::uniform_int_distribution<int>(0, kEffectKindCount)(rng);
+  const int cls = std::uniform_int_distribution<int>(0, kBenchEffectKinds)(rng);
   std::vector<AppliedEffect> hidden;
   c.truth = "none";
   if (cls > 0) {

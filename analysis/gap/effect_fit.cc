@@ -239,6 +239,22 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       }
       return Best(c, 2);
     }
+    case EffectKind::kCoupledInertia: {
+      // The second inertia's own frequency on a log grid over and beyond the band (above f0
+      // it is the coupled mode's anti-resonance; far above, J2 acts as added inertia), times
+      // a few mass ratios and losses; every trial is the full network, so the first mode's
+      // shift, its Q and height and the coupled mode are all scored together.
+      std::vector<Candidate> c;
+      std::vector<AppliedEffect> trial(base.begin(), base.end());
+      trial.push_back({kind, {0.1, 1.0, 30.0}});
+      for (double f2 : LogSpace(0.6 * f_lo_, 4.0 * f_hi_, 48))
+        for (double mu : {0.02, 0.05, 0.1, 0.2, 0.5, 1.0})
+          for (double q2 : {10.0, 40.0, 150.0}) {
+            trial.back().params = {mu, f2, q2};
+            c.push_back({-Chi2(trial, mask), trial.back().params});
+          }
+      return Best(c, 3);
+    }
     case EffectKind::kAdhesiveCreep: {
       std::vector<Candidate> c;
       std::vector<AppliedEffect> trial(base.begin(), base.end());

@@ -12,8 +12,8 @@ namespace {
 using Cplx = std::complex<double>;
 
 constexpr std::array<const char*, kEffectKindCount> kNames = {
-    "series_resistance", "channel_delay",      "stray_capacitance", "lossy_inductance",
-    "skin_effect",       "fixture_compliance", "second_mode",       "adhesive_creep"};
+    "series_resistance",  "channel_delay", "stray_capacitance", "lossy_inductance", "skin_effect",
+    "fixture_compliance", "second_mode",   "adhesive_creep",    "coupled_inertia"};
 
 constexpr double kSkinReferenceHz = 1000.0;
 
@@ -43,7 +43,7 @@ double MaxNominalMagnitude(const NominalNetwork& n, double f_lo, double f_hi) {
 
 // Motional impedance with the mechanical effects (creep, fixture) of the top of effects.h.
 Cplx MotionalWithEffects(const MotionalImpedance& m, const AppliedEffect* creep,
-                         const AppliedEffect* fixture, Cplx s) {
+                         const AppliedEffect* fixture, const AppliedEffect* coupled, Cplx s) {
   const double w0 = TwoPi() * m.f0_hz;
   const double cp = m.q / (w0 * m.rp_ohm);
   const double lp = m.rp_ohm / (m.q * w0);
@@ -57,6 +57,12 @@ Cplx MotionalWithEffects(const MotionalImpedance& m, const AppliedEffect* creep,
     const double kappa = Param(fixture, 0);
     const double eta = Param(fixture, 1);
     support = 1.0 / (1.0 / support + s * lp / (kappa * Cplx(1.0, eta)));
+  }
+  if (coupled) {
+    const double c2 = Param(coupled, 0) * cp;
+    const double w2 = TwoPi() * Param(coupled, 1);
+    const Cplx spring2 = w2 * c2 / Param(coupled, 2) + w2 * w2 * c2 / s;
+    support += 1.0 / (1.0 / (s * c2) + 1.0 / spring2);
   }
   return 1.0 / (s * cp + support);
 }
@@ -161,6 +167,14 @@ EffectSpec DescribeEffect(EffectKind kind, const NominalNetwork& n, double f_lo,
                   {height, unit, 0.0, h_max, true, 1e-3 * h_max}};
       break;
     }
+    case EffectKind::kCoupledInertia:
+      s.equation =
+          "Ym' = Ym + 1 / (1 / (s mass_ratio Cp) + 1 / (w2 mass_ratio Cp / q2 + w2^2 mass_ratio "
+          "Cp / s)), w2 = 2 pi f2_hz";
+      s.params = {{"mass_ratio", "1", 1e-3, 10.0, true, 0.1},
+                  {"f2_hz", "Hz", 0.5 * f_lo, 5.0 * f_hi, true, std::sqrt(f_lo * f_hi)},
+                  {"q2", "1", 0.5, 3000.0, true, 30.0}};
+      break;
     case EffectKind::kAdhesiveCreep:
       s.equation = "C(f) = C0 (1 - creep_lambda log10(f / f0)) (causal power law)";
       s.params = {{"creep_lambda", "1", 0.0, 0.3, true, 0.02}};
@@ -224,9 +238,10 @@ std::complex<double> EvaluateNetwork(const NominalNetwork& n,
     }
     const AppliedEffect* creep = FindEffect(effects, EffectKind::kAdhesiveCreep);
     const AppliedEffect* fixture = FindEffect(effects, EffectKind::kFixtureCompliance);
+    const AppliedEffect* coupled = FindEffect(effects, EffectKind::kCoupledInertia);
     const Cplx motional =
-        creep || fixture
-            ? MotionalWithEffects(m, creep, fixture, s)
+        creep || fixture || coupled
+            ? MotionalWithEffects(m, creep, fixture, coupled, s)
             : m.rp_ohm / (1.0 + m.q * (s / (TwoPi() * m.f0_hz) + TwoPi() * m.f0_hz / s));
     inside = winding + motional;
   }
@@ -265,6 +280,11 @@ std::vector<DerivedParam> DeriveEffectParams(const NominalNetwork& n, const Appl
     const double k_nominal = n.NominalStiffnessNmPerRad();
     if (k_nominal > 0.0) out.push_back({"k_fixture_nm_per_rad", "N m/rad", kappa * k_nominal});
     out.push_back({"f_loaded_hz", "Hz", n.motional.f0_hz * std::sqrt(kappa / (1.0 + kappa))});
+  } else if (e.kind == EffectKind::kCoupledInertia && n.inertia_kg_m2 > 0.0) {
+    const double j2 = Param(&e, 0) * n.inertia_kg_m2;
+    const double w2 = TwoPi() * Param(&e, 1);
+    out.push_back({"j2_kg_m2", "kg m^2", j2});
+    out.push_back({"k2_nm_per_rad", "N m/rad", j2 * w2 * w2});
   } else if (e.kind == EffectKind::kLossyInductance) {
     const double l2 = Param(&e, 0);
     if (l2 > 0.0) out.push_back({"corner_hz", "Hz", Param(&e, 1) / (TwoPi() * l2)});

@@ -11,7 +11,8 @@
 // The corrected network, every effect at its place (absent effects drop out):
 //   support  Ys = Gp + 1 / (s Lp c(s))                       rotor spring + damper (+ creep)
 //            Ys' = 1 / (1/Ys + s Lp / (kappa (1 + j eta)))    fixture spring in series
-//   motional Zm' = 1 / (s Cp + Ys')
+//   coupled  Yb = 1 / (1 / (s C2) + 1 / (G2 + 1 / (s L2)))     second inertia J2 on k2 (c2)
+//   motional Zm' = 1 / (s Cp + Ys' + Yb)
 //   winding  Zw = R + dR + R a (f / 1 kHz)^2 + s L - s^2 L2^2 / (s L2 + R2)
 //   mode     Z2 = H2 / (1 + Q2 (s/w2 + w2/s))
 //   inside   Zi = Zw + Zm' + Z2                  (mobility: Zi = M0 + Z2)
@@ -47,6 +48,19 @@
 //                       further parallel R-L-C in series with the motional one (its modal
 //                       term). f in [0.5 f_lo, 2 f_hi], 0.5 <= q <= 3000,
 //                       0 < height <= 100 max|Z0|.
+//   coupled_inertia     mass_ratio mu = J2 / J, f2_hz = sqrt(k2 / J2) / (2 pi) (J2 alone on its
+//                       spring), q2 = sqrt(k2 J2) / c2: a second inertia (coupling hub, fan,
+//                       encoder disc) on a spring k2 with damper c2 at the rotor, where the
+//                       torque acts. Seen through T^2 its branch is the series of C2 = mu Cp
+//                       with (G2 + 1 / (s L2)), L2 = 1 / (w2^2 C2), G2 = w2 C2 / q2, in
+//                       parallel with the motional C-G-L. Unlike second_mode it is coupled to
+//                       the measured mode: the first mode always moves down (to
+//                       f0 / sqrt(1 + mu) when f2 >> f0, where Q rises by sqrt(1 + mu) and the
+//                       peak height Rp stays; a fixture spring keeps Q and lowers the height
+//                       with its loss) and the coupled mode rings above with its own
+//                       anti-resonance at f2. 1e-3 <= mu <= 10, f2 in [0.5 f_lo, 5 f_hi],
+//                       0.5 <= q2 <= 3000. second_mode remains the model of a mode that is
+//                       not coupled to the measured one (another path, another part).
 //   adhesive_creep      creep_lambda lambda: viscoelastic adhesive, the rotor compliance
 //                       C(f) = C0 (1 - lambda log10(f / f0)), written causally as the power law
 //                       c(s) = (s / w0)^(-n), n = lambda / ln 10 (the same real part to first
@@ -100,8 +114,9 @@ enum class EffectKind {
   kFixtureCompliance,
   kSecondMode,
   kAdhesiveCreep,
+  kCoupledInertia,
 };
-inline constexpr int kEffectKindCount = 8;
+inline constexpr int kEffectKindCount = 9;
 
 const char* ToString(EffectKind kind);  // the stable name, e.g. "fixture_compliance"
 std::optional<EffectKind> ParseEffectKind(std::string_view name);
@@ -156,6 +171,7 @@ double FixtureLossKeepingQ(double kappa, double q);
 
 // Quantities derived from fitted parameters for reports (name, unit, value):
 //   fixture_compliance: k_fixture_nm_per_rad (when J is known), f_loaded_hz;
+//   coupled_inertia:    j2_kg_m2, k2_nm_per_rad (when J is known);
 //   lossy_inductance:   corner_hz.
 struct DerivedParam {
   std::string name;
