@@ -4,7 +4,9 @@
 // Input: the nominal network calibrated to the simulation (calibration.h) and one or more
 // measured units (several units or rotor positions of one design), each line with sigma.
 // Metric: g = sqrt(mean |H_meas - H_model|^2 / sigma^2) over all lines of all units
-// (residual.h); chi2 = 2 K g^2 over 2K real residuals.
+// (residual.h); chi2 = 2 K g^2 over 2K real residuals. The noise test and the bands take
+// each unit's sigma_dof into account (residual.h: F-distributed lines when sigma is
+// estimated).
 //
 // Which (the nominal's parameters stay at the simulation's values):
 //   1. every effect of the library (effects.h) is fitted on top of the nominal, its
@@ -13,8 +15,9 @@
 //      nominal); a fit outside its plausibility bounds, or not converged, is rejected;
 //   3. the best plausible single effect is named when it lowers the score by at least
 //      min_score_gain below "none" (10: very strong evidence on the BIC scale). Otherwise the
-//      answer is "none" when the nominal's residual is consistent with the noise (chi2 test
-//      z <= noise_z_max and no significant band) and "unexplained" when it is not;
+//      answer is "none" when the nominal's residual is consistent with the noise (no
+//      significant band, and noise test z <= noise_z_max or sigma_scale <= max_sigma_scale)
+//      and "unexplained" when it is not;
 //   4. when the winner still leaves a residual inconsistent with the noise, pairs are fitted
 //      (the pair_candidates best singles among themselves, and the winner with every other
 //      effect); a plausible pair wins when it lowers the score by min_score_gain more. Its
@@ -43,6 +46,10 @@ struct GapOptions {
   // it carries 66 degrees of freedom, which alone lifts g^2 by ~3 % (z ~ 0.8 over 601 lines)
   // and spreads it (z about +-1).
   double noise_z_max = 5.0;
+  // A residual with no significant band that is uniformly at most this factor above sigma is
+  // "none" (the sigma scale is reported) even when the noise test rejects: a sigma mis-scaled
+  // by a few percent (a calibration, a dof not given) is not a model gap.
+  double max_sigma_scale = 1.1;
   bool try_pairs = true;
   int pair_candidates = 4;
   int max_iterations = 200;
@@ -98,7 +105,9 @@ struct GapSummary {
   double gap_before = 0.0, gap_after = 0.0;
   double chi2_before = 0.0, chi2_after = 0.0;
   int residuals = 0;                                 // 2K
-  double noise_z_before = 0.0, noise_z_after = 0.0;  // chi2 test z (residual.h)
+  double noise_z_before = 0.0, noise_z_after = 0.0;  // noise test z (residual.h), with
+                                                     // each unit's sigma_dof
+  double sigma_scale = 1.0;  // sqrt(mean |r|^2 / E|r|^2) of the nominal (residual.h)
   HeldOutGap heldout;
   std::vector<BandGap> where;
   std::vector<BandGap> where_after;

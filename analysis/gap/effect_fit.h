@@ -33,6 +33,9 @@ struct GapUnit {
   std::vector<double> freq_hz;
   std::vector<std::complex<double>> value;
   std::vector<double> sigma;
+  // Degrees of freedom of each sigma^2 (residual.h NoiseLine): 2 (P - 1) from P periods,
+  // times the lines pooled; 0 when sigma is known exactly.
+  double sigma_dof = 0.0;
 
   std::size_t size() const { return freq_hz.size(); }
 };

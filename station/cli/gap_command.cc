@@ -3,6 +3,7 @@
 // shrinks (also on held-out lines or units), and optionally where a second simulated design
 // would land in the measured set-up (--predict-sim). Inputs: drivers/io/gap_inputs.h;
 // report: gap_report.h; plot: drivers/io/svg_plot.h.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -33,6 +34,8 @@ struct GapArgs {
   double f_lo_hz = 0.0;
   double f_hi_hz = 0.0;
   int sigma_pool = 0;
+  double sigma_dof = 0.0;
+  int sigma_periods = 0;
   double period_s = 0.0;
   std::string input_column, output_column, lines_file;
   std::vector<std::string> effects;
@@ -155,6 +158,10 @@ int RunGap(const GapArgs& a) {
   GapReport r;
   r.quantity = io.quantity;
   r.sigma_pool = a.sigma_pool;
+  // P periods give sigma^2 with 2 (P - 1) degrees of freedom per line; pooling over 2 N + 1
+  // lines multiplies them.
+  const double dof = a.sigma_dof > 0.0 ? a.sigma_dof : 2.0 * std::max(a.sigma_periods - 1, 0);
+  r.sigma_dof = dof * (2 * a.sigma_pool + 1);
   for (const std::string& path : a.measured) {
     io::GapInput m = io::ReadGapMeasurement(path, io);
     Band(&m.frf, a.f_lo_hz, a.f_hi_hz);
@@ -181,6 +188,7 @@ int RunGap(const GapArgs& a) {
     u.freq_hz = m.frf.freq_hz;
     u.value = m.frf.value;
     u.sigma = m.sigma_estimated ? m.frf.sigma : analysis::PoolLineSigma(m.frf, a.sigma_pool);
+    u.sigma_dof = m.sigma_estimated ? 0.0 : r.sigma_dof;
     units.push_back(std::move(u));
   }
   analysis::GapOptions go;
@@ -278,6 +286,15 @@ void AddGapCommand(CLI::App& app) {
                   "on few periods and was not pooled (the periodic estimator already pools: 0)")
       ->capture_default_str()
       ->check(CLI::Range(0, 50));
+  cmd->add_option("--sigma-periods", a->sigma_periods,
+                  "The measured files' sigma comes from this many periods: each sigma^2 has "
+                  "2 (P - 1) degrees of freedom and the residual is tested as F, not chi2 "
+                  "(default: sigma exact)")
+      ->check(CLI::Range(4, 100000));
+  cmd->add_option("--sigma-dof", a->sigma_dof,
+                  "Degrees of freedom of each line's sigma^2 in the measured files (above 4; "
+                  "overrides --sigma-periods)")
+      ->check(CLI::Range(4.000001, 1e12));
   cmd->add_option("--period-s", a->period_s,
                   "Raw recordings: the excitation period (default: detect)")
       ->check(CLI::NonNegativeNumber);

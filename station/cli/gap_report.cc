@@ -84,6 +84,7 @@ json GapReportJson(const GapReport& r) {
   j["residuals"] = g.residuals;
   j["noise_z_before"] = Num(g.noise_z_before);
   j["noise_z_after"] = Num(g.noise_z_after);
+  j["sigma_scale"] = Num(g.sigma_scale);
   j["heldout"] = {{"gap_before", Num(g.heldout.gap_before)},
                   {"gap_after", Num(g.heldout.gap_after)},
                   {"method", g.heldout.method}};
@@ -141,6 +142,7 @@ json GapReportJson(const GapReport& r) {
   }
   j["measurements"] = meas;
   j["sigma_pool_lines"] = r.sigma_pool;
+  j["sigma_dof"] = Num(r.sigma_dof);
   if (r.prediction) {
     const auto& p = r.prediction->prediction;
     json effects = json::array();
@@ -184,7 +186,11 @@ std::string GapReportText(const GapReport& r) {
   if (r.sigma_pool > 0)
     os << "             sigma pooled over +-" << r.sigma_pool << " lines (relative variance)\n";
   os << "\nGAP          g = " << Fmt("%.3f", g.gap_before) << " over " << g.residuals / 2
-     << " lines (1 = within the noise; chi2 test z = " << Fmt("%.1f", g.noise_z_before) << ")\n";
+     << " lines (1 = within the noise; noise test z = " << Fmt("%.1f", g.noise_z_before)
+     << ", sigma scale " << Fmt("%.3f", g.sigma_scale) << ")\n";
+  if (r.sigma_dof > 0.0)
+    os << "             sigma^2 with " << Fmt("%.0f", r.sigma_dof)
+       << " degrees of freedom per line (F test)\n";
   os << "WHERE        ";
   if (g.where.empty()) os << "no band of the residual is significant";
   os << "\n";

@@ -7,7 +7,8 @@
 //   effects             the winner's effect names (empty for none / unexplained)
 //   params              the winner's parameters {name: value} (fitted, then derived)
 //   gap_before, gap_after        g = sqrt(mean |H_meas - H_model|^2 / sigma^2) over all lines
-//   chi2_before, chi2_after, residuals (2K), noise_z_before, noise_z_after (chi2 test z)
+//   chi2_before, chi2_after, residuals (2K), noise_z_before, noise_z_after (noise test z,
+//   residual.h), sigma_scale (sqrt(mean |r|^2 / E|r|^2) of the nominal)
 //   heldout             {gap_before, gap_after, method}: "interleaved-2fold",
 //                       "leave-one-unit-out" or "none"
 //   where               [{f_lo_hz, f_hi_hz, significance, gap_before, gap_after}] bands of the
@@ -25,6 +26,7 @@
 //                       nominal refitted to each measurement (not an unmodelled effect)
 //   measurements        [{source, kind, note, lines, sigma_estimated, gap_before, gap_after}]
 //   sigma_pool_lines    the --sigma-pool half-width used (0: the files' sigma as given)
+//   sigma_dof           degrees of freedom of each line's sigma^2 after pooling (0: exact)
 //   prediction          (with --predict-sim) {simulation, f0_simulated_hz, f0_predicted_hz,
 //                       sigma_f0_hz, q_predicted, effects [{effect, params}], message}
 //   score_rule, message
@@ -58,6 +60,7 @@ struct GapReport {
   analysis::CalibrationSummary calibration;
   std::vector<io::GapInput> measured;
   int sigma_pool = 0;
+  double sigma_dof = 0.0;
   analysis::GapSummary gap;
   std::vector<analysis::FeatureSummary> features;  // per measured unit
   std::optional<GapPrediction> prediction;
