@@ -77,6 +77,7 @@ AppliedEffect DrawEffect(EffectKind kind, const NominalNetwork& n, const std::ve
     case EffectKind::kStrayCapacitance:
     case EffectKind::kSkinEffect:
     case EffectKind::kCoupledInertia:  // not drawn: see kBenchEffectKinds
+    case EffectKind::kFractionalInductance:
     case EffectKind::kAdhesiveCreep:
       make = [](double x) { return std::vector<double>{x}; };
       log = kind == EffectKind::kStrayCapacitance;

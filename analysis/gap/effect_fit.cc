@@ -239,6 +239,19 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       }
       return Best(c, 2);
     }
+    case EffectKind::kFractionalInductance: {
+      // The share is linear for a given order: B = L (w_r^(1-n) (j w)^n - s).
+      std::vector<Candidate> c;
+      for (double order : {0.4, 0.5, 0.6, 0.7, 0.8, 0.9}) {
+        const double share = Amplitude(
+            l,
+            Shape(l, [&](double f, Cplx) { return m.l_h * (FractionalShape(order, f) - s_of(f)); }),
+            &red);
+        if (share > 0.0) c.push_back({red, {std::min(share, 0.9), order}});
+      }
+      if (c.empty()) c.push_back({0.0, {0.05, 0.7}});
+      return Best(c, 2);
+    }
     case EffectKind::kCoupledInertia: {
       // The second inertia's own frequency on a log grid over and beyond the band (above f0
       // it is the coupled mode's anti-resonance; far above, J2 acts as added inertia), times

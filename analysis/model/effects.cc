@@ -12,10 +12,12 @@ namespace {
 using Cplx = std::complex<double>;
 
 constexpr std::array<const char*, kEffectKindCount> kNames = {
-    "series_resistance",  "channel_delay", "stray_capacitance", "lossy_inductance", "skin_effect",
-    "fixture_compliance", "second_mode",   "adhesive_creep",    "coupled_inertia"};
+    "series_resistance", "channel_delay",        "stray_capacitance", "lossy_inductance",
+    "skin_effect",       "fixture_compliance",   "second_mode",       "adhesive_creep",
+    "coupled_inertia",   "fractional_inductance"};
 
 constexpr double kSkinReferenceHz = 1000.0;
+constexpr double kFractionalReferenceHz = 1000.0;
 
 double TwoPi() { return 2.0 * std::numbers::pi; }
 
@@ -68,6 +70,12 @@ Cplx MotionalWithEffects(const MotionalImpedance& m, const AppliedEffect* creep,
 }
 
 }  // namespace
+
+std::complex<double> FractionalShape(double order, double f_hz) {
+  const double w_r = TwoPi() * kFractionalReferenceHz;
+  return w_r * std::pow(f_hz / kFractionalReferenceHz, order) *
+         std::polar(1.0, order * std::numbers::pi / 2.0);
+}
 
 std::complex<double> RigidShaftMobility::At(double f_hz) const {
   const Cplx s(0.0, TwoPi() * f_hz);
@@ -167,6 +175,12 @@ EffectSpec DescribeEffect(EffectKind kind, const NominalNetwork& n, double f_lo,
                   {height, unit, 0.0, h_max, true, 1e-3 * h_max}};
       break;
     }
+    case EffectKind::kFractionalInductance:
+      s.equation =
+          "Z = Z0 + inductance_share L (w_r^(1 - order) (j w)^order - s), w_r = 2 pi 1 kHz";
+      s.params = {{"inductance_share", "1", 0.0, 0.95, true, 0.1},
+                  {"order", "1", 0.3, 0.98, false, 0.1}};
+      break;
     case EffectKind::kCoupledInertia:
       s.equation =
           "Ym' = Ym + 1 / (1 / (s mass_ratio Cp) + 1 / (w2 mass_ratio Cp / q2 + w2^2 mass_ratio "
@@ -236,6 +250,8 @@ std::complex<double> EvaluateNetwork(const NominalNetwork& n,
       const double l2 = Param(eddy, 0);
       winding -= s * s * l2 * l2 / (s * l2 + Param(eddy, 1));
     }
+    if (const AppliedEffect* frac = FindEffect(effects, EffectKind::kFractionalInductance))
+      winding += m.l_h * Param(frac, 0) * (FractionalShape(Param(frac, 1), f_hz) - s);
     const AppliedEffect* creep = FindEffect(effects, EffectKind::kAdhesiveCreep);
     const AppliedEffect* fixture = FindEffect(effects, EffectKind::kFixtureCompliance);
     const AppliedEffect* coupled = FindEffect(effects, EffectKind::kCoupledInertia);

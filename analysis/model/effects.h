@@ -14,6 +14,7 @@
 //   coupled  Yb = 1 / (1 / (s C2) + 1 / (G2 + 1 / (s L2)))     second inertia J2 on k2 (c2)
 //   motional Zm' = 1 / (s Cp + Ys' + Yb)
 //   winding  Zw = R + dR + R a (f / 1 kHz)^2 + s L - s^2 L2^2 / (s L2 + R2)
+//               + b L (w_r^(1 - n) (j w)^n - s)       (fractional, w_r = 2 pi 1 kHz)
 //   mode     Z2 = H2 / (1 + Q2 (s/w2 + w2/s))
 //   inside   Zi = Zw + Zm' + Z2                  (mobility: Zi = M0 + Z2)
 //   stray    Zc = Zi / (1 + s C Zi)
@@ -31,6 +32,12 @@
 //                       low frequency and L - L2 far above the corner R2 / (2 pi L2), where the
 //                       resistance has risen by R2). 0 < L2 <= 0.9 L; corner in
 //                       [0.1 f_lo, 100 f_hi].
+//   fractional_inductance  inductance_share b, order n: eddy currents in laminations as a
+//                       fractional-order (semi-)inductance: the share b of L becomes
+//                       b L w_r^(1 - n) (j w)^n (same |Z| at w_r = 2 pi 1 kHz; phase n 90 deg,
+//                       so Re Z rises as w^n and Im Z / w falls as w^(n - 1)), where the L2-R2
+//                       branch has one corner. The selection between them is by evidence (both
+//                       have two parameters). 0 <= b <= 0.95, 0.3 <= n <= 0.98.
 //   skin_effect         skin_r_rise_at_1khz a: skin/proximity effect below the skin-depth
 //                       transition, R(f) = R (1 + a (f / 1 kHz)^2). 0 <= a <= 3.
 //   fixture_compliance  k_fixture_ratio kappa = k_fixture / k_nominal, fixture_loss_factor eta:
@@ -115,8 +122,9 @@ enum class EffectKind {
   kSecondMode,
   kAdhesiveCreep,
   kCoupledInertia,
+  kFractionalInductance,
 };
-inline constexpr int kEffectKindCount = 9;
+inline constexpr int kEffectKindCount = 10;
 
 const char* ToString(EffectKind kind);  // the stable name, e.g. "fixture_compliance"
 std::optional<EffectKind> ParseEffectKind(std::string_view name);
@@ -165,6 +173,9 @@ std::complex<double> EvaluateNetwork(const NominalNetwork& nominal,
                                      std::span<const AppliedEffect> effects, double f_hz);
 Frf EvaluateNetwork(const NominalNetwork& nominal, std::span<const AppliedEffect> effects,
                     const std::vector<double>& freq_hz);
+
+// w_r^(1 - n) (j w)^n at f_hz, w_r = 2 pi 1 kHz: the fractional inductance's shape (H -> ohm).
+std::complex<double> FractionalShape(double order, double f_hz);
 
 // The fixture_loss_factor that keeps the nominal Q for stiffness ratio kappa (see above).
 double FixtureLossKeepingQ(double kappa, double q);
