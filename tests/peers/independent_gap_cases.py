@@ -206,13 +206,13 @@ def write_csv(path, f, z, sigma=None):
             out.write(row + "\n")
 
 
-def generate(out_dir, cases, seed, s_lo, s_hi):
+def generate(out_dir, cases, seed, s_lo, s_hi, plan=None):
     os.makedirs(out_dir, exist_ok=True)
     rng = np.random.default_rng(seed)
     f = lines()
     truth = []
     for c in range(cases):
-        kind = PLAN[c % len(PLAN)]
+        kind = (plan or PLAN)[c % len(plan or PLAN)]
         m = draw_motor(rng)
         p = draw_effect(rng, kind, m)
         z0 = impedance(m, f)
@@ -294,6 +294,8 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--s-lo", type=float, default=15.0)
     ap.add_argument("--s-hi", type=float, default=150.0)
+    ap.add_argument("--plan", default="",
+                    help="comma-separated hidden effects, cycled over the cases (default: PLAN)")
     ap.add_argument("--score", action="store_true", help="run `eol gap` on the cases")
     ap.add_argument("--eol", default="build/eol")
     ap.add_argument("extra", nargs="*", help="extra `eol gap` arguments (after --)")
@@ -301,7 +303,11 @@ def main():
     if a.score:
         score(a.out, a.eol, a.extra)
     else:
-        t = generate(a.out, a.cases, a.seed, a.s_lo, a.s_hi)
+        plan = [p for p in a.plan.split(",") if p]
+        for p in plan:
+            if p not in EXPECTED:
+                ap.error("--plan: unknown effect '%s' (known: %s)" % (p, ", ".join(EXPECTED)))
+        t = generate(a.out, a.cases, a.seed, a.s_lo, a.s_hi, plan)
         print("%d cases written to %s" % (len(t), a.out))
     return 0
 
