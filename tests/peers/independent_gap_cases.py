@@ -93,8 +93,11 @@ def draw_motor(rng):
     m["k_f"] = ratio * m["k_r"]
     q = rng.uniform(20.0, 80.0)
     c = math.sqrt(k_series * m["J"]) / q
-    m["c_r"] = 0.6 * c
-    m["c_f"] = 0.6 * c * (m["k_f"] / m["k_r"]) ** 2  # keeps the loss shared by compliance
+    # Stiffness-proportional damping (c = beta k): the two springs in series are then again
+    # one spring with one damper, the single-mode nominal the simulation is.
+    beta = c / k_series
+    m["c_r"] = beta * m["k_r"]
+    m["c_f"] = beta * m["k_f"]
     # Torque constant: motional peak T^2 / c between 0.05 and 2 times w0 L.
     peak = log_uniform(rng, 0.05, 2.0) * 2 * math.pi * f0 * m["L"]
     m["T"] = math.sqrt(peak * c)
