@@ -14,10 +14,11 @@ inline constexpr int kApplicationId = 0x454F4C53;
 // Version 0 -> 1: the initial schema.
 //
 // tests: one row per test. The columns are authoritative for identity, outcome, times,
-//   reasons and retest_of; `record` holds the rest of the TestRecord as JSON (measurements
-//   with doc lines, conditions, calibration, fit, trace), without the curves, and is NULL
-//   until the test is finished. A row is RUNNING from BeginTest until FinishTest; a RUNNING
-//   row found when the store is opened was interrupted and becomes ABORTED.
+//   reasons and retest_of (reasons: a JSON array of {"code", "text"}; rows written before
+//   reasons had codes hold plain strings, read as code "legacy"); `record` holds the rest of the
+//   TestRecord as JSON (measurements with doc lines, conditions, calibration, fit, trace), without
+//   the curves, and is NULL until the test is finished. A row is RUNNING from BeginTest until
+//   FinishTest; a RUNNING row found when the store is opened was interrupted and becomes ABORTED.
 //   Times are ISO 8601 UTC strings of one format (millisecond precision, 'Z'), so string
 //   order is time order.
 // measurements: a copy of the record's measurements for SQL queries (yield, trends, Cpk).

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string_view>
 #include <utility>
 
@@ -246,7 +247,9 @@ int AbortUnfinished(sqlite3* db, const std::string& path) {
               "WHERE outcome = 'RUNNING'",
               "open (mark unfinished tests ABORTED)");
   s.BindText(1, UtcNowIso8601());
-  s.BindText(2, nlohmann::json::array({kInterruptedReason}).dump());
+  s.BindText(2, nlohmann::json::array(
+                    {analysis::Reason{analysis::ReasonCode::kAborted, kInterruptedReason}})
+                    .dump());
   s.Run();
   return sqlite3_changes(db);
 }
@@ -287,10 +290,7 @@ void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
   s.BindText(5, record.recipe_hash);
   s.BindText(6, record.software_version);
   s.BindText(7, record.started_at);
-  if (record.kind != "production" && record.kind != "self_check")
-    throw StoreError(
-        Message(path, op, "record.kind '" + record.kind + "' is not production or self_check"));
-  s.BindText(8, record.kind);
+  s.BindText(8, ToString(record.kind));
   if (!s.Step()) throw StoreError(Message(path, op, "the insert returned no id"));
   const std::int64_t id = s.Int(0);
   const std::optional<std::int64_t> retest_of = s.OptInt(1);
@@ -345,7 +345,7 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
     m.Run();
   }
 
-  if (record.kind == "self_check") {
+  if (record.kind == RecordKind::kSelfCheck) {
     const nlohmann::json& c = record.self_check;
     const std::string check_op = op + " (write the self-check)";
     if (!c.is_object() || !c.contains("master") || !c["master"].is_string() ||
@@ -395,9 +395,11 @@ TestRecord RowToRecord(const Statement& s, const std::string& path) {
   try {
     // An aborted test has no record JSON: its columns are all there is.
     if (!s.IsNull(12)) r = nlohmann::json::parse(s.Text(12)).get<TestRecord>();
-    r.reasons = nlohmann::json::parse(s.Text(11)).get<std::vector<std::string>>();
+    r.reasons = nlohmann::json::parse(s.Text(11)).get<std::vector<analysis::Reason>>();
   } catch (const nlohmann::json::exception& e) {
     throw StoreError(Message(path, op, std::string("stored JSON is not a record: ") + e.what()));
+  } catch (const std::invalid_argument& e) {  // an unknown enum string (test_record.h)
+    throw StoreError(Message(path, op, std::string("stored record: ") + e.what()));
   }
   r.id = id;
   r.serial = s.Text(1);
@@ -413,7 +415,11 @@ TestRecord RowToRecord(const Statement& s, const std::string& path) {
   if (!parsed) throw StoreError(Message(path, op, "unknown outcome '" + outcome + "'"));
   r.outcome = *parsed;
   r.retest_of = s.OptInt(10);
-  r.kind = s.Text(13);
+  try {
+    r.kind = ParseRecordKind(s.Text(13));
+  } catch (const std::invalid_argument& e) {
+    throw StoreError(Message(path, op, e.what()));
+  }
   r.curves.clear();
   return r;
 }
@@ -638,12 +644,12 @@ std::optional<SelfCheckEntry> Store::LatestSelfCheck(const std::string& master) 
   return RowToSelfCheck(s);
 }
 
-int Store::CountTestsSince(const std::string& kind, const std::string& since) {
+int Store::CountTestsSince(RecordKind kind, const std::string& since) {
   Statement s(db_, path_,
               "SELECT count(*) FROM tests WHERE kind = ?1 AND started_at >= ?2 "
               "AND outcome <> 'RUNNING'",
-              "count " + kind + " tests since " + since);
-  s.BindText(1, kind);
+              std::string("count ") + ToString(kind) + " tests since " + since);
+  s.BindText(1, ToString(kind));
   s.BindText(2, since);
   if (!s.Step()) throw StoreError(Message(path_, "count tests", "no result"));
   return static_cast<int>(s.Int(0));
@@ -667,7 +673,7 @@ std::vector<MeasurementRow> Store::MeasurementRows(const MeasurementQuery& q) {
   if (serial_i) sql += " AND t.serial = ?" + std::to_string(serial_i);
   sql += " ORDER BY t.started_at, t.id, m.id LIMIT 1000000";
   Statement s(db_, path_, sql, "read measurements for statistics");
-  s.BindText(1, q.kind);
+  s.BindText(1, ToString(q.kind));
   if (from_i) s.BindText(from_i, *q.from);
   if (to_i) s.BindText(to_i, *q.to);
   if (hash_i) s.BindText(hash_i, *q.recipe_hash);

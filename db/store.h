@@ -71,7 +71,7 @@ struct MeasurementQuery {
   std::optional<std::string> to;    // exclusive
   std::optional<std::string> recipe_hash;
   std::optional<std::string> serial;
-  std::string kind = "production";  // "production" or "self_check"
+  RecordKind kind = RecordKind::kProduction;
 };
 
 struct MeasurementRow {
@@ -132,7 +132,7 @@ class Store {
   // The newest check of one master ("good" or "limit"), if any.
   std::optional<SelfCheckEntry> LatestSelfCheck(const std::string& master);
   // Finished (or aborted) tests of `kind` that started at or after `since` (ISO 8601).
-  int CountTestsSince(const std::string& kind, const std::string& since);
+  int CountTestsSince(RecordKind kind, const std::string& since);
   // Every measurement row of finished PASS/FAIL/ERROR tests matching the query, in test order
   // (started_at, id), at most 1,000,000 rows.
   std::vector<MeasurementRow> MeasurementRows(const MeasurementQuery& query);

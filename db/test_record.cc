@@ -3,58 +3,29 @@
 #include <cmath>
 #include <limits>
 
-namespace eol::analysis {
-namespace {
-// JSON has no NaN: unknown numbers are null.
-nlohmann::json Num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-double NumOr(const nlohmann::json& j, const char* key) {
-  const auto it = j.find(key);
-  if (it == j.end() || it->is_null()) return std::numeric_limits<double>::quiet_NaN();
-  return it->get<double>();
-}
-}  // namespace
-
-void to_json(nlohmann::json& j, const Limit& l) {
-  j = nlohmann::json::object();
-  j["lo"] = l.lo ? nlohmann::json(*l.lo) : nlohmann::json();
-  j["hi"] = l.hi ? nlohmann::json(*l.hi) : nlohmann::json();
-  j["marginal"] = l.marginal;
-}
-
-void from_json(const nlohmann::json& j, Limit& l) {
-  l = Limit{};
-  if (j.contains("lo") && !j.at("lo").is_null()) l.lo = j.at("lo").get<double>();
-  if (j.contains("hi") && !j.at("hi").is_null()) l.hi = j.at("hi").get<double>();
-  l.marginal = j.value("marginal", 0.0);
-}
-
-void to_json(nlohmann::json& j, const Measurement& m) {
-  j = {{"name", m.name},
-       {"unit", m.unit},
-       {"doc", m.doc},
-       {"value", Num(m.value)},
-       {"sigma", Num(m.sigma)},
-       {"limit", m.limit},
-       {"outcome", ToString(m.outcome)},
-       {"marginal", m.marginal}};
-}
-
-void from_json(const nlohmann::json& j, Measurement& m) {
-  m.name = j.at("name").get<std::string>();
-  m.unit = j.value("unit", "");
-  m.doc = j.value("doc", "");
-  m.value = NumOr(j, "value");
-  m.sigma = NumOr(j, "sigma");
-  m.limit = j.value("limit", Limit{});
-  const std::string o = j.value("outcome", "UNSET");
-  m.outcome = o == "PASS"   ? MeasurementOutcome::kPass
-              : o == "FAIL" ? MeasurementOutcome::kFail
-                            : MeasurementOutcome::kUnset;
-  m.marginal = j.value("marginal", false);
-}
-}  // namespace eol::analysis
+#include "analysis/enum_names.h"
 
 namespace eol::db {
+
+const char* ToString(RecordKind k) {
+  switch (k) {
+    case RecordKind::kProduction:
+      return "production";
+    case RecordKind::kSelfCheck:
+      return "self_check";
+  }
+  return "production";
+}
+
+RecordKind ParseRecordKind(std::string_view name) {
+  return analysis::ParseEnumOrThrow("kind", name, kAllRecordKinds);
+}
+
+void to_json(nlohmann::json& j, const RecordKind& k) { j = ToString(k); }
+
+void from_json(const nlohmann::json& j, RecordKind& k) {
+  k = ParseRecordKind(j.get<std::string>());
+}
 
 void to_json(nlohmann::json& j, const Curve& c) {
   j = {{"name", c.name}, {"unit", c.unit}, {"freq_hz", c.freq_hz},
@@ -103,7 +74,7 @@ void to_json(nlohmann::json& j, const TestRecord& r) {
        {"started_at", r.started_at},
        {"finished_at", r.finished_at},
        {"retest_of", r.retest_of ? nlohmann::json(*r.retest_of) : nlohmann::json()},
-       {"outcome", analysis::ToString(r.outcome)},
+       {"outcome", r.outcome},
        {"reasons", r.reasons},
        {"measurements", r.measurements},
        {"conditions", r.conditions},
@@ -129,19 +100,15 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   r.retest_of.reset();
   if (j.contains("retest_of") && !j.at("retest_of").is_null())
     r.retest_of = j.at("retest_of").get<std::int64_t>();
-  const std::string outcome = j.at("outcome").get<std::string>();
-  const auto parsed = analysis::ParseOutcome(outcome);
-  if (!parsed)
-    throw nlohmann::json::other_error::create(501, "outcome: unknown value '" + outcome + "'", &j);
-  r.outcome = *parsed;
-  r.reasons = j.value("reasons", std::vector<std::string>{});
+  r.outcome = j.at("outcome").get<analysis::Outcome>();
+  r.reasons = j.value("reasons", std::vector<analysis::Reason>{});
   r.measurements = j.value("measurements", std::vector<analysis::Measurement>{});
   r.conditions = j.value("conditions", nlohmann::json::object());
   r.calibration = j.value("calibration", nlohmann::json::object());
   r.fit = j.value("fit", nlohmann::json::object());
   r.curves = j.value("curves", std::vector<Curve>{});
   r.trace = j.value("trace", std::vector<StateEntry>{});
-  r.kind = j.value("kind", "production");
+  r.kind = j.value("kind", RecordKind::kProduction);
   r.self_check = j.value("self_check", nlohmann::json::object());
 }
 

@@ -4,15 +4,29 @@
 // the fit, the verdict with reasons, the raw curves and the sequencer's state trace.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "analysis/qc/measurement.h"
+#include "analysis/qc/measurement_json.h"
 
 namespace eol::db {
+
+// What was tested (schema v3): a production unit, or a master part that checks the station
+// (never in production statistics). Stored as "production" | "self_check" (ToString) in the
+// tests.kind column and the record JSON; the schema's CHECK holds the same two strings.
+enum class RecordKind { kProduction, kSelfCheck };
+inline constexpr std::array kAllRecordKinds = {RecordKind::kProduction, RecordKind::kSelfCheck};
+const char* ToString(RecordKind k);
+// The kind named `name`; std::invalid_argument "kind: unknown value 'x' (accepted: ...)".
+RecordKind ParseRecordKind(std::string_view name);
+void to_json(nlohmann::json& j, const RecordKind& k);
+void from_json(const nlohmann::json& j, RecordKind& k);
 
 // A curve over frequency (the measured impedance with its sigma, a limit mask, ...).
 struct Curve {
@@ -44,7 +58,10 @@ struct TestRecord {
   std::optional<std::int64_t> retest_of;  // id of the first test of this serial, if any
 
   analysis::Outcome outcome = analysis::Outcome::kError;
-  std::vector<std::string> reasons;
+  // Why the outcome is what it is, the decisive first: [{"code", "text"}] in JSON
+  // (analysis/qc/measurement.h lists the codes). Old records whose reasons are plain strings
+  // read back with the code "legacy".
+  std::vector<analysis::Reason> reasons;
   std::vector<analysis::Measurement> measurements;
 
   // Conditions and context, free-form but with unit-carrying keys:
@@ -55,9 +72,7 @@ struct TestRecord {
   std::vector<Curve> curves;
   std::vector<StateEntry> trace;
 
-  // What was tested (schema v3): "production" (a unit) or "self_check" (a master part that
-  // checks the station; never in production statistics).
-  std::string kind = "production";
+  RecordKind kind = RecordKind::kProduction;
   // For a self-check: {"master": "good" | "limit", "passed": bool, "detail": "..."}; the store
   // writes it to the self_checks table in the test's own transaction. Empty otherwise.
   nlohmann::json self_check = nlohmann::json::object();
@@ -68,14 +83,8 @@ void from_json(const nlohmann::json& j, Curve& c);
 void to_json(nlohmann::json& j, const StateEntry& s);
 void from_json(const nlohmann::json& j, StateEntry& s);
 void to_json(nlohmann::json& j, const TestRecord& r);
-// Throws nlohmann::json::exception naming the field when the JSON is not a record.
+// Throws nlohmann::json::exception naming the field when the JSON is not a record, and
+// std::invalid_argument naming the field for an unknown outcome or kind.
 void from_json(const nlohmann::json& j, TestRecord& r);
 
 }  // namespace eol::db
-
-namespace eol::analysis {
-void to_json(nlohmann::json& j, const Limit& l);
-void from_json(const nlohmann::json& j, Limit& l);
-void to_json(nlohmann::json& j, const Measurement& m);
-void from_json(const nlohmann::json& j, Measurement& m);
-}  // namespace eol::analysis

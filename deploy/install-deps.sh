@@ -11,7 +11,8 @@ build_pkgs=(
   libsndfile1-dev libsystemd-dev
 )
 test_pkgs=(
-  python3 python3-numpy python3-scipy python3-pymodbus python3-can can-utils socat sqlite3
+  python3 python3-numpy python3-scipy python3-pymodbus python3-serial-asyncio python3-can
+  can-utils socat sqlite3
   chromium dpkg-dev pulseaudio libasound2-plugins clang-format
 )
 

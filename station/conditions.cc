@@ -35,22 +35,31 @@ double RmsAfter(const std::vector<double>& x, std::size_t skip) {
 }
 
 std::vector<std::string> EvaluateConditions(const ConditionWindows& w,
-                                            const analysis::Recording& rec,
+                                            const analysis::Recording* rec,
                                             std::size_t transient_periods,
-                                            std::optional<double> r_ohm,
-                                            nlohmann::json& conditions) {
-  const std::size_t skip = transient_periods * rec.period_samples;
-  const double v_rms = RmsAfter(rec.voltage_v, skip);
-  const double a_rms = RmsAfter(rec.current_a, skip);
-  conditions["excitation_v_rms"] = v_rms;  // NaN is stored as null
-  conditions["excitation_a_rms"] = a_rms;
+                                            std::optional<double> r_ohm, nlohmann::json& conditions,
+                                            std::vector<std::string>* not_evaluated) {
+  double v_rms = std::nan(""), a_rms = std::nan("");
+  if (rec) {
+    const std::size_t skip = transient_periods * rec->period_samples;
+    v_rms = RmsAfter(rec->voltage_v, skip);
+    a_rms = RmsAfter(rec->current_a, skip);
+    conditions["excitation_v_rms"] = v_rms;  // NaN is stored as null
+    conditions["excitation_a_rms"] = a_rms;
+  }
   std::vector<std::string> out;
   if (!w.enabled) return out;
   auto check = [&out](const std::string& line) {
     if (!line.empty()) out.push_back(line);
   };
-  check(Outside("excitation level", v_rms, w.excitation_v_rms, "V rms", 3));
-  check(Outside("excitation current", a_rms, w.excitation_a_rms, "A rms", 3));
+  if (rec) {
+    check(Outside("excitation level", v_rms, w.excitation_v_rms, "V rms", 3));
+    check(Outside("excitation current", a_rms, w.excitation_a_rms, "A rms", 3));
+  } else if (not_evaluated) {
+    auto set = [](const analysis::Limit& l) { return l.lo.has_value() || l.hi.has_value(); };
+    if (set(w.excitation_v_rms)) not_evaluated->push_back("excitation_v_rms");
+    if (set(w.excitation_a_rms)) not_evaluated->push_back("excitation_a_rms");
+  }
   if (w.r_ref_ohm > 0.0 && r_ohm && std::isfinite(*r_ohm)) {
     const double t_c = WindingTemperatureC(*r_ohm, w.r_ref_ohm, w.t_ref_c);
     conditions["winding_temperature_c"] = t_c;

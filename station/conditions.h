@@ -60,11 +60,13 @@ double RmsAfter(const std::vector<double>& x, std::size_t skip);
 // Writes excitation_v_rms, excitation_a_rms and (with r_ref_ohm and a finite r_ohm)
 // winding_temperature_c into `conditions`, and returns one line per condition outside its
 // window: "winding temperature 61.3 degC outside 0.0..45.0 degC". Nothing is checked when the
-// windows are not enabled.
+// windows are not enabled. Without a recording (an FRF file judged offline) the excitation
+// levels cannot be known: they are neither written nor checked, and the name of each such
+// window the recipe sets is appended to `not_evaluated` ("excitation_v_rms", ...).
 std::vector<std::string> EvaluateConditions(const ConditionWindows& windows,
-                                            const analysis::Recording& recording,
+                                            const analysis::Recording* recording,
                                             std::size_t transient_periods,
-                                            std::optional<double> r_ohm,
-                                            nlohmann::json& conditions);
+                                            std::optional<double> r_ohm, nlohmann::json& conditions,
+                                            std::vector<std::string>* not_evaluated = nullptr);
 
 }  // namespace eol::station

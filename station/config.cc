@@ -15,6 +15,22 @@ std::string Resolve(const std::string& base_dir, const std::string& p) {
 
 }  // namespace
 
+const char* ToString(Role role) {
+  switch (role) {
+    case Role::kOperator:
+      return "operator";
+    case Role::kEngineer:
+      return "engineer";
+  }
+  return "unknown";
+}
+
+std::optional<Role> ParseRole(std::string_view text) {
+  for (Role r : {Role::kOperator, Role::kEngineer})
+    if (text == ToString(r)) return r;
+  return std::nullopt;
+}
+
 StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,
                                  const std::string& base_dir) {
   using io::JsonObject;
@@ -33,10 +49,9 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
         if (!list.is_array()) throw io::ConfigError(http->PathOf("tokens") + ": must be an array");
         for (std::size_t i = 0; i < list.size(); ++i) {
           const JsonObject t(list[i], http->PathOf("tokens") + "/" + std::to_string(i));
-          ApiToken token{t.RequiredString("name"), t.RequiredString("role"),
-                         t.RequiredString("token")};
-          t.Require(token.role == "operator" || token.role == "engineer", "role",
-                    "must be operator or engineer");
+          const std::optional<Role> role = ParseRole(t.RequiredString("role"));
+          t.Require(role.has_value(), "role", "must be one of: operator, engineer");
+          ApiToken token{t.RequiredString("name"), *role, t.RequiredString("token")};
           // Token values never appear in messages.
           if (token.token.size() < 16)
             throw io::ConfigError(t.PathOf("token") + ": must be at least 16 characters");

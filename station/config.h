@@ -20,7 +20,9 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace eol::station {
@@ -31,9 +33,18 @@ struct SafetyOptions {
   double poll_period_ms = 10.0;        // clamp/release confirmation polling
 };
 
+// What a token may do. Operators start tests; engineers also change and teach recipes.
+// Ordered: a higher role may do everything a lower one may.
+enum class Role { kOperator, kEngineer };
+
+// "operator" or "engineer", as in the config and the audit log.
+const char* ToString(Role role);
+// The role named `text`, or nullopt when it names none.
+std::optional<Role> ParseRole(std::string_view text);
+
 struct ApiToken {
   std::string name;  // who, in the audit log
-  std::string role;  // "operator" or "engineer"
+  Role role = Role::kOperator;
   std::string token;
 };
 

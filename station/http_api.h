@@ -24,29 +24,32 @@
 // Errors are JSON {"error": {"code": "...", "message": "..."}} with a fitting HTTP status.
 // Reads need no token; request bodies are limited to 64 KiB. Reads of the database go
 // through a connection of the API's own that never recovers unfinished tests.
+//
+// This is a thin transport: one handler per route in station/http/*_routes.cc, sharing
+// RequireRole and ParseBody (station/http/request.h); the station decides (RecipeChange,
+// TeachResult) and only station/http/ maps its typed results to statuses and JSON.
 #pragma once
 
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <thread>
-#include <utility>
 #include <vector>
 
 #include "station/config.h"
 #include "station/recipe.h"
+#include "station/recipe_change.h"
 #include "station/status_board.h"
 
 namespace httplib {
 class Server;
 }
 
-namespace eol::db {
-class Store;
-}
-
 namespace eol::station {
+
+namespace http {
+struct ApiContext;
+}
 
 struct HttpOptions {
   std::string listen = "127.0.0.1";
@@ -65,9 +68,8 @@ struct HttpHandlers {
   std::function<nlohmann::json()> recipe;
   // The recipe in use, parsed (teaching and detectability work from it).
   std::function<std::shared_ptr<const Recipe>()> current_recipe;
-  // Validates, stores and activates a new recipe version; returns the HTTP status and body.
-  std::function<std::pair<int, nlohmann::json>(const nlohmann::json& recipe, const ApiToken& who)>
-      change_recipe;
+  // Validates, stores and activates a new recipe version (Station::ChangeRecipe).
+  std::function<RecipeChange(const nlohmann::json& recipe, const ApiToken& who)> change_recipe;
 };
 
 class HttpApi {
@@ -83,16 +85,10 @@ class HttpApi {
   int port() const { return port_; }
 
  private:
-  void Routes();
-
-  StatusBoard& board_;
-  HttpOptions options_;
-  HttpHandlers handlers_;
+  std::unique_ptr<http::ApiContext> context_;
   std::unique_ptr<httplib::Server> server_;
   std::thread thread_;
   int port_ = 0;
-  std::mutex db_mu_;
-  std::unique_ptr<db::Store> db_;
 };
 
 }  // namespace eol::station

@@ -1,46 +1,36 @@
 #include "station/qc_service.h"
 
+#include "station/serial_number.h"
+
 namespace eol::station {
 
 using nlohmann::json;
 
-json MaskJson(const analysis::CurveMask& m) {
-  json points = json::array();
-  for (const analysis::MaskPoint& p : m.points) {
-    json pt = {{"f_hz", p.f_hz}};
-    if (p.lo) pt["lo"] = *p.lo;
-    if (p.hi) pt["hi"] = *p.hi;
-    points.push_back(pt);
-  }
-  return {{"name", m.name},
-          {"quantity", m.quantity == analysis::MaskQuantity::kReOhm ? "re_ohm" : "abs_ohm"},
-          {"max_lines_outside", m.max_lines_outside},
-          {"guard_sigma", m.guard_sigma},
-          {"points", points}};
-}
-
 json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
                       const analysis::TeachOptions& o) {
-  json j = r.source;
-  j["version"] = r.version + 1;
-  for (json& l : j["limits"]) {
+  Recipe taught = r;
+  taught.version = r.version + 1;
+  for (analysis::MeasurementSpec& l : taught.limits) {
     for (const analysis::MeasurementSpec& spec : s.limits) {
-      if (l.at("name") != spec.name) continue;
-      if (spec.limit.lo) l["lo"] = *spec.limit.lo;
-      if (spec.limit.hi) l["hi"] = *spec.limit.hi;
-      l["marginal"] = spec.limit.marginal;
+      if (l.name != spec.name) continue;
+      if (spec.limit.lo) l.limit.lo = spec.limit.lo;
+      if (spec.limit.hi) l.limit.hi = spec.limit.hi;
+      l.limit.marginal = spec.limit.marginal;
     }
   }
-  if (!s.masks.empty()) {
-    j["masks"] = json::array();
-    for (const analysis::CurveMask& m : s.masks) j["masks"].push_back(MaskJson(m));
-  }
-  const std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
-                           std::to_string(s.units_used) + " golden units (" + o.method +
-                           ", coverage " + json(o.coverage).dump() + ", confidence " +
-                           json(o.confidence).dump() + ", k " + json(s.k_factor).dump() + ").";
-  j["description"] = j.value("description", std::string()) + note;
-  return j;
+  if (!s.masks.empty()) taught.masks = s.masks;
+  std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
+                     std::to_string(s.units_used) + " golden units (" +
+                     analysis::ToString(o.method) + ", allocation " + o.allocation +
+                     ", false-reject target " + json(1.0 - o.coverage).dump() + ", confidence " +
+                     json(o.confidence).dump() + ", expected false rejects " +
+                     json(s.expected_false_reject).dump() + " [" + json(s.false_reject_lo).dump() +
+                     ", " + json(s.false_reject_hi).dump() + "]).";
+  if (s.few_units_forced)
+    note += " FORCED: " + std::to_string(s.units_used) + " golden units where " +
+            std::to_string(s.units_needed) + " are needed.";
+  taught.description += note;
+  return RecipeToJson(taught);
 }
 
 json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOptions& o) {
@@ -53,8 +43,25 @@ json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOpti
   for (const auto& t : s.statistics)
     stats.push_back({{"name", t.name}, {"centre", t.centre}, {"scale", t.scale}});
   for (const auto& m : s.masks) masks.push_back(MaskJson(m));
+  json bounds = json::array();
+  for (const auto& b : s.taught_bounds)
+    bounds.push_back({{"statistic", b.statistic},
+                      {"side", b.lo ? "lo" : "hi"},
+                      {"role", b.defect_side ? "defect" : "plausibility"},
+                      {"share", b.share},
+                      {"k", b.k},
+                      {"limit", b.limit}});
   return {{"usable", s.usable},
           {"method", o.method},
+          {"allocation", o.allocation},
+          {"false_reject_target", 1.0 - o.coverage},
+          {"expected_false_reject",
+           {{"value", s.expected_false_reject},
+            {"lo", s.false_reject_lo},
+            {"hi", s.false_reject_hi},
+            {"confidence", o.confidence}}},
+          {"few_units_forced", s.few_units_forced},
+          {"taught_bounds", bounds},
           {"confidence", o.confidence},
           {"coverage", o.coverage},
           {"bounds", s.bounds},
@@ -84,6 +91,58 @@ analysis::GoldenUnit GoldenFromRecord(const db::TestRecord& r, const std::string
     u.curve.method = "record";
   }
   return u;
+}
+
+TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe& recipe,
+                           const std::vector<std::string>& serials,
+                           const analysis::TeachOptions& options) {
+  TeachResult result;
+  for (const std::string& serial : serials) {
+    std::string why;
+    if (!ValidSerial(serial, &why)) {
+      result.kind = TeachResult::Kind::kBadSerial;
+      result.message = "serials: " + json(serial).dump() + ": " + why;
+      return result;
+    }
+  }
+  std::vector<analysis::GoldenUnit> golden;
+  json skipped = json::array();
+  {
+    std::lock_guard<std::mutex> lock(store_mu);
+    for (const std::string& serial : serials) {
+      const auto latest = store.LatestOfSerial(serial);
+      if (!latest || latest->outcome == analysis::Outcome::kError ||
+          latest->outcome == analysis::Outcome::kAborted) {
+        skipped.push_back(serial + (latest ? ": latest test is " +
+                                                 std::string(analysis::ToString(latest->outcome))
+                                           : ": no test stored"));
+        continue;
+      }
+      const auto full = store.Test(latest->id, true);
+      if (full) golden.push_back(GoldenFromRecord(*full, serial));
+    }
+  }
+  const analysis::TeachSummary summary = analysis::TeachLimits(recipe.limits, golden, options);
+  result.report = TeachSummaryJson(summary, options);
+  result.report["skipped"] = skipped;
+  result.report["previous"] = {
+      {"id", recipe.id}, {"version", recipe.version}, {"hash", recipe.hash}};
+  if (!summary.usable) {
+    result.kind = TeachResult::Kind::kNotUsable;
+    result.message = summary.message;
+    return result;
+  }
+  const json proposed = TaughtRecipeJson(recipe, summary, options);
+  try {
+    const Recipe checked = ParseRecipe(proposed, "taught recipe");
+    result.report["recipe"] = proposed;
+    result.report["recipe_hash"] = checked.hash;
+  } catch (const std::exception& e) {
+    result.kind = TeachResult::Kind::kInvalidRecipe;
+    result.message = e.what();
+    result.report = json();
+  }
+  return result;
 }
 
 analysis::DetectabilityOptions DetectabilityOptionsFor(const Recipe& r, double k_fixture_nm_per_rad,

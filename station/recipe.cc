@@ -260,4 +260,92 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
 
 Recipe LoadRecipe(const std::string& path) { return ParseRecipe(io::ReadJsonFile(path), path); }
 
+// The emitting half of the field list above: every key ParseRecipe reads, in its schema.
+namespace {
+
+void PutWindow(nlohmann::json& j, const analysis::Limit& l) {
+  if (l.lo) j["lo"] = *l.lo;
+  if (l.hi) j["hi"] = *l.hi;
+}
+
+nlohmann::json LimitJson(const analysis::MeasurementSpec& s) {
+  nlohmann::json j = {{"name", s.name}, {"unit", s.unit}, {"doc", s.doc}};
+  PutWindow(j, s.limit);
+  j["marginal"] = s.limit.marginal;
+  return j;
+}
+
+nlohmann::json ConditionsJson(const ConditionWindows& w) {
+  nlohmann::json j = {{"out_of_window", w.error_when_out ? "error" : "record"}};
+  if (w.r_ref_ohm > 0) {
+    nlohmann::json t = {{"r_ref_ohm", w.r_ref_ohm}, {"t_ref_c", w.t_ref_c}};
+    PutWindow(t, w.winding_temperature_c);
+    j["winding_temperature_c"] = t;
+  }
+  if (w.excitation_v_rms.lo || w.excitation_v_rms.hi) {
+    j["excitation_v_rms"] = nlohmann::json::object();
+    PutWindow(j["excitation_v_rms"], w.excitation_v_rms);
+  }
+  if (w.excitation_a_rms.lo || w.excitation_a_rms.hi) {
+    j["excitation_a_rms"] = nlohmann::json::object();
+    PutWindow(j["excitation_a_rms"], w.excitation_a_rms);
+  }
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json MaskJson(const analysis::CurveMask& m) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const analysis::MaskPoint& p : m.points) {
+    nlohmann::json pt = {{"f_hz", p.f_hz}};
+    if (p.lo) pt["lo"] = *p.lo;
+    if (p.hi) pt["hi"] = *p.hi;
+    points.push_back(pt);
+  }
+  return {{"name", m.name},
+          {"quantity", m.quantity == analysis::MaskQuantity::kReOhm ? "re_ohm" : "abs_ohm"},
+          {"max_lines_outside", m.max_lines_outside},
+          {"guard_sigma", m.guard_sigma},
+          {"points", points}};
+}
+
+nlohmann::json RecipeToJson(const Recipe& r) {
+  nlohmann::json pairs = nlohmann::json::array();
+  for (drivers::PhasePair p : r.phase_pairs) pairs.push_back(static_cast<int>(p));
+  nlohmann::json limits = nlohmann::json::array();
+  for (const analysis::MeasurementSpec& s : r.limits) limits.push_back(LimitJson(s));
+  nlohmann::json masks = nlohmann::json::array();
+  for (const analysis::CurveMask& m : r.masks) masks.push_back(MaskJson(m));
+  nlohmann::json j = {
+      {"id", r.id},
+      {"version", r.version},
+      {"description", r.description},
+      {"motor", {{"poles", r.poles}, {"rotor_inertia_kg_m2", r.rotor_inertia_kg_m2}}},
+      {"excitation",
+       {{"f_lo_hz", r.excitation.f_lo_hz},
+        {"f_hi_hz", r.excitation.f_hi_hz},
+        {"line_spacing_hz", r.excitation.line_spacing_hz},
+        {"sample_rate_hz", r.excitation.sample_rate_hz},
+        {"peak_v", r.excitation.peak_v},
+        {"crest_iterations", r.excitation.crest_iterations},
+        {"periods", r.periods},
+        {"transient_periods", r.transient_periods},
+        {"phase_pairs", pairs}}},
+      {"fixture",
+       {{"clamp_pressure_bar", {{"lo", r.clamp_pressure_lo_bar}, {"hi", r.clamp_pressure_hi_bar}}},
+        {"clamp_timeout_s", r.clamp_timeout_s},
+        {"release_timeout_s", r.release_timeout_s}}},
+      {"analysis",
+       {{"f0_min_hz", r.analysis.fit.f0_min_hz},
+        {"f0_max_hz", r.analysis.fit.f0_max_hz},
+        {"q_min", r.analysis.fit.q_min},
+        {"q_max", r.analysis.fit.q_max}}},
+      {"retest", {{"max_tests_per_serial", r.max_tests_per_serial}}},
+      {"limits", limits},
+      {"masks", masks}};
+  if (r.conditions.enabled) j["conditions"] = ConditionsJson(r.conditions);
+  return j;
+}
+
 }  // namespace eol::station

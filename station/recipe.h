@@ -81,6 +81,14 @@ struct Recipe {
 Recipe ParseRecipe(const nlohmann::json& j, const std::string& source);
 Recipe LoadRecipe(const std::string& path);
 
+// The recipe as JSON in the schema ParseRecipe reads (every key, defaults written out), so
+// that ParseRecipe(RecipeToJson(r)) gives r back (tests/station/recipe_test.cc). Used for
+// every recipe the station writes (a taught proposal); the hash stays that of the file's own
+// JSON as loaded.
+nlohmann::json RecipeToJson(const Recipe& r);
+// One curve mask in the recipe's "masks" schema.
+nlohmann::json MaskJson(const analysis::CurveMask& mask);
+
 std::string Sha256Hex(const std::string& data);
 std::string CanonicalHash(const nlohmann::json& j);
 

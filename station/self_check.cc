@@ -43,7 +43,7 @@ std::optional<std::string> MasterRole(const SelfCheckConfig& c, const std::strin
 nlohmann::json JudgeMasterTest(const std::string& master, const db::TestRecord& r) {
   const std::string who = master + " master " + r.serial;
   const std::string outcome = analysis::ToString(r.outcome);
-  const std::string first = r.reasons.empty() ? "" : ": " + r.reasons.front();
+  const std::string first = r.reasons.empty() ? "" : ": " + r.reasons.front().text;
   const analysis::Measurement* f0 = FindMeasurement(r, analysis::names::kResonanceFHz);
   const std::string f0_text =
       f0 && std::isfinite(f0->value)
@@ -103,7 +103,7 @@ LockoutState EvaluateLockout(const SelfCheckConfig& c, db::Store& store,
     }
   }
   const std::string since = std::min(s.good->at, s.limit->at);
-  s.tests_since_check = store.CountTestsSince("production", since);
+  s.tests_since_check = store.CountTestsSince(db::RecordKind::kProduction, since);
   if (c.every_hours > 0) {
     const auto valid = std::chrono::duration_cast<std::chrono::system_clock::duration>(
         std::chrono::duration<double, std::ratio<3600>>(c.every_hours));

@@ -7,11 +7,12 @@
 #include <sstream>
 #include <thread>
 
+#include "analysis/fit/fit_json.h"
 #include "analysis/impedance_analysis.h"
-#include "analysis/qc/measurement_names.h"
 #include "analysis/text.h"
 #include "db/clock.h"
 #include "drivers/daq/calibration_file.h"
+#include "station/judge.h"
 #include "station/self_check.h"
 #include "station/version.h"
 
@@ -19,6 +20,8 @@ namespace eol::station {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using analysis::Outcome;
+using analysis::ReasonCode;
 using drivers::FixtureOutput;
 
 using analysis::Fixed;
@@ -34,22 +37,6 @@ db::Curve ToCurve(const analysis::Frf& z, const std::string& name) {
   }
   c.sigma = z.sigma;
   return c;
-}
-
-nlohmann::json FitJson(const analysis::FitSummary& fit) {
-  nlohmann::json params = nlohmann::json::object();
-  for (const auto& p : fit.params)
-    params[p.name] = {{"value", p.value}, {"sigma", p.sigma}, {"unit", p.unit}};
-  return {{"model", fit.model},
-          {"usable", fit.usable},
-          {"termination", fit.termination},
-          {"message", fit.message},
-          {"params", params},
-          {"chi2", fit.chi2},
-          {"dof", fit.dof},
-          {"chi2_per_dof", fit.chi2_per_dof},
-          {"iterations", fit.iterations},
-          {"sigma_estimated", fit.sigma_estimated}};
 }
 
 }  // namespace
@@ -112,7 +99,15 @@ std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& r, bo
 // A fault that ends the test: ERROR (station fault) or ABORTED (stop requested).
 struct Sequencer::Fault {
   analysis::Outcome outcome;
-  std::string reason;
+  analysis::Reason reason;
+};
+
+// One phase pair measured: its recording is kept for the judge (conditions are computed
+// from it).
+struct Sequencer::MeasuredPair {
+  drivers::PhasePair pair;
+  analysis::Recording recording;
+  analysis::ImpedanceAnalysis analysis;
 };
 
 // Polls the interlocks while the stator is excited. On the first broken interlock it opens
@@ -210,7 +205,7 @@ void Sequencer::RequestAbort(const std::string& why) {
 void Sequencer::ThrowIfAborted() {
   if (!stop_requested_.load()) return;
   std::lock_guard<std::mutex> lock(abort_mu_);
-  throw Fault{analysis::Outcome::kAborted, "aborted: " + abort_reason_};
+  throw Fault{Outcome::kAborted, {ReasonCode::kAborted, "aborted: " + abort_reason_}};
 }
 
 void Sequencer::Enter(db::TestRecord& record, SeqState s, const std::string& detail) {
@@ -218,13 +213,14 @@ void Sequencer::Enter(db::TestRecord& record, SeqState s, const std::string& det
   const double t_ms = std::chrono::duration<double, std::milli>(Clock::now() - test_start_).count();
   record.trace.push_back({ToString(s), t_ms, detail});
   spdlog::info("[{}] {}{}{}", record.serial, ToString(s), detail.empty() ? "" : ": ", detail);
-  board_.OnState(record.serial, ToString(s), detail);
+  board_.OnState(record.serial, s, detail);
 }
 
 drivers::FixtureInputs Sequencer::ReadInputs(const char* purpose) {
   auto in = fixture_.ReadInputs();
   if (!in.ok())
-    throw Fault{analysis::Outcome::kError, std::string(purpose) + ": " + in.status().message()};
+    throw Fault{Outcome::kError,
+                {ReasonCode::kFixture, std::string(purpose) + ": " + in.status().message()}};
   return in.value();
 }
 
@@ -234,29 +230,31 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
   if (fixture_.lifecycle() != drivers::Lifecycle::kInactive &&
       fixture_.lifecycle() != drivers::Lifecycle::kActive) {
     if (const drivers::Status s = fixture_.Connect(); !s.ok())
-      throw Fault{analysis::Outcome::kError, "fixture unavailable: " + s.message()};
+      throw Fault{Outcome::kError, {ReasonCode::kFixture, "fixture unavailable: " + s.message()}};
   }
   if (daq_.lifecycle() != drivers::Lifecycle::kInactive) {
     if (const drivers::Status s = daq_.Connect(); !s.ok())
-      throw Fault{analysis::Outcome::kError, "acquisition unavailable: " + s.message()};
+      throw Fault{Outcome::kError,
+                  {ReasonCode::kAcquisition, "acquisition unavailable: " + s.message()}};
   }
   const drivers::FixtureInputs in = ReadInputs("check interlocks");
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
-    throw Fault{analysis::Outcome::kError, "fixture heartbeat frozen for " +
-                                               Fixed(heartbeat_.stale_ms(Clock::now()), 0) + " ms"};
+    throw Fault{Outcome::kError,
+                {ReasonCode::kInterlock, "fixture heartbeat frozen for " +
+                                             Fixed(heartbeat_.stale_ms(Clock::now()), 0) + " ms"}};
   if (const std::string why = InterlockFault(in, *recipe_, false); !why.empty())
-    throw Fault{analysis::Outcome::kError, "interlock: " + why};
+    throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock: " + why}};
 }
 
 void Sequencer::ClampAndConfirm(db::TestRecord& record) {
   Enter(record, SeqState::kClamp,
         "phase pair " + std::to_string(static_cast<int>(recipe_->phase_pair)));
   if (const drivers::Status s = fixture_.Activate(); !s.ok())
-    throw Fault{analysis::Outcome::kError, s.message()};
+    throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
   if (const drivers::Status s = fixture_.SelectPhasePair(recipe_->phase_pair); !s.ok())
-    throw Fault{analysis::Outcome::kError, s.message()};
+    throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, true); !s.ok())
-    throw Fault{analysis::Outcome::kError, s.message()};
+    throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
 
   Enter(record, SeqState::kConfirmClamp);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -270,8 +268,9 @@ void Sequencer::ClampAndConfirm(db::TestRecord& record) {
     why = InterlockFault(in, *recipe_, true);
     if (why.empty()) break;
     if (Clock::now() > deadline)
-      throw Fault{analysis::Outcome::kError, "clamp not confirmed within " +
-                                                 Fixed(recipe_->clamp_timeout_s, 1) + " s: " + why};
+      throw Fault{Outcome::kError,
+                  {ReasonCode::kInterlock, "clamp not confirmed within " +
+                                               Fixed(recipe_->clamp_timeout_s, 1) + " s: " + why}};
     std::this_thread::sleep_for(poll);
   }
   record.conditions["clamp_pressure_bar"] = in.clamp_pressure_bar;
@@ -285,7 +284,7 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
   // Re-check right before closing the relay: nothing may have changed since confirmation.
   const drivers::FixtureInputs in = ReadInputs("interlocks before excitation");
   if (const std::string why = InterlockFault(in, *recipe_, true); !why.empty())
-    throw Fault{analysis::Outcome::kError, "interlock before excitation: " + why};
+    throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock before excitation: " + why}};
   ThrowIfAborted();
 
   drivers::AcquisitionRequest req;
@@ -303,7 +302,7 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
     Watchdog watchdog(*this);
     if (const drivers::Status s = fixture_.Write(FixtureOutput::kExcitationEnable, true); !s.ok()) {
       (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
-      throw Fault{analysis::Outcome::kError, s.message()};
+      throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
     }
     result.emplace(daq_.Acquire(req, abort_));
     (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
@@ -320,103 +319,64 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
   }
   record.calibration = drivers::CalibrationToJson(daq_.calibration());
   record.calibration["daq"] = daq_.name();
-  if (watchdog_fault) throw Fault{analysis::Outcome::kError, *watchdog_fault};
+  if (watchdog_fault) throw Fault{Outcome::kError, {ReasonCode::kInterlock, *watchdog_fault}};
   ThrowIfAborted();
   if (!result->ok())
-    throw Fault{analysis::Outcome::kError, "acquisition failed: " + result->status().message()};
+    throw Fault{Outcome::kError,
+                {ReasonCode::kAcquisition, "acquisition failed: " + result->status().message()}};
   return std::move(result->value());
 }
 
-void Sequencer::AnalyseAndJudge(db::TestRecord& record, const analysis::Recording& recording) {
+void Sequencer::MeasurePair(db::TestRecord& record, std::size_t k,
+                            std::vector<MeasuredPair>& measured) {
+  const drivers::PhasePair pair = recipe_->phase_pairs[k];
+  const std::string suffix = k == 0 ? "" : std::string("@") + PairName(pair);
+  if (k > 0) {
+    ThrowIfAborted();
+    Enter(record, SeqState::kClamp, "phase pair " + std::to_string(static_cast<int>(pair)));
+    if (const drivers::Status s = fixture_.SelectPhasePair(pair); !s.ok())
+      throw Fault{
+          Outcome::kError,
+          {ReasonCode::kFixture, "phase pair " + std::string(PairName(pair)) + ": " + s.message()}};
+  }
+  analysis::Recording recording = ExciteAndRecord(record);
   Enter(record, SeqState::kAnalyse);
-  const analysis::ImpedanceAnalysis a =
+  analysis::ImpedanceAnalysis a =
       analysis::AnalyzeRecording(recording, excitation_.lines, recipe_->analysis);
-  if (a.frf.frf.size() > 0) record.curves.push_back(ToCurve(a.frf.frf, "impedance"));
+  if (a.frf.frf.size() > 0) record.curves.push_back(ToCurve(a.frf.frf, "impedance" + suffix));
   record.conditions["periods_used"] = a.frf.periods_used;
   if (!a.fit.params.empty()) {
-    record.fit = FitJson(a.fit);
-    record.curves.push_back(ToCurve(a.fit.Model().Evaluate(a.frf.frf.freq_hz), "model"));
+    if (k == 0) record.fit = a.fit;  // analysis/fit/fit_json.h
+    record.curves.push_back(ToCurve(a.fit.Model().Evaluate(a.frf.frf.freq_hz), "model" + suffix));
   }
-  if (!a.usable) throw Fault{analysis::Outcome::kError, a.message};
-
-  Enter(record, SeqState::kJudge);
-  std::map<std::string, analysis::Estimate> values = a.values;
-  std::vector<std::string> mask_details;
-  for (const analysis::CurveMask& mask : recipe_->masks) {
-    const analysis::MaskCheck c = analysis::CheckMask(a.frf.frf, mask);
-    values[mask.MeasurementName()] = {static_cast<double>(c.lines_outside), std::nan("")};
-    if (c.lines_outside > mask.max_lines_outside)
-      mask_details.push_back("mask " + mask.name + ": worst line " + Fixed(c.worst_f_hz, 1) +
-                             " Hz, " + Fixed(c.worst_excess, 3) + " ohm beyond the bound");
-  }
-  const analysis::Verdict v = analysis::Judge(recipe_->Specs(), values);
-  record.outcome = v.outcome;
-  record.reasons = v.reasons;
-  if (v.outcome == analysis::Outcome::kFail)
-    record.reasons.insert(record.reasons.end(), mask_details.begin(), mask_details.end());
-  record.measurements = v.measurements;
-
-  std::optional<double> r_ohm;
-  if (const auto it = values.find(std::string(analysis::names::kWindingROhm)); it != values.end())
-    r_ohm = it->second.value;
-  const std::vector<std::string> off = EvaluateConditions(
-      recipe_->conditions, recording, recipe_->transient_periods, r_ohm, record.conditions);
-  if (!off.empty() && recipe_->conditions.error_when_out) {
-    // The limits assume the recipe's conditions: the station did not measure this motor.
-    record.outcome = analysis::Outcome::kError;
-    std::vector<std::string> reasons;
-    for (const std::string& line : off) reasons.push_back("condition out of window: " + line);
-    reasons.insert(reasons.end(), record.reasons.begin(), record.reasons.end());
-    record.reasons = std::move(reasons);
-  }
+  measured.push_back({pair, std::move(recording), std::move(a)});
 }
 
-void Sequencer::MeasureFurtherPair(db::TestRecord& record, drivers::PhasePair pair) {
-  static constexpr const char* kPairNames[] = {"U-V", "V-W", "W-U"};
-  const std::string name = kPairNames[static_cast<int>(pair)];
-  ThrowIfAborted();
-  Enter(record, SeqState::kClamp, "phase pair " + std::to_string(static_cast<int>(pair)));
-  if (const drivers::Status s = fixture_.SelectPhasePair(pair); !s.ok())
-    throw Fault{analysis::Outcome::kError, "phase pair " + name + ": " + s.message()};
-  const analysis::Outcome first_outcome = record.outcome;
-  std::vector<std::string> reasons = std::move(record.reasons);
-  std::vector<analysis::Measurement> measurements = std::move(record.measurements);
-  const nlohmann::json first_fit = record.fit;
-  const std::size_t first_curves = record.curves.size();
-  record.reasons.clear();
-  record.measurements.clear();
-
-  const analysis::Recording recording = ExciteAndRecord(record);
-  AnalyseAndJudge(record, recording);
-
-  for (analysis::Measurement& m : record.measurements) {
-    m.name += "@" + name;
-    measurements.push_back(std::move(m));
-  }
-  for (std::size_t i = first_curves; i < record.curves.size(); ++i)
-    record.curves[i].name += "@" + name;
-  for (const std::string& r : record.reasons) reasons.push_back("phase pair " + name + ": " + r);
-  record.fit = first_fit;
-  record.fit["further_pairs"][name] = {{"outcome", analysis::ToString(record.outcome)}};
-  auto rank = [](analysis::Outcome o) {
-    return o == analysis::Outcome::kPass ? 0 : o == analysis::Outcome::kFail ? 1 : 2;
-  };
-  if (rank(first_outcome) > rank(record.outcome)) record.outcome = first_outcome;
-  record.reasons = std::move(reasons);
-  record.measurements = std::move(measurements);
+void Sequencer::Judge(db::TestRecord& record, const std::vector<MeasuredPair>& measured) {
+  Enter(record, SeqState::kJudge);
+  std::vector<PairMeasurement> pairs;
+  for (const MeasuredPair& m : measured) pairs.push_back({m.pair, &m.analysis, &m.recording});
+  Judgement j = JudgeUnit(*recipe_, pairs, record.conditions);
+  record.outcome = j.outcome;
+  record.reasons = std::move(j.reasons);
+  record.measurements = std::move(j.measurements);
+  for (std::size_t k = 1; k < measured.size(); ++k)
+    record.fit["further_pairs"][PairName(measured[k].pair)] = {
+        {"outcome", analysis::ToString(j.pair_outcomes[k])}};
 }
 
 void Sequencer::Unclamp(db::TestRecord& record) {
   Enter(record, SeqState::kUnclamp);
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false); !s.ok())
-    throw Fault{analysis::Outcome::kError, "unclamp: " + s.message()};
+    throw Fault{Outcome::kError, {ReasonCode::kFixture, "unclamp: " + s.message()}};
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(recipe_->release_timeout_s));
   while (!ReadInputs("confirm release").released) {
     if (Clock::now() > deadline)
-      throw Fault{analysis::Outcome::kError,
-                  "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s"};
+      throw Fault{Outcome::kError,
+                  {ReasonCode::kFixture,
+                   "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s"}};
     std::this_thread::sleep_for(
         std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
   }
@@ -424,27 +384,31 @@ void Sequencer::Unclamp(db::TestRecord& record) {
 }
 
 void Sequencer::SafeState(db::TestRecord& record) {
-  Enter(record, SeqState::kSafeState, record.reasons.empty() ? "" : record.reasons.front());
+  Enter(record, SeqState::kSafeState, record.reasons.empty() ? "" : record.reasons.front().text);
   // 1. Excitation off, always first, whatever state the fixture is in.
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kExcitationEnable, false); !s.ok())
-    record.reasons.push_back("excitation-off command failed: " + s.message() +
-                             " (the relay is wired to drop on controller loss)");
+    record.reasons.push_back(
+        {ReasonCode::kFixture, "excitation-off command failed: " + s.message() +
+                                   " (the relay is wired to drop on controller loss)"});
   // 2. Unclamp only when it is safe: the controller answers, nobody is at the door, the
   //    emergency-stop chain is healthy. Otherwise leave the part clamped and say so.
   auto in = fixture_.ReadInputs();
   std::string unsafe;
-  if (!in.ok())
+  ReasonCode code = ReasonCode::kInterlock;
+  if (!in.ok()) {
     unsafe = "fixture not answering";
-  else if (!in.value().estop_ok)
+    code = ReasonCode::kFixture;
+  } else if (!in.value().estop_ok) {
     unsafe = "emergency stop open";
-  else if (!in.value().door_closed)
+  } else if (!in.value().door_closed) {
     unsafe = "door open";
+  }
   if (!unsafe.empty()) {
-    record.reasons.push_back("clamp left as it is: " + unsafe);
+    record.reasons.push_back({code, "clamp left as it is: " + unsafe});
   } else {
     (void)fixture_.Activate();
     const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false);
-    if (!s.ok()) record.reasons.push_back("unclamp failed: " + s.message());
+    if (!s.ok()) record.reasons.push_back({ReasonCode::kFixture, "unclamp failed: " + s.message()});
   }
   (void)fixture_.Deactivate();
 }
@@ -458,7 +422,8 @@ void Sequencer::StoreAndPublish(db::TestRecord& record) {
     // Not stored: never show the motor's verdict; the station failed.
     spdlog::error("[{}] record not stored: {}", record.serial, e.what());
     record.outcome = analysis::Outcome::kError;
-    record.reasons.insert(record.reasons.begin(), std::string("record not stored: ") + e.what());
+    record.reasons.insert(record.reasons.begin(),
+                          {ReasonCode::kStore, std::string("record not stored: ") + e.what()});
   }
   Enter(record, SeqState::kPublish, analysis::ToString(record.outcome));
   board_.OnVerdict(record);
@@ -481,7 +446,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
   record.outcome = analysis::Outcome::kError;
   Enter(record, SeqState::kWaitSerial, "serial " + serial + " received");
   const std::optional<std::string> master = MasterRole(options_.self_check, serial);
-  if (master) record.kind = "self_check";
+  if (master) record.kind = db::RecordKind::kSelfCheck;
 
   try {
     if (options_.self_check.enabled() && !master) {
@@ -489,7 +454,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
           EvaluateLockout(options_.self_check, store_, std::chrono::system_clock::now());
       if (lock.locked) {
         // Refused before anything moves; not a test of the motor, so nothing is stored.
-        record.reasons = {"station locked out: " + lock.reason};
+        record.reasons = {{ReasonCode::kLockout, "station locked out: " + lock.reason}};
         board_.SetLockout(lock.ToJson());
         Enter(record, SeqState::kPublish, "ERROR");
         board_.OnVerdict(record);
@@ -502,9 +467,10 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
       const std::size_t earlier = store_.TestsOfSerial(serial).size();
       if (earlier >= static_cast<std::size_t>(max_tests)) {
         // Refused before anything moves; not a test of the motor, so nothing is stored.
-        record.reasons = {"retest limit: serial " + serial + " already has " +
-                          std::to_string(earlier) + " tests (recipe allows " +
-                          std::to_string(max_tests) + "); send the motor to rework"};
+        record.reasons = {{ReasonCode::kRetestLimit,
+                           "retest limit: serial " + serial + " already has " +
+                               std::to_string(earlier) + " tests (recipe allows " +
+                               std::to_string(max_tests) + "); send the motor to rework"}};
         Enter(record, SeqState::kPublish, "ERROR");
         board_.OnVerdict(record);
         Enter(record, SeqState::kWaitSerial);
@@ -514,7 +480,8 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
     store_.BeginTest(record);
   } catch (const std::exception& e) {
     // No durable record possible: do not clamp, do not excite.
-    record.reasons = {std::string("database unavailable, test not started: ") + e.what()};
+    record.reasons = {
+        {ReasonCode::kStore, std::string("database unavailable, test not started: ") + e.what()}};
     Enter(record, SeqState::kPublish, "ERROR");
     board_.OnVerdict(record);
     Enter(record, SeqState::kWaitSerial);
@@ -526,26 +493,31 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
     if (options_.on_serial) options_.on_serial(serial);
     CheckInterlocks(record);
     ClampAndConfirm(record);
-    const analysis::Recording recording = ExciteAndRecord(record);
-    AnalyseAndJudge(record, recording);
-    for (std::size_t k = 1; k < recipe_->phase_pairs.size(); ++k)
-      MeasureFurtherPair(record, recipe_->phase_pairs[k]);
+    std::vector<MeasuredPair> measured;
+    for (std::size_t k = 0; k < recipe_->phase_pairs.size(); ++k) {
+      MeasurePair(record, k, measured);
+      // The verdict cannot be better than ERROR now: do not excite the motor again.
+      if (!measured.back().analysis.usable) break;
+    }
+    Judge(record, measured);
     Unclamp(record);
   } catch (const Fault& f) {
     record.outcome = f.outcome;
     record.reasons.insert(record.reasons.begin(), f.reason);
     SafeState(record);
   } catch (const std::exception& e) {
-    record.outcome = analysis::Outcome::kError;
-    record.reasons.insert(record.reasons.begin(), std::string("internal error: ") + e.what());
+    record.outcome = Outcome::kError;
+    record.reasons.insert(record.reasons.begin(),
+                          {ReasonCode::kInternal, std::string("internal error: ") + e.what()});
     SafeState(record);
   }
   if (master) {
     record.self_check = JudgeMasterTest(*master, record);
-    record.reasons.push_back(std::string(record.self_check["passed"].get<bool>()
-                                             ? "self-check passed: "
-                                             : "self-check failed: ") +
-                             record.self_check["detail"].get<std::string>());
+    record.reasons.push_back(
+        {ReasonCode::kSelfCheck,
+         std::string(record.self_check["passed"].get<bool>() ? "self-check passed: "
+                                                             : "self-check failed: ") +
+             record.self_check["detail"].get<std::string>()});
   }
   StoreAndPublish(record);
   if (options_.self_check.enabled()) PublishLockout();

@@ -19,6 +19,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "analysis/signal/multisine.h"
 #include "db/store.h"
@@ -103,11 +104,14 @@ class Sequencer {
   void CheckInterlocks(db::TestRecord& record);
   void ClampAndConfirm(db::TestRecord& record);
   analysis::Recording ExciteAndRecord(db::TestRecord& record);
-  void AnalyseAndJudge(db::TestRecord& record, const analysis::Recording& recording);
-  // A further phase pair of the recipe in the same clamping: relay off, switch the pair,
-  // excite, analyse; its measurements and curves are renamed "<name>@<pair>" and merged, the
-  // outcome is the worse of the two.
-  void MeasureFurtherPair(db::TestRecord& record, drivers::PhasePair pair);
+  // The recipe's phase pair k in the same clamping (k > 0: relay off, switch the pair first):
+  // excite, analyse, record the curves ("impedance", "model"; "<name>@<pair>" for k > 0) and,
+  // for the first pair, the fit summary. Appends the recording and analysis to `measured`.
+  struct MeasuredPair;
+  void MeasurePair(db::TestRecord& record, std::size_t k, std::vector<MeasuredPair>& measured);
+  // The verdict of every pair measured, by the one judge (station/judge.h): the sequencer
+  // decides nothing about the motor itself.
+  void Judge(db::TestRecord& record, const std::vector<MeasuredPair>& measured);
   void Unclamp(db::TestRecord& record);
   void SafeState(db::TestRecord& record);
   void StoreAndPublish(db::TestRecord& record);

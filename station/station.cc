@@ -76,30 +76,33 @@ std::shared_ptr<const Recipe> Station::recipe() const {
   return recipe_;
 }
 
-std::pair<int, nlohmann::json> Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who) {
-  auto error = [](int status, const std::string& code, const std::string& message) {
-    return std::pair<int, nlohmann::json>(status,
-                                          {{"error", {{"code", code}, {"message", message}}}});
+RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who) {
+  auto refused = [](RecipeChange::Kind kind, std::string message) {
+    RecipeChange r;
+    r.kind = kind;
+    r.message = std::move(message);
+    return r;
   };
   std::shared_ptr<const Recipe> next;
   try {
     next = std::make_shared<const Recipe>(ParseRecipe(j, "PUT /api/recipe"));
   } catch (const io::ConfigError& e) {
-    return error(400, "invalid_recipe", e.what());
+    return refused(RecipeChange::Kind::kInvalid, e.what());
   }
   // Holding the queue lock keeps the sequencer idle until the new recipe is in place.
   std::lock_guard<std::mutex> queue_lock(queue_mu_);
   if (running_test_ || !queue_.empty())
-    return error(409, "busy", "a test is running or waiting; change the recipe between tests");
+    return refused(RecipeChange::Kind::kBusy,
+                   "a test is running or waiting; change the recipe between tests");
   const std::shared_ptr<const Recipe> current = recipe();
   if (next->id != current->id)
-    return error(409, "wrong_recipe",
-                 "recipe id must stay '" + current->id +
-                     "' (another motor type needs another station config)");
+    return refused(RecipeChange::Kind::kWrongRecipe,
+                   "recipe id must stay '" + current->id +
+                       "' (another motor type needs another station config)");
   if (next->version <= current->version)
-    return error(409, "version_not_increased",
-                 "version must increase: the station runs version " +
-                     std::to_string(current->version) + ", got " + std::to_string(next->version));
+    return refused(RecipeChange::Kind::kVersionNotIncreased,
+                   "version must increase: the station runs version " +
+                       std::to_string(current->version) + ", got " + std::to_string(next->version));
   namespace fs = std::filesystem;
   const fs::path path = config_.recipe_path;
   const fs::path kept = path.parent_path() /
@@ -115,12 +118,12 @@ std::pair<int, nlohmann::json> Station::ChangeRecipe(const nlohmann::json& j, co
     }
     fs::rename(tmp, path);  // atomic on one file system
   } catch (const std::exception& e) {
-    return error(500, "recipe_not_written", e.what());
+    return refused(RecipeChange::Kind::kIoError, e.what());
   }
   db::RecipeAudit audit;
   audit.at = db::UtcNowIso8601();
   audit.who = who.name;
-  audit.role = who.role;
+  audit.role = ToString(who.role);
   audit.recipe_id = next->id;
   audit.old_version = current->version;
   audit.new_version = next->version;
@@ -134,16 +137,19 @@ std::pair<int, nlohmann::json> Station::ChangeRecipe(const nlohmann::json& j, co
   }
   sequencer_->SetRecipe(next);
   board_->SetRecipe(next->id, next->hash);
-  spdlog::warn("recipe {} changed by {} ({}): v{} {} -> v{} {}", next->id, who.name, who.role,
-               current->version, current->hash.substr(0, 12), next->version,
+  spdlog::warn("recipe {} changed by {} ({}): v{} {} -> v{} {}", next->id, who.name,
+               ToString(who.role), current->version, current->hash.substr(0, 12), next->version,
                next->hash.substr(0, 12));
-  return {200,
-          {{"id", next->id},
-           {"version", next->version},
-           {"hash", next->hash},
-           {"path", path.string()},
-           {"previous",
-            {{"version", current->version}, {"hash", current->hash}, {"kept_as", kept.string()}}}}};
+  RecipeChange changed;
+  changed.kind = RecipeChange::Kind::kChanged;
+  changed.id = next->id;
+  changed.version = next->version;
+  changed.hash = next->hash;
+  changed.path = path.string();
+  changed.previous_version = current->version;
+  changed.previous_hash = current->hash;
+  changed.kept_as = kept.string();
+  return changed;
 }
 
 int Station::http_port() const { return http_ ? http_->port() : 0; }
@@ -186,7 +192,7 @@ void Station::Serve() {
     }
     const db::TestRecord r = sequencer_->RunTest(serial);
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),
-                 r.reasons.empty() ? "" : r.reasons.front());
+                 r.reasons.empty() ? "" : r.reasons.front().text);
     std::lock_guard<std::mutex> lock(queue_mu_);
     running_test_ = false;
   }

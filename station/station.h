@@ -15,6 +15,7 @@
 #include "station/config.h"
 #include "station/http_api.h"
 #include "station/recipe.h"
+#include "station/recipe_change.h"
 #include "station/sequencer.h"
 #include "station/status_board.h"
 
@@ -50,7 +51,9 @@ class Station {
   // PUT /api/recipe: validates a new version of the recipe in use, keeps the old file as
   // <name>.v<old version>.json beside it, replaces the configured file atomically, writes the
   // audit log, and activates it for the next test. Refused while a test runs or waits.
-  std::pair<int, nlohmann::json> ChangeRecipe(const nlohmann::json& recipe, const ApiToken& who);
+  // Checks run in that order: validation, busy, id, version; then the files, the audit, the
+  // swap. Anything refused before the files leaves everything as it was.
+  RecipeChange ChangeRecipe(const nlohmann::json& recipe, const ApiToken& who);
   const StationConfig& config() const { return config_; }
   StatusBoard& board() { return *board_; }
   drivers::SimBench* bench() { return drivers_.bench.get(); }

@@ -44,7 +44,7 @@ nlohmann::json DriftJson(const analysis::DriftSummary& d) {
 
 nlohmann::json GaugeReport(db::Store& store, const StatsRequest& req) {
   std::vector<db::MeasurementRow> rows;
-  for (const char* kind : {"production", "self_check"}) {
+  for (const db::RecordKind kind : db::kAllRecordKinds) {
     db::MeasurementQuery q;
     q.from = req.from;
     q.to = req.to;
@@ -141,7 +141,7 @@ nlohmann::json StatsReport(db::Store& store, const StatsRequest& req) {
   q.from = req.from;
   q.to = req.to;
   q.recipe_hash = req.recipe_hash;
-  q.kind = "production";
+  q.kind = db::RecordKind::kProduction;
   const std::vector<db::MeasurementRow> rows = store.MeasurementRows(q);
 
   std::vector<std::string> hashes;  // first-seen order

@@ -1,5 +1,7 @@
 #include "station/status_board.h"
 
+#include "station/sequencer.h"  // ToString(SeqState)
+
 namespace eol::station {
 
 nlohmann::json RecordSummary(const db::TestRecord& r) {
@@ -25,13 +27,13 @@ void StatusBoard::PushEventLocked(nlohmann::json event) {
   cv_.notify_all();
 }
 
-void StatusBoard::OnState(const std::string& serial, const std::string& state,
-                          const std::string& detail) {
+void StatusBoard::OnState(const std::string& serial, SeqState state, const std::string& detail) {
   std::lock_guard<std::mutex> lock(mu_);
   state_ = state;
   serial_ = serial;
   detail_ = detail;
-  PushEventLocked({{"type", "state"}, {"state", state}, {"serial", serial}, {"detail", detail}});
+  PushEventLocked(
+      {{"type", "state"}, {"state", ToString(state)}, {"serial", serial}, {"detail", detail}});
 }
 
 void StatusBoard::OnVerdict(const db::TestRecord& record) {
@@ -80,7 +82,7 @@ void StatusBoard::SetLockout(const nlohmann::json& lockout) {
 nlohmann::json StatusBoard::Snapshot() const {
   std::lock_guard<std::mutex> lock(mu_);
   return {{"station_id", station_id_},
-          {"state", state_},
+          {"state", state_ ? ToString(*state_) : "idle"},
           {"serial", serial_},
           {"detail", detail_},
           {"message", message_},

@@ -9,6 +9,7 @@
 #include <deque>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,13 +17,17 @@
 
 namespace eol::station {
 
+// The board's state is the sequencer's (station/sequencer.h, named by its ToString: the page
+// and /metrics read those strings), or "idle" before the first test.
+enum class SeqState;
+
 class StatusBoard {
  public:
   explicit StatusBoard(std::string station_id, std::string recipe_id = "",
                        std::string recipe_hash = "");
 
   // A sequencer state was entered.
-  void OnState(const std::string& serial, const std::string& state, const std::string& detail);
+  void OnState(const std::string& serial, SeqState state, const std::string& detail);
   // A finished, stored record.
   void OnVerdict(const db::TestRecord& record);
   // The recipe changed (between tests).
@@ -34,7 +39,7 @@ class StatusBoard {
   void SetLockout(const nlohmann::json& lockout);
 
   // {"station_id", "state", "serial", "detail", "message", "recipe": {...}, "counts": {...},
-  //  "last": {serial, outcome, reasons, measurements, finished_at, id} | null,
+  //  "last": {serial, outcome, reasons [{code, text}], measurements, finished_at, id} | null,
   //  "recent": [...], "lockout": {...} | null}
   nlohmann::json Snapshot() const;
 
@@ -52,7 +57,7 @@ class StatusBoard {
   std::string recipe_hash_;
   mutable std::mutex mu_;
   mutable std::condition_variable cv_;
-  std::string state_ = "idle";
+  std::optional<SeqState> state_;  // nullopt: idle
   std::string serial_;
   std::string detail_;
   std::string message_;

@@ -2,7 +2,28 @@
 
 #include <unsupported/Eigen/NonLinearOptimization>
 
+#include "analysis/enum_names.h"
+
 namespace eol::analysis {
+
+const char* ToString(Termination t) {
+  switch (t) {
+    case Termination::kConverged:
+      return "converged";
+    case Termination::kMaxIterations:
+      return "max_iterations";
+    case Termination::kFailed:
+      return "failed";
+    case Termination::kInvalidInput:
+      return "invalid_input";
+  }
+  return "unknown";
+}
+
+std::optional<Termination> ParseTermination(std::string_view name) {
+  return ParseEnum(name, kAllTerminations);
+}
+
 namespace {
 
 constexpr double kRejectResidual = 1e100;
@@ -63,14 +84,14 @@ LeastSquaresOutcome MinimizeLeastSquares(const LeastSquaresProblem& problem, Eig
     case Status::XtolTooSmall:
     case Status::GtolTooSmall:
       out.converged = true;
-      out.termination = "converged";
+      out.termination = Termination::kConverged;
       break;
     case Status::Running:
     case Status::TooManyFunctionEvaluation:
-      out.termination = "max_iterations";
+      out.termination = Termination::kMaxIterations;
       break;
     default:
-      out.termination = "failed";
+      out.termination = Termination::kFailed;
       break;
   }
   return out;

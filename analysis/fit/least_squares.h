@@ -5,10 +5,26 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <functional>
-#include <string>
+#include <optional>
+#include <string_view>
 
 namespace eol::analysis {
+
+// How a fit ended. Stored in records and printed by the API as "converged", "max_iterations",
+// "failed", "invalid_input" (ToString); those strings must not change.
+enum class Termination {
+  kConverged,      // a minimum within the tolerances
+  kMaxIterations,  // stopped by the iteration (or evaluation) budget
+  kFailed,         // the minimiser gave up (MINPACK status other than the above)
+  kInvalidInput,   // no fit was attempted: bad data or options
+};
+inline constexpr std::array kAllTerminations = {Termination::kConverged,
+                                                Termination::kMaxIterations, Termination::kFailed,
+                                                Termination::kInvalidInput};
+const char* ToString(Termination t);
+std::optional<Termination> ParseTermination(std::string_view name);
 
 struct LeastSquaresProblem {
   int parameters = 0;
@@ -27,7 +43,7 @@ struct LeastSquaresSettings {
 
 struct LeastSquaresOutcome {
   bool converged = false;
-  std::string termination;  // "converged", "max_iterations", "failed"
+  Termination termination = Termination::kFailed;  // never kInvalidInput
   int iterations = 0;
   int minpack_status = 0;
 };

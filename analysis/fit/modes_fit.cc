@@ -240,7 +240,7 @@ FitSummary AddMode(const Data& d, const MultiModeImpedance& fitted, const ModesF
   int bi = -1, bj = -1;
   SearchPoint start = search.Grid(fs, qs, &bi, &bj);
   if (!start.ok) {
-    s.termination = "failed";
+    s.termination = Termination::kFailed;
     os << "no start for mode " << m << ": no (f, Q) gives positive linear parameters";
     s.message = candidate->message = os.str();
     return s;
@@ -311,7 +311,7 @@ FitSummary AddMode(const Data& d, const MultiModeImpedance& fitted, const ModesF
 
   const double step = std::log(f0_hi / f0_lo) / (o.single.grid_f0 - 1);
   if (!lm.converged) {
-    os << "Levenberg-Marquardt did not converge for " << m << " modes (" << lm.termination
+    os << "Levenberg-Marquardt did not converge for " << m << " modes (" << ToString(lm.termination)
        << ", MINPACK status " << lm.minpack_status << ")";
   } else if (!covariance_ok) {
     os << m << " modes are not determined by the data (singular Jacobian)";
@@ -394,7 +394,7 @@ ModesFitSummary FitMotionalModes(const Frf& z, const ModesFitOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) {
     out.message = "invalid input: options: " + why;
-    out.fit.termination = "invalid_input";
+    out.fit.termination = Termination::kInvalidInput;
     return out;
   }
   out.fit = FitMotionalResonance(z, options.single);

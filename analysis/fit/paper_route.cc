@@ -18,7 +18,7 @@ struct Output {
 
 PaperRouteSummary Invalid(const std::string& why) {
   PaperRouteSummary s;
-  s.rational.termination = "invalid_input";
+  s.rational.termination = Termination::kInvalidInput;
   s.message = "invalid input: " + why;
   return s;
 }

@@ -50,7 +50,7 @@ Cplx Horner(const Eigen::VectorXd& c, Cplx x) {
 
 RationalFitSummary Invalid(const std::string& why) {
   RationalFitSummary s;
-  s.termination = "invalid_input";
+  s.termination = Termination::kInvalidInput;
   s.message = "invalid input: " + why;
   return s;
 }
@@ -213,7 +213,7 @@ RationalFitSummary FitRational(const std::vector<double>& freq_hz, const std::ve
 
   std::ostringstream os = MessageStream();
   if (!lm.converged) {
-    os << "Levenberg-Marquardt on the output error did not converge (" << lm.termination
+    os << "Levenberg-Marquardt on the output error did not converge (" << ToString(lm.termination)
        << " after " << lm.iterations << " iterations, MINPACK status " << lm.minpack_status << ")";
   } else if (!covariance_ok) {
     os << "the coefficients are not determined by the data (singular Jacobian)";

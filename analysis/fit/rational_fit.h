@@ -46,7 +46,7 @@ struct RationalFitOptions {
 struct RationalFitSummary {
   bool usable = false;
   std::string message;
-  std::string termination;      // "converged", "max_iterations", "failed", "invalid_input"
+  Termination termination = Termination::kInvalidInput;
   Eigen::VectorXd numerator;    // n_0 .. n_nb, s in rad/s
   Eigen::VectorXd denominator;  // d_0 .. d_na
   // The free coefficients "n1".."d3" (the fixed one absent), with sigma; covariance in order.

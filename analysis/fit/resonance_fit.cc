@@ -146,7 +146,7 @@ class VarProGrid {
 FitSummary Invalid(const std::string& why) {
   FitSummary s;
   s.usable = false;
-  s.termination = "invalid_input";
+  s.termination = Termination::kInvalidInput;
   s.message = "invalid input: " + why;
   return s;
 }
@@ -238,7 +238,7 @@ FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options
   int bi = -1, bj = -1;
   GridPoint start = grid.Search(f0s, qs, &bi, &bj);
   if (!start.ok) {
-    s.termination = "failed";
+    s.termination = Termination::kFailed;
     s.message = no_resonance() + ": no (f0, Q) grid point gives positive R, L and Rp";
     return s;
   }
@@ -325,8 +325,8 @@ FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options
 
   std::ostringstream os = MessageStream();
   if (!converged) {
-    os << (s.termination == "max_iterations" ? "Levenberg-Marquardt did not converge in "
-                                             : "Levenberg-Marquardt failed after ")
+    os << (s.termination == Termination::kMaxIterations ? "Levenberg-Marquardt did not converge in "
+                                                        : "Levenberg-Marquardt failed after ")
        << s.iterations << " iterations (MINPACK status " << lm.minpack_status
        << "); started from the grid at f0 = " << start.f0_hz << " Hz, Q = " << start.q;
     s.message = os.str();

@@ -20,7 +20,7 @@
 //        1 by construction) and sigma_estimated is set.
 //
 // usable == false (params filled when a fit was made, for diagnosis) when:
-//   - the input is bad (termination "invalid_input"): Frf::Validate fails, the quantity is not
+//   - the input is bad (termination kInvalidInput): Frf::Validate fails, the quantity is not
 //     impedance, fewer than 2 x 5 lines, or invalid options;
 //   - no resonance was found between f0_min and f0_max: the fitted f0 is outside the search
 //     range or within one coarse grid step of its edges, or Rp is not significant
@@ -34,6 +34,7 @@
 #include <string_view>
 #include <vector>
 
+#include "analysis/fit/least_squares.h"
 #include "analysis/frf.h"
 #include "analysis/model/motor_model.h"
 
@@ -64,8 +65,8 @@ struct FittedParameter {
 struct FitSummary {
   std::string model = "R+sL+parallel-RLC";
   bool usable = false;
-  std::string message;      // human-readable: what happened, or why not usable
-  std::string termination;  // "converged", "max_iterations", "failed", "invalid_input"
+  std::string message;  // human-readable: what happened, or why not usable
+  Termination termination = Termination::kInvalidInput;
   std::vector<FittedParameter> params;
   Eigen::MatrixXd covariance;  // of params, in their order, natural units
   double chi2 = 0.0;

@@ -119,7 +119,8 @@ CalibrationSummary CalibrateMobility(const Frf& sim, const CalibrationOptions& o
     sa = a_scale * std::sqrt(inverse(1, 1) * noise);
   }
   if (!outcome.converged) {
-    s.message = "the rigid-shaft fit did not converge (" + outcome.termination + ")";
+    s.message =
+        "the rigid-shaft fit did not converge (" + std::string(ToString(outcome.termination)) + ")";
     return s;
   }
   s.nominal.rigid.gain_rad_per_s2_per_a = g;

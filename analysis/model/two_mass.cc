@@ -168,7 +168,7 @@ const FittedParameter* TwoMassFit::Find(const std::string& name) const {
 
 TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
   TwoMassFit out;
-  out.termination = "invalid_input";
+  out.termination = Termination::kInvalidInput;
   std::string why;
   if (!o.IsValid(&why)) {
     out.message = "invalid input: options: " + why;
@@ -204,7 +204,7 @@ TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
   for (std::size_t k = 1; k < n; ++k)
     if (std::abs(d.h[k]) > std::abs(d.h[i_max])) i_max = k;
   if (i_max == 0) {
-    out.termination = "failed";
+    out.termination = Termination::kFailed;
     out.message = "no resonance: |H| has its maximum at the lowest line";
     return out;
   }
@@ -212,7 +212,7 @@ TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
   for (std::size_t k = 1; k < i_max; ++k)
     if (std::abs(d.h[k]) < std::abs(d.h[i_min])) i_min = k;
   if (i_min == 0) {
-    out.termination = "failed";
+    out.termination = Termination::kFailed;
     out.message = "no anti-resonance: |H| has no minimum below its maximum at " +
                   std::to_string(d.f[i_max]) + " Hz";
     return out;
@@ -303,8 +303,9 @@ TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
 
   std::ostringstream os = MessageStream();
   if (!converged) {
-    os << "Levenberg-Marquardt " << out.termination << " (MINPACK status " << lm.minpack_status
-       << ") from f_ar = " << start.f_ar_hz << " Hz, f_r = " << start.f_r_hz << " Hz";
+    os << "Levenberg-Marquardt " << ToString(out.termination) << " (MINPACK status "
+       << lm.minpack_status << ") from f_ar = " << start.f_ar_hz << " Hz, f_r = " << start.f_r_hz
+       << " Hz";
     out.message = os.str();
     return out;
   }

@@ -83,7 +83,7 @@ struct TwoMassFitOptions {
 struct TwoMassFit {
   bool usable = false;
   std::string message;
-  std::string termination;
+  Termination termination = Termination::kInvalidInput;
   // g_rad_per_s2_per_a, f_ar_hz, f_r_hz, zeta_ar[, friction_per_s][, delay_s]
   std::vector<FittedParameter> params;
   TwoMassResponse response;

@@ -25,6 +25,63 @@ std::optional<Outcome> ParseOutcome(const std::string& s) {
   return std::nullopt;
 }
 
+Outcome Worse(Outcome a, Outcome b) {
+  auto severity = [](Outcome o) {
+    switch (o) {
+      case Outcome::kPass:
+        return 0;
+      case Outcome::kFail:
+        return 1;
+      case Outcome::kError:
+        return 2;
+      case Outcome::kAborted:
+        return 3;
+    }
+    return 2;
+  };
+  return severity(a) >= severity(b) ? a : b;
+}
+
+const char* ToString(ReasonCode c) {
+  switch (c) {
+    case ReasonCode::kLimit:
+      return "limit";
+    case ReasonCode::kMask:
+      return "mask";
+    case ReasonCode::kCondition:
+      return "condition";
+    case ReasonCode::kInterlock:
+      return "interlock";
+    case ReasonCode::kFixture:
+      return "fixture";
+    case ReasonCode::kAcquisition:
+      return "acquisition";
+    case ReasonCode::kAnalysis:
+      return "analysis";
+    case ReasonCode::kAborted:
+      return "aborted";
+    case ReasonCode::kStore:
+      return "store";
+    case ReasonCode::kLockout:
+      return "lockout";
+    case ReasonCode::kRetestLimit:
+      return "retest_limit";
+    case ReasonCode::kSelfCheck:
+      return "self_check";
+    case ReasonCode::kInternal:
+      return "internal";
+    case ReasonCode::kLegacy:
+      return "legacy";
+  }
+  return "internal";
+}
+
+std::optional<ReasonCode> ParseReasonCode(const std::string& s) {
+  for (int i = 0; i <= static_cast<int>(ReasonCode::kLegacy); ++i)
+    if (s == ToString(static_cast<ReasonCode>(i))) return static_cast<ReasonCode>(i);
+  return std::nullopt;
+}
+
 const char* ToString(MeasurementOutcome o) {
   switch (o) {
     case MeasurementOutcome::kPass:
@@ -38,7 +95,7 @@ const char* ToString(MeasurementOutcome o) {
 }
 
 Verdict Judge(const std::vector<MeasurementSpec>& specs,
-              const std::map<std::string, Estimate>& values) {
+              const std::map<std::string, Estimate>& values, ReasonCode out_of_limits) {
   Verdict v;
   bool missing = false, failed = false;
   for (const MeasurementSpec& spec : specs) {
@@ -55,7 +112,7 @@ Verdict Judge(const std::vector<MeasurementSpec>& specs,
       m.outcome = MeasurementOutcome::kUnset;
       missing = true;
       reason << spec.name << ": not measured";
-      v.reasons.push_back(reason.str());
+      v.reasons.push_back({ReasonCode::kAnalysis, reason.str()});
       v.measurements.push_back(m);
       continue;
     }
@@ -70,7 +127,7 @@ Verdict Judge(const std::vector<MeasurementSpec>& specs,
     if (!reason.str().empty()) {
       m.outcome = MeasurementOutcome::kFail;
       failed = true;
-      v.reasons.push_back(reason.str());
+      v.reasons.push_back({out_of_limits, reason.str()});
     } else {
       m.outcome = MeasurementOutcome::kPass;
       m.marginal = (l.lo && m.value < *l.lo + l.marginal) || (l.hi && m.value > *l.hi - l.marginal);

@@ -5,6 +5,7 @@
 // station failed: it says nothing about the motor), ABORTED (the test was interrupted).
 #pragma once
 
+#include <array>
 #include <map>
 #include <optional>
 #include <string>
@@ -13,8 +14,48 @@
 namespace eol::analysis {
 
 enum class Outcome { kPass, kFail, kError, kAborted };
-const char* ToString(Outcome o);
+inline constexpr std::array kAllOutcomes = {Outcome::kPass, Outcome::kFail, Outcome::kError,
+                                            Outcome::kAborted};
+const char* ToString(Outcome o);  // "PASS", "FAIL", "ERROR", "ABORTED"
 std::optional<Outcome> ParseOutcome(const std::string& s);
+
+// The more severe of two outcomes, in the order ABORTED > ERROR > FAIL > PASS. Why this order:
+// a FAIL says something about the motor, an ERROR says the station could not measure it, so
+// a unit with one phase pair FAILed and another in ERROR has not been fully measured and must
+// be re-tested, not scrapped on partial evidence (ERROR over FAIL). ABORTED (someone or
+// something stopped the test) tops ERROR: the test never ran to its end, whatever its
+// completed parts showed. Symmetric; PASS only when both are PASS.
+Outcome Worse(Outcome a, Outcome b);
+
+// Why a verdict is what it is: a stable machine-readable code (what databases, dashboards
+// and tests match on) with the human sentence (what the operator reads). The codes are
+// stored by name (ToString); never rename one, only add.
+enum class ReasonCode {
+  kLimit,        // "limit": a measurement outside its recipe limits (FAIL)
+  kMask,         // "mask": the impedance curve outside a recipe mask (FAIL)
+  kCondition,    // "condition": a test condition outside its recipe window (ERROR)
+  kInterlock,    // "interlock": door, emergency stop, part, clamp or heartbeat (ERROR)
+  kFixture,      // "fixture": the fixture controller failed or did not answer (ERROR)
+  kAcquisition,  // "acquisition": the DAQ could not record (ERROR)
+  kAnalysis,     // "analysis": the recording or FRF could not be analysed, or a declared
+                 //   measurement has no value (ERROR)
+  kAborted,      // "aborted": the test was stopped (ABORTED)
+  kStore,        // "store": the database could not store or begin the record (ERROR)
+  kLockout,      // "lockout": the station refuses tests until a self-check passes
+  kRetestLimit,  // "retest_limit": the serial has used up the recipe's tests
+  kSelfCheck,    // "self_check": the verdict of a master part's check of the station
+  kInternal,     // "internal": a programming error caught at the sequencer's edge
+  kLegacy,       // "legacy": read from a record stored before reasons had codes; the text
+                 //   is the stored string (no code is guessed from old text)
+};
+const char* ToString(ReasonCode c);
+std::optional<ReasonCode> ParseReasonCode(const std::string& s);
+
+struct Reason {
+  ReasonCode code = ReasonCode::kInternal;
+  std::string text;
+  bool operator==(const Reason&) const = default;
+};
 
 // Closed interval [lo, hi]; an absent bound is open. A value inside the limits but within
 // `marginal` of a bound is flagged marginal (still a pass).
@@ -38,7 +79,9 @@ struct Estimate {
 };
 
 enum class MeasurementOutcome { kPass, kFail, kUnset };
-const char* ToString(MeasurementOutcome o);
+inline constexpr std::array kAllMeasurementOutcomes = {
+    MeasurementOutcome::kPass, MeasurementOutcome::kFail, MeasurementOutcome::kUnset};
+const char* ToString(MeasurementOutcome o);  // "PASS", "FAIL", "UNSET"
 
 struct Measurement {
   std::string name;
@@ -53,14 +96,18 @@ struct Measurement {
 
 struct Verdict {
   Outcome outcome = Outcome::kError;
-  std::vector<std::string> reasons;  // empty for a clean PASS
+  std::vector<Reason> reasons;  // empty for a clean PASS
   std::vector<Measurement> measurements;
 };
 
 // Judges every declared measurement against its limits. A declared measurement whose value
 // is missing or not finite makes the verdict ERROR (never PASS, never FAIL: the station could
-// not measure). Otherwise any measurement out of limits makes it FAIL, with one reason each.
+// not measure; reason code kAnalysis). Otherwise any measurement out of limits makes it
+// FAIL, with one reason each coded `out_of_limits` (kLimit for scalar limits, kMask when the
+// specs are mask counts). The station's whole verdict (masks, conditions, phase pairs) is
+// station/judge.h, which calls this.
 Verdict Judge(const std::vector<MeasurementSpec>& specs,
-              const std::map<std::string, Estimate>& values);
+              const std::map<std::string, Estimate>& values,
+              ReasonCode out_of_limits = ReasonCode::kLimit);
 
 }  // namespace eol::analysis

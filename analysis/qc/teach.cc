@@ -3,8 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <random>
 #include <set>
+#include <stdexcept>
 
+#include "analysis/enum_names.h"
+#include "analysis/qc/measurement_names.h"
 #include "analysis/qc/tolerance.h"
 
 namespace eol::analysis {
@@ -12,6 +17,32 @@ namespace {
 
 constexpr double kMadToSigma = 1.4826;
 constexpr double kMadEfficiency = 0.37;
+
+// Design weights of the false-reject budget (teach.h's table).
+constexpr double kPlausibilityWeight = 0.002;
+constexpr double kOtherWeight = 0.02;
+constexpr double kMaskMaxWeight = 0.20;   // all segments together
+constexpr double kMaskMinWeight = 0.005;  // all segments together
+
+struct SideWeights {
+  double lo = 0.0, hi = 0.0;
+  bool defect_lo = false, defect_hi = false;
+};
+
+SideWeights DesignWeights(const std::string& name) {
+  namespace n = names;
+  const double p = kPlausibilityWeight;
+  if (name == n::kResonanceFHz) return {0.40, p, true, false};
+  if (name == n::kFitChi2PerDof) return {p, 0.25, false, true};
+  if (name == n::kResonanceQ) return {0.05, p, true, false};
+  return {kOtherWeight, kOtherWeight, true, true};
+}
+
+// One-sided distribution-free count: the minimum of n units bounds `coverage` from below with
+// confidence 1 - coverage^n.
+int OneSidedWilksUnitsNeeded(double coverage, double confidence) {
+  return static_cast<int>(std::ceil(std::log(1.0 - confidence) / std::log(coverage)));
+}
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -92,15 +123,81 @@ bool CommonGrid(const std::vector<const GoldenUnit*>& units, std::string* why) {
   return true;
 }
 
+// teach.h: plug-in tails beyond each bound, and their parametric-bootstrap interval.
+void ExpectedFalseReject(TeachSummary& s, std::size_t n_units, double confidence) {
+  std::map<std::string, const TaughtStatistic*> by_name;
+  for (const TaughtStatistic& t : s.statistics) by_name[t.name] = &t;
+  auto reject_share = [&](auto centre_of, auto scale_of) {
+    double pass = 1.0;
+    for (const TaughtBound& b : s.taught_bounds) {
+      const TaughtStatistic& t = *by_name.at(b.statistic);
+      const double z = (b.lo ? centre_of(t) - b.limit : b.limit - centre_of(t)) / scale_of(t);
+      pass *= 1.0 - NormalCdf(-z);
+    }
+    return 1.0 - pass;
+  };
+  s.expected_false_reject = reject_share([](const TaughtStatistic& t) { return t.centre; },
+                                         [](const TaughtStatistic& t) { return t.scale; });
+  const double n = static_cast<double>(n_units);
+  std::mt19937_64 rng(20261124);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::chi_squared_distribution<double> chi2(n - 1.0);
+  const int draws = 4000;
+  std::vector<double> shares;
+  std::map<std::string, std::pair<double, double>> drawn;  // name -> (centre, scale)
+  for (int i = 0; i < draws; ++i) {
+    for (const TaughtStatistic& t : s.statistics) {
+      const double sd = t.scale * std::sqrt((n - 1.0) / chi2(rng));
+      drawn[t.name] = {t.centre + sd * normal(rng) / std::sqrt(n), sd};
+    }
+    shares.push_back(reject_share([&](const TaughtStatistic& t) { return drawn[t.name].first; },
+                                  [&](const TaughtStatistic& t) { return drawn[t.name].second; }));
+  }
+  // The expected share of new good units rejected, given the golden ones: the mean over the
+  // draws (the plug-in value sits low in the tail when the scale is uncertain).
+  double sum = 0.0;
+  for (double v : shares) sum += v;
+  s.expected_false_reject = sum / static_cast<double>(shares.size());
+  std::sort(shares.begin(), shares.end());
+  auto at = [&](double q) {
+    return shares[std::min(shares.size() - 1, static_cast<std::size_t>(q * shares.size()))];
+  };
+  s.false_reject_lo = at(0.5 * (1.0 - confidence));
+  s.false_reject_hi = at(0.5 * (1.0 + confidence));
+}
+
 }  // namespace
+
+const char* ToString(TeachMethod m) {
+  switch (m) {
+    case TeachMethod::kToleranceInterval:
+      return "tolerance_interval";
+    case TeachMethod::kMad:
+      return "mad";
+  }
+  return "tolerance_interval";
+}
+
+TeachMethod ParseTeachMethod(std::string_view name) {
+  return ParseEnumOrThrow("method", name, kAllTeachMethods);
+}
+
+void to_json(nlohmann::json& j, const TeachMethod& m) { j = ToString(m); }
+
+void from_json(const nlohmann::json& j, TeachMethod& m) {
+  if (!j.is_string())
+    throw std::invalid_argument(
+        "method: must be a string (accepted: " + AcceptedNames(kAllTeachMethods) + ")");
+  m = ParseTeachMethod(j.get<std::string>());
+}
 
 bool TeachOptions::IsValid(std::string* why) const {
   auto fail = [&](const std::string& m) {
     if (why) *why = m;
     return false;
   };
-  if (method != "tolerance_interval" && method != "mad")
-    return fail("method must be tolerance_interval or mad (got " + method + ")");
+  if (allocation != "physics" && allocation != "even")
+    return fail("allocation must be physics or even (got " + allocation + ")");
   if (!(confidence > 0.5 && confidence < 1.0)) return fail("confidence must be in (0.5, 1)");
   if (!(coverage > 0.5 && coverage < 1.0)) return fail("coverage must be in (0.5, 1)");
   if (!(outlier_z >= 2.0)) return fail("outlier_z must be at least 2");
@@ -118,7 +215,7 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
   std::string why;
   if (!o.IsValid(&why)) return Fail(s, "teach options: " + why);
   if (declared.empty()) return Fail(s, "the recipe declares no scalar limit to teach");
-  const bool robust = o.method == "mad";
+  const bool robust = o.method == TeachMethod::kMad;
 
   // Every golden unit must carry every declared measurement, finite.
   for (const GoldenUnit& u : golden)
@@ -220,15 +317,15 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
     }
   }
 
-  s.bounds = 0;
-  for (const MeasurementSpec& d : declared) s.bounds += (d.limit.lo ? 1 : 0) + (d.limit.hi ? 1 : 0);
-  for (const Run& r : runs) s.bounds += 2 * static_cast<int>(r.segments);
-  s.p_bound = 1.0 - 2.0 * (1.0 - o.coverage) / s.bounds;
-  s.k_factor = ToleranceFactorTwoSided(n_eff, s.p_bound, o.confidence);
-  const int needed = ToleranceUnitsNeeded(s.p_bound, o.confidence, o.width_margin);
-  s.units_needed = robust ? static_cast<int>(std::ceil(needed / kMadEfficiency)) : needed;
-  s.units_needed_distribution_free = WilksUnitsNeeded(s.p_bound, o.confidence);
-
+  // Every statistic with its centre, scale and the bounds it gets (declared sides only).
+  struct Stat {
+    TaughtStatistic t;
+    bool want_lo = false, want_hi = false;
+    double w_lo = 0.0, w_hi = 0.0;  // design weights ("physics")
+    bool defect_lo = false, defect_hi = false;
+    double k_lo = 0.0, k_hi = 0.0;
+  };
+  std::vector<Stat> stats;
   for (const MeasurementSpec& d : declared) {
     std::vector<double> v;
     for (const GoldenUnit* u : used) v.push_back(u->values.at(d.name));
@@ -237,24 +334,17 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
       return Fail(s, "no spread in " + d.name + " among the golden units (" +
                          std::to_string(used.size()) +
                          " units, all equal?): a limit cannot be learned from it");
-    TaughtStatistic t{d.name, cs.centre, cs.scale, cs.centre - s.k_factor * cs.scale,
-                      cs.centre + s.k_factor * cs.scale};
-    MeasurementSpec spec = d;
-    if (d.limit.lo) spec.limit.lo = Round6(t.lo);
-    if (d.limit.hi) spec.limit.hi = Round6(t.hi);
-    spec.limit.marginal = Round6(o.marginal_scales * cs.scale);
-    s.limits.push_back(spec);
-    s.statistics.push_back(t);
+    const SideWeights sw = DesignWeights(d.name);
+    stats.push_back(Stat{TaughtStatistic{d.name, cs.centre, cs.scale, 0.0, 0.0},
+                         d.limit.lo.has_value(), d.limit.hi.has_value(), sw.lo, sw.hi, sw.defect_lo,
+                         sw.defect_hi});
   }
-
+  const std::size_t scalar_count = stats.size();
+  std::size_t mask_segments_total = 0;
+  for (const Run& r : runs) mask_segments_total += r.segments;
   for (const Run& run : runs) {
     const Frf& grid = used.front()->curve;
     const std::size_t lines = run.b - run.a, segs = run.segments;
-    CurveMask mask;
-    mask.name = run.name;
-    mask.quantity = MaskQuantity::kReOhm;
-    mask.guard_sigma = o.mask_guard_sigma;
-    mask.max_lines_outside = 0;
     for (std::size_t g = 0; g < segs; ++g) {
       const std::size_t a = run.a + g * lines / segs, b = run.a + (g + 1) * lines / segs;
       std::vector<double> maxima, minima;
@@ -269,13 +359,91 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
       }
       const CentreScale hi = CentreAndScale(maxima, robust), lo = CentreAndScale(minima, robust);
       const std::string band = "[" + Num(grid.freq_hz[a]) + "-" + Num(grid.freq_hz[b - 1]) + " Hz]";
-      TaughtStatistic th{mask.name + band + " max", hi.centre, hi.scale,
-                         hi.centre - s.k_factor * hi.scale, hi.centre + s.k_factor * hi.scale};
-      TaughtStatistic tl{mask.name + band + " min", lo.centre, lo.scale,
-                         lo.centre - s.k_factor * lo.scale, lo.centre + s.k_factor * lo.scale};
-      s.statistics.push_back(th);
-      s.statistics.push_back(tl);
-      double hi_v = Round6(th.hi), lo_v = Round6(tl.lo);
+      const double per = 1.0 / static_cast<double>(mask_segments_total);
+      stats.push_back(Stat{TaughtStatistic{run.name + band + " max", hi.centre, hi.scale, 0, 0},
+                           false, true, 0.0, kMaskMaxWeight * per, false, true});
+      stats.push_back(Stat{TaughtStatistic{run.name + band + " min", lo.centre, lo.scale, 0, 0},
+                           true, false, kMaskMinWeight * per, 0.0, false, false});
+    }
+  }
+
+  // The budget: shares and factors.
+  const double alpha = 1.0 - o.coverage;
+  s.bounds = 0;
+  double weight_sum = 0.0, largest = 0.0;
+  for (const Stat& st : stats) {
+    s.bounds += (st.want_lo ? 1 : 0) + (st.want_hi ? 1 : 0);
+    weight_sum += (st.want_lo ? st.w_lo : 0.0) + (st.want_hi ? st.w_hi : 0.0);
+    largest = std::max({largest, st.want_lo ? st.w_lo : 0.0, st.want_hi ? st.w_hi : 0.0});
+  }
+  const bool even = o.allocation == "even";
+  int needed = 0;
+  if (even) {
+    s.p_bound = 1.0 - 2.0 * alpha / s.bounds;
+    s.k_factor = ToleranceFactorTwoSided(n_eff, s.p_bound, o.confidence);
+    needed = ToleranceUnitsNeeded(s.p_bound, o.confidence, o.width_margin);
+    s.units_needed_distribution_free = WilksUnitsNeeded(s.p_bound, o.confidence);
+  } else {
+    s.p_bound = 1.0 - alpha * largest / weight_sum;
+    s.k_factor = ToleranceFactorOneSided(n_eff, s.p_bound, o.confidence);
+    needed = OneSidedUnitsNeeded(s.p_bound, o.confidence, o.width_margin);
+    s.units_needed_distribution_free = OneSidedWilksUnitsNeeded(s.p_bound, o.confidence);
+  }
+  s.units_needed = robust ? static_cast<int>(std::ceil(needed / kMadEfficiency)) : needed;
+  if (s.units_used < s.units_needed) {
+    if (!o.allow_few_units)
+      return Fail(s, "too few golden units: " + std::to_string(s.units_used) + " used, " +
+                         std::to_string(s.units_needed) + " needed for limits within " +
+                         Num(100 * o.width_margin) +
+                         " % of those of a known spread (teach anyway with allow_few_units, "
+                         "`eol teach --allow-few-units`)");
+    s.few_units_forced = true;
+  }
+  std::map<double, double> factor_cache;  // share -> one-sided factor
+  auto factor = [&](double share) {
+    const auto it = factor_cache.find(share);
+    if (it != factor_cache.end()) return it->second;
+    return factor_cache[share] = ToleranceFactorOneSided(n_eff, 1.0 - share, o.confidence);
+  };
+  for (Stat& st : stats) {
+    const double share_lo = even ? 0.0 : alpha * st.w_lo / weight_sum;
+    const double share_hi = even ? 0.0 : alpha * st.w_hi / weight_sum;
+    st.k_lo = even ? s.k_factor : (st.want_lo ? factor(share_lo) : 0.0);
+    st.k_hi = even ? s.k_factor : (st.want_hi ? factor(share_hi) : 0.0);
+    st.t.lo = st.t.centre - st.k_lo * st.t.scale;
+    st.t.hi = st.t.centre + st.k_hi * st.t.scale;
+    if (st.want_lo)
+      s.taught_bounds.push_back(TaughtBound{st.t.name, true, st.defect_lo,
+                                            even ? 2.0 * alpha / s.bounds : share_lo, st.k_lo,
+                                            st.t.lo});
+    if (st.want_hi)
+      s.taught_bounds.push_back(TaughtBound{st.t.name, false, st.defect_hi,
+                                            even ? 2.0 * alpha / s.bounds : share_hi, st.k_hi,
+                                            st.t.hi});
+  }
+
+  for (std::size_t i = 0; i < scalar_count; ++i) {
+    const TaughtStatistic& t = stats[i].t;
+    MeasurementSpec spec = declared[i];
+    if (spec.limit.lo) spec.limit.lo = Round6(t.lo);
+    if (spec.limit.hi) spec.limit.hi = Round6(t.hi);
+    spec.limit.marginal = Round6(o.marginal_scales * t.scale);
+    s.limits.push_back(spec);
+  }
+  for (const Stat& st : stats) s.statistics.push_back(st.t);
+
+  std::size_t next = scalar_count;
+  for (const Run& run : runs) {
+    const Frf& grid = used.front()->curve;
+    const std::size_t lines = run.b - run.a, segs = run.segments;
+    CurveMask mask;
+    mask.name = run.name;
+    mask.quantity = MaskQuantity::kReOhm;
+    mask.guard_sigma = o.mask_guard_sigma;
+    mask.max_lines_outside = 0;
+    for (std::size_t g = 0; g < segs; ++g, next += 2) {
+      const std::size_t a = run.a + g * lines / segs, b = run.a + (g + 1) * lines / segs;
+      double hi_v = Round6(stats[next].t.hi), lo_v = Round6(stats[next + 1].t.lo);
       if (!(hi_v > lo_v)) hi_v = lo_v + 1e-6;  // degenerate (no spread): keep the mask valid
       for (std::size_t k : {a, b - 1})
         mask.points.push_back(MaskPoint{grid.freq_hz[k], lo_v, hi_v});
@@ -283,18 +451,28 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
     if (!mask.IsValid(&why)) return Fail(s, "taught mask " + mask.name + " is not valid: " + why);
     s.masks.push_back(mask);
   }
+  ExpectedFalseReject(s, used.size(), o.confidence);
 
   s.usable = true;
-  s.message =
-      std::string("method ") + o.method + ", " + std::to_string(s.units_used) + " of " +
-      std::to_string(s.units_given) + " golden units used (" + std::to_string(s.rejected.size()) +
-      " rejected as outliers), coverage " + Num(o.coverage) + " of good units over " +
-      std::to_string(s.bounds) + " bounds (" + Num(s.p_bound) + " each) at confidence " +
-      Num(o.confidence) + ": k = " + Num(s.k_factor) + "; " + std::to_string(s.units_needed) +
-      " units needed for limits within " + Num(100 * o.width_margin) + " % of a known spread (" +
-      std::to_string(s.units_needed_distribution_free) + " distribution-free)" + mask_note;
-  if (s.units_used < s.units_needed)
-    s.message += "; WARNING: fewer golden units than needed, the limits are wide";
+  const std::string budget = even ? std::to_string(s.bounds) + " bounds (" + Num(s.p_bound) +
+                                        " each): k = " + Num(s.k_factor)
+                                  : std::to_string(s.bounds) +
+                                        " bounds, shared by physics (largest share " +
+                                        Num(1.0 - s.p_bound) + ": k = " + Num(s.k_factor) + ")";
+  s.message = std::string("method ") + ToString(o.method) + ", allocation " + o.allocation + ", " +
+              std::to_string(s.units_used) + " of " + std::to_string(s.units_given) +
+              " golden units used (" + std::to_string(s.rejected.size()) +
+              " rejected as outliers), false-reject target " + Num(100 * alpha) + " % over " +
+              budget + " at confidence " + Num(o.confidence) + "; expected false rejects " +
+              Num(100 * s.expected_false_reject) + " % (" + Num(100 * o.confidence) +
+              " % interval " + Num(100 * s.false_reject_lo) + "-" + Num(100 * s.false_reject_hi) +
+              " %); " + std::to_string(s.units_needed) + " units needed for limits within " +
+              Num(100 * o.width_margin) + " % of a known spread (" +
+              std::to_string(s.units_needed_distribution_free) + " distribution-free)" + mask_note;
+  if (s.few_units_forced)
+    s.message +=
+        "; WARNING: taught from fewer golden units than needed (forced), the limits "
+        "are wide";
   return s;
 }
 

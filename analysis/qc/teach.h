@@ -1,19 +1,40 @@
 // Learning recipe limits from good ("golden") units: `eol teach`.
 //
-// Scalar limits. For each measurement the recipe declares (the sides it declares: lo, hi or
-// both), from the n golden values:
-//   method "tolerance_interval": centre = mean, scale = standard deviation (n - 1), and
-//     limit = centre -/+ k scale with k = ToleranceFactorTwoSided(n, p_bound, confidence)
-//     (tolerance.h): with the stated confidence, at least p_bound of good units lie inside.
-//   method "mad": centre = median, scale = 1.4826 MAD (robust to a bad unit among the golden
-//     ones), and k computed as above for n_eff = 0.37 n, the asymptotic efficiency of the MAD
-//     against the standard deviation for normal data, so the robust limits keep the stated
-//     confidence at the price of width.
-// Coverage is stated for the whole recipe: a good unit must pass every bound together, so the
-// tail 1 - coverage is shared equally between the B bounds taught (each lo or hi of a scalar
-// limit, each lo and hi of a mask segment; Bonferroni, conservative when they are correlated):
-//   p_bound = 1 - 2 (1 - coverage) / B   (the two-sided coverage used for each statistic).
+// The statement taught: with confidence `confidence`, at most 1 - coverage of good units (the
+// false-reject target, default 0.3 %) fail any taught bound. That budget alpha = 1 - coverage
+// is spent bound by bound (each lo or hi of a scalar limit, each side of a mask segment):
+//   allocation "physics" (default): alpha_b = alpha w_b / sum(w), the weights by design, most
+//     to the bounds on the side where a defect moves the measurement (the table below); each
+//     bound is a one-sided normal tolerance bound, centre -/+ k_b scale with
+//     k_b = ToleranceFactorOneSided(n, 1 - alpha_b, confidence) (tolerance.h);
+//   allocation "even" (the method before issue 12): every bound gets the same share,
+//     p_bound = 1 - 2 alpha / B, and k = ToleranceFactorTwoSided(n, p_bound, confidence).
+// A union bound (Bonferroni) over the bounds: conservative when they are correlated.
+//
+// Sides by physics (allocation "physics"): the declared sides are taught; a side that no bond
+// defect moves keeps a plausibility bound (weight 0.002: wrong motor, station fault) so that
+// the recipe keeps its shape without spending the budget there.
+//   measurement        defect side  weight  why
+//   resonance_f_hz     lo           0.40    a softer bond (or looser clamp) only lowers the mode
+//   fit_chi2_per_dof   hi           0.25    a soft magnet's local mode is a peak the one-mode
+//                                           model cannot follow; it only raises chi2
+//   Re Z mask max      hi           0.20    (all segments together) an extra motional peak
+//                                           outside the resonance band only adds Re Z
+//   resonance_q        lo           0.05    a loose or lossy bond adds damping
+//   anything else      lo and hi    0.02    each side (R, L, Rp: winding and contacts)
+//   Re Z mask min      lo           0.005   (all segments) plausibility only
+//
+// Centre and scale: method "tolerance_interval": mean and standard deviation (n - 1); method
+// "mad": median and 1.4826 MAD (robust to a bad unit among the golden ones) with the factor
+// for n_eff = 0.37 n, the asymptotic efficiency of the MAD for normal data.
 // Marginal band: marginal_scales x scale inside each limit.
+//
+// Expected false-reject rate of the taught recipe: per bound the normal tail beyond it,
+// combined as 1 - prod(1 - tail_b) (bounds independent), averaged over the draws below; its
+// interval at `confidence` from the distribution of the true centre and scale given the golden
+// ones (fiducial, the same as Jeffreys' posterior for normal data): per statistic sigma =
+// s sqrt(nu / chi2_nu), mu = m + sigma N(0, 1) / sqrt(n), limits held fixed (fixed seed, 4000
+// draws). For one bound its upper end at `confidence` is the bound's tolerance statement.
 //
 // Curve masks. The golden curves' Re Z (ohm), all on one frequency grid, is masked outside
 // the band where the good units' resonance may lie: the golden f0 range widened by half of
@@ -31,14 +52,17 @@
 // Outliers among the golden units: a unit whose robust z = |x - median| / (1.4826 MAD) exceeds
 // outlier_z in any declared measurement is left out (named in the summary) before teaching.
 //
-// Units needed: ToleranceUnitsNeeded(p_bound, confidence, width_margin) (limits at most
-// width_margin wider than with a perfectly known spread; divided by 0.37 for "mad"), and the
-// distribution-free Wilks count for the same p_bound and confidence, for when normality is in
-// doubt.
+// Units needed: the smallest n whose factor for the bound with the largest share is at most
+// (1 + width_margin) times that of a perfectly known spread (divided by 0.37 for "mad"); also
+// the distribution-free Wilks count for the same share. Fewer used units than needed: not
+// usable, unless allow_few_units (then the summary says so, and the taught recipe's note).
 #pragma once
 
+#include <array>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "analysis/frf.h"
@@ -53,13 +77,26 @@ struct GoldenUnit {
   Frf curve;                             // measured impedance; may be empty (then no mask)
 };
 
+// Named "tolerance_interval" and "mad" (ToString) in POST /api/teach, `eol teach --method` and
+// the taught recipe's description.
+enum class TeachMethod { kToleranceInterval, kMad };
+inline constexpr std::array kAllTeachMethods = {TeachMethod::kToleranceInterval, TeachMethod::kMad};
+const char* ToString(TeachMethod m);
+// The method named `name`; std::invalid_argument "method: unknown value 'x' (accepted: ...)".
+TeachMethod ParseTeachMethod(std::string_view name);
+void to_json(nlohmann::json& j, const TeachMethod& m);
+void from_json(const nlohmann::json& j, TeachMethod& m);
+
 struct TeachOptions {
-  std::string method = "tolerance_interval";  // or "mad"
-  double confidence = 0.95;                   // gamma of the tolerance interval
-  double coverage = 0.9973;  // share of good units passing every taught bound together
+  TeachMethod method = TeachMethod::kToleranceInterval;
+  std::string allocation = "physics";  // or "even" (see above)
+  double confidence = 0.95;            // gamma of the tolerance bounds
+  // Share of good units passing every taught bound together: 1 - the false-reject target.
+  double coverage = 0.997;
   double outlier_z = 5.0;
-  double width_margin = 0.2;  // for units_needed
-  int mask_segments = 12;     // in all masks; 0: no mask taught
+  double width_margin = 0.3;     // for units_needed
+  bool allow_few_units = false;  // teach from fewer units than needed (said in the summary)
+  int mask_segments = 12;        // in all masks; 0: no mask taught
   double mask_guard_sigma = 3.0;
   double marginal_scales = 1.0;
 
@@ -73,6 +110,16 @@ struct TaughtStatistic {
   double lo = 0.0, hi = 0.0;  // the bounds computed (only the declared sides are used)
 };
 
+// One taught bound: which statistic, which side, its share of the false-reject budget.
+struct TaughtBound {
+  std::string statistic;    // TaughtStatistic::name
+  bool lo = true;           // lower bound (else upper)
+  bool defect_side = true;  // the side a defect moves it (else a plausibility bound)
+  double share = 0.0;       // alpha_b, the share of good units it may reject
+  double k = 0.0;           // the tolerance factor applied
+  double limit = 0.0;
+};
+
 struct TeachSummary {
   bool usable = false;
   std::string message;                  // what was used, or why nothing may be used
@@ -83,10 +130,15 @@ struct TeachSummary {
   int units_given = 0;
   int units_used = 0;
   int bounds = 0;         // B
-  double p_bound = 0.0;   // coverage per statistic
-  double k_factor = 0.0;  // the tolerance factor applied
+  double p_bound = 0.0;   // "even": coverage per statistic; "physics": 1 - the largest share
+  double k_factor = 0.0;  // "even": the factor applied; "physics": that of the largest share
   int units_needed = 0;   // for the stated confidence (see above)
   int units_needed_distribution_free = 0;
+  bool few_units_forced = false;  // fewer than units_needed, taught under allow_few_units
+  std::vector<TaughtBound> taught_bounds;
+  // Expected share of good units the taught recipe rejects, and its interval at confidence.
+  double expected_false_reject = 0.0;
+  double false_reject_lo = 0.0, false_reject_hi = 0.0;
 };
 
 // Never throws for bad data: usable == false with the reason (names the unit or measurement).

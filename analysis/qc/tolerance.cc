@@ -136,6 +136,58 @@ double ToleranceFactorTwoSided(double n, double coverage, double confidence) {
   return 0.5 * (lo + hi);
 }
 
+double ToleranceFactorOneSided(double n, double coverage, double confidence) {
+  if (!(n >= 2.0)) throw std::invalid_argument("ToleranceFactorOneSided: n must be >= 2");
+  CheckProbability(coverage, "ToleranceFactorOneSided: coverage");
+  CheckProbability(confidence, "ToleranceFactorOneSided: confidence");
+  const double zp = NormalQuantile(coverage), nu = n - 1.0, sn = std::sqrt(n);
+  // Nodes over x (the standardised sample mean) where z_p + x / sqrt(n) > 0, Simpson.
+  const double x_lo = std::max(-10.0, -zp * sn), x_hi = 10.0;
+  const int m = 400;
+  const double h = (x_hi - x_lo) / m;
+  std::vector<double> d2, w;
+  for (int i = 0; i <= m; ++i) {
+    const double x = x_lo + i * h;
+    const double simpson = (i == 0 || i == m) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+    const double d = zp + x / sn;
+    d2.push_back(d * d);
+    w.push_back(simpson * h / 3.0 * NormalPdf(x));
+  }
+  const double below = NormalCdf(x_lo);  // z_p + x / sqrt(n) <= 0: the bound always holds
+  auto conf = [&](double k) {
+    double sum = below;
+    for (std::size_t i = 0; i < d2.size(); ++i)
+      sum += w[i] * ChiSquareUpperTail(nu * d2[i] / (k * k), nu);
+    return sum;
+  };
+  double lo = std::max(1e-3, zp * 0.5), hi = std::max(1.0, zp * 2.0);
+  while (conf(hi) < confidence) hi *= 2.0;
+  for (int i = 0; i < 60 && hi - lo > 1e-7 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (conf(mid) < confidence ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+int OneSidedUnitsNeeded(double coverage, double confidence, double width_margin) {
+  if (!(width_margin > 0.0))
+    throw std::invalid_argument("OneSidedUnitsNeeded: width_margin must be positive");
+  const double target = (1.0 + width_margin) * NormalQuantile(coverage);
+  auto ok = [&](int n) { return ToleranceFactorOneSided(n, coverage, confidence) <= target; };
+  int hi = 2;
+  while (!ok(hi)) {
+    if (hi > 1000000) return hi;
+    hi *= 2;
+  }
+  if (hi == 2) return 2;
+  int lo = hi / 2;
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    (ok(mid) ? hi : lo) = mid;
+  }
+  return hi;
+}
+
 int ToleranceUnitsNeeded(double coverage, double confidence, double width_margin) {
   if (!(width_margin > 0.0))
     throw std::invalid_argument("ToleranceUnitsNeeded: width_margin must be positive");

@@ -78,4 +78,16 @@ SimUnit DrawUnit(const MotorPopulation& p, const std::string& serial, bool defec
   return u;
 }
 
+void to_json(nlohmann::json& j, const MotorPopulation& p) {
+  j = nlohmann::json::object();
+  for (const PopulationNumber& f : kPopulationNumbers) j[f.key] = p.*f.member;
+  j["seed"] = p.seed;
+}
+
+void from_json(const nlohmann::json& j, MotorPopulation& p) {
+  p = MotorPopulation{};
+  for (const PopulationNumber& f : kPopulationNumbers) p.*f.member = j.value(f.key, p.*f.member);
+  p.seed = j.value("seed", p.seed);
+}
+
 }  // namespace eol::analysis

@@ -8,7 +8,9 @@
 // Gaussian, drawn independently per unit.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "analysis/model/motor_model.h"
@@ -41,6 +43,39 @@ struct MotorPopulation {
   double KRotorNmPerRad(bool defective) const;
   double KFixtureNmPerRad() const;
 };
+
+// The population's one field list: JSON key (the member's name) and member. The sim
+// configuration's "population" object (drivers/factory ParsePopulation) and to_json /
+// from_json below both walk it, so a field added here is read and written everywhere.
+// "seed" (an integer) is the one field outside it.
+struct PopulationNumber {
+  const char* key;
+  double MotorPopulation::*member;
+};
+inline constexpr std::array<PopulationNumber, 17> kPopulationNumbers = {{
+    {"inertia_kg_m2", &MotorPopulation::inertia_kg_m2},
+    {"f_rigid_hz", &MotorPopulation::f_rigid_hz},
+    {"f_rigid_defect_hz", &MotorPopulation::f_rigid_defect_hz},
+    {"f_fixture_hz", &MotorPopulation::f_fixture_hz},
+    {"q_good", &MotorPopulation::q_good},
+    {"q_defect", &MotorPopulation::q_defect},
+    {"r_ohm", &MotorPopulation::r_ohm},
+    {"l_h", &MotorPopulation::l_h},
+    {"transmission_nm_per_a", &MotorPopulation::transmission_nm_per_a},
+    {"spread_inertia", &MotorPopulation::spread_inertia},
+    {"spread_k_rotor", &MotorPopulation::spread_k_rotor},
+    {"spread_k_fixture", &MotorPopulation::spread_k_fixture},
+    {"spread_q", &MotorPopulation::spread_q},
+    {"spread_r", &MotorPopulation::spread_r},
+    {"spread_l", &MotorPopulation::spread_l},
+    {"spread_transmission", &MotorPopulation::spread_transmission},
+    {"defect_share", &MotorPopulation::defect_share},
+}};
+
+// Every field; absent keys keep their defaults on reading. from_json does not validate
+// (callers check IsValid and name their JSON path).
+void to_json(nlohmann::json& j, const MotorPopulation& p);
+void from_json(const nlohmann::json& j, MotorPopulation& p);
 
 // One simulated unit: the truth the simulator knows and the station must find.
 struct SimUnit {

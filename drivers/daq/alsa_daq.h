@@ -31,7 +31,20 @@ typedef struct _snd_pcm snd_pcm_t;  // NOLINT: the C library's own name
 namespace eol::drivers {
 
 enum class AlsaSampleFormat { kS16, kS32, kFloat };
-const char* ToString(AlsaSampleFormat f);  // "S16_LE", "S32_LE", "FLOAT_LE"
+// "S16_LE", "S32_LE", "FLOAT_LE". Inline: the config reader (eol::driver_factory) and the
+// driver (eol::drivers, only with ALSA) both need it, and the driver's target must not
+// depend on the factory's.
+inline const char* ToString(AlsaSampleFormat f) {
+  switch (f) {
+    case AlsaSampleFormat::kS16:
+      return "S16_LE";
+    case AlsaSampleFormat::kS32:
+      return "S32_LE";
+    case AlsaSampleFormat::kFloat:
+      return "FLOAT_LE";
+  }
+  return "?";
+}
 
 struct AlsaDaqSettings {
   std::string playback_device = "default";

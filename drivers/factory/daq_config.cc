@@ -6,19 +6,6 @@
 
 namespace eol::drivers {
 
-// Here rather than in alsa_daq.cc, which a build without ALSA leaves out.
-const char* ToString(AlsaSampleFormat f) {
-  switch (f) {
-    case AlsaSampleFormat::kS16:
-      return "S16_LE";
-    case AlsaSampleFormat::kS32:
-      return "S32_LE";
-    case AlsaSampleFormat::kFloat:
-      return "FLOAT_LE";
-  }
-  return "?";
-}
-
 namespace {
 
 std::size_t Count(const io::JsonObject& o, const std::string& key, std::size_t fallback,

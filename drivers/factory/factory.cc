@@ -12,23 +12,8 @@ namespace eol::drivers {
 
 analysis::MotorPopulation ParsePopulation(const io::JsonObject& o) {
   analysis::MotorPopulation p;
-  p.inertia_kg_m2 = o.Number("inertia_kg_m2", p.inertia_kg_m2);
-  p.f_rigid_hz = o.Number("f_rigid_hz", p.f_rigid_hz);
-  p.f_rigid_defect_hz = o.Number("f_rigid_defect_hz", p.f_rigid_defect_hz);
-  p.f_fixture_hz = o.Number("f_fixture_hz", p.f_fixture_hz);
-  p.q_good = o.Number("q_good", p.q_good);
-  p.q_defect = o.Number("q_defect", p.q_defect);
-  p.r_ohm = o.Number("r_ohm", p.r_ohm);
-  p.l_h = o.Number("l_h", p.l_h);
-  p.transmission_nm_per_a = o.Number("transmission_nm_per_a", p.transmission_nm_per_a);
-  p.spread_inertia = o.Number("spread_inertia", p.spread_inertia);
-  p.spread_k_rotor = o.Number("spread_k_rotor", p.spread_k_rotor);
-  p.spread_k_fixture = o.Number("spread_k_fixture", p.spread_k_fixture);
-  p.spread_q = o.Number("spread_q", p.spread_q);
-  p.spread_r = o.Number("spread_r", p.spread_r);
-  p.spread_l = o.Number("spread_l", p.spread_l);
-  p.spread_transmission = o.Number("spread_transmission", p.spread_transmission);
-  p.defect_share = o.Number("defect_share", p.defect_share);
+  for (const analysis::PopulationNumber& f : analysis::kPopulationNumbers)
+    p.*f.member = o.Number(f.key, p.*f.member);
   p.seed = static_cast<std::uint64_t>(o.Integer("seed", static_cast<int>(p.seed)));
   o.RejectUnknown();
   std::string why;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace eol::drivers {
 
@@ -33,7 +34,8 @@ std::optional<SimFault> ParseSimFault(const std::string& s) {
   return std::nullopt;
 }
 
-SimBench::SimBench(SimBenchSettings settings) : settings_(std::move(settings)) {}
+SimBench::SimBench(SimBenchSettings settings, SimClock now)
+    : settings_(std::move(settings)), now_(std::move(now)), born_(now_()) {}
 
 void SimBench::LoadPart(const std::string& serial) {
   analysis::SimUnit unit;
@@ -92,10 +94,12 @@ void SimBench::CheckAnsweringLocked(Clock::time_point now) const {
 
 FixtureInputs SimBench::ReadInputs() {
   std::lock_guard<std::mutex> lock(mu_);
-  const auto now = Clock::now();
+  const auto now = now_();
   CheckAnsweringLocked(now);
   FixtureInputs in;
-  const double since_cmd = std::chrono::duration<double>(now - clamp_cmd_at_).count();
+  const double since_cmd = clamp_cmd_at_
+                               ? std::chrono::duration<double>(now - *clamp_cmd_at_).count()
+                               : std::numeric_limits<double>::infinity();
   const bool dropped = FaultActiveLocked(SimFault::kClampDrops, now);
   if (clamp_cmd_) {
     in.clamped = part_.has_value() && since_cmd >= settings_.clamp_close_s && !dropped;
@@ -127,7 +131,7 @@ FixtureInputs SimBench::ReadInputs() {
 
 void SimBench::Write(FixtureOutput output, bool on) {
   std::lock_guard<std::mutex> lock(mu_);
-  const auto now = Clock::now();
+  const auto now = now_();
   // A dead controller cannot act on a command, except that its outputs drop to safe on their
   // own: a real PLC's excitation relay is wired fail-safe.
   if (FaultActiveLocked(SimFault::kStopsAnswering, now)) {
@@ -162,7 +166,7 @@ void SimBench::Write(FixtureOutput output, bool on) {
 
 void SimBench::SelectPhasePair(PhasePair pair) {
   std::lock_guard<std::mutex> lock(mu_);
-  CheckAnsweringLocked(Clock::now());
+  CheckAnsweringLocked(now_());
   pair_ = pair;
 }
 
@@ -199,7 +203,7 @@ std::optional<SimBench::Clock::time_point> SimBench::last_excitation_off() const
 void SimBench::InjectFault(SimFault fault, std::chrono::milliseconds delay, bool on_excitation,
                            std::optional<std::chrono::milliseconds> duration) {
   std::lock_guard<std::mutex> lock(mu_);
-  fault_ = PendingFault{fault, delay, on_excitation, Clock::now(), duration, std::nullopt};
+  fault_ = PendingFault{fault, delay, on_excitation, now_(), duration, std::nullopt};
 }
 
 void SimBench::ClearFaults() {
@@ -209,7 +213,7 @@ void SimBench::ClearFaults() {
 
 bool SimBench::FaultActive(SimFault fault) const {
   std::lock_guard<std::mutex> lock(mu_);
-  return FaultActiveLocked(fault, Clock::now());
+  return FaultActiveLocked(fault, now_());
 }
 
 std::optional<SimBench::Clock::time_point> SimBench::fault_visible_at() const {

@@ -5,7 +5,8 @@
 // the phase-pair relay, the lamps and the controller heartbeat, plus injectable faults.
 // The sim fixture driver reads and writes it directly; `eol fixture-sim` serves it over
 // Modbus/CAN; the sim DAQ asks it which motor is connected and whether the relay is closed.
-// Thread-safe.
+// Thread-safe. Its time comes from a SimClock (sim_clock.h): the steady clock unless a test
+// passes a ManualClock, and every time point it reports is on that clock.
 #pragma once
 
 #include <chrono>
@@ -17,6 +18,7 @@
 
 #include "analysis/sim/population.h"
 #include "drivers/fixture/fixture.h"
+#include "drivers/sim/sim_clock.h"
 
 namespace eol::drivers {
 
@@ -55,7 +57,7 @@ std::optional<SimFault> ParseSimFault(const std::string& s);
 class SimBench {
  public:
   using Clock = std::chrono::steady_clock;
-  explicit SimBench(SimBenchSettings settings);
+  explicit SimBench(SimBenchSettings settings, SimClock now = SteadySimClock());
 
   const SimBenchSettings& settings() const { return settings_; }
 
@@ -93,16 +95,17 @@ class SimBench {
   void CheckAnsweringLocked(Clock::time_point now) const;
 
   SimBenchSettings settings_;
+  const SimClock now_;
   mutable std::mutex mu_;
   std::optional<analysis::SimUnit> part_;
   std::uint64_t parts_loaded_ = 0;
   bool clamp_cmd_ = false;
-  Clock::time_point clamp_cmd_at_{};
+  std::optional<Clock::time_point> clamp_cmd_at_;  // none: never commanded, long released
   bool excitation_ = false;
   bool lamp_pass_ = false, lamp_fail_ = false;
   PhasePair pair_ = PhasePair::kUV;
   std::optional<Clock::time_point> excitation_off_at_;
-  const Clock::time_point born_ = Clock::now();
+  const Clock::time_point born_;
 
   struct PendingFault {
     SimFault fault;

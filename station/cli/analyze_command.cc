@@ -1,7 +1,11 @@
 // `eol analyze --measured FILE`: the station's analysis on a measured FRF or raw recording,
 // offline. Reads the file (drivers/io/measured_input.h), estimates Z(f) with sigma for a
 // periodic recording, fits the clamped motor (analysis::AnalyzeImpedance / AnalyzeRecording)
-// and, with --recipe, judges the result against the recipe's limits (analysis::Judge).
+// and, with --recipe, judges the unit with the station's own judge (station/judge.h: limits,
+// masks, conditions), so a recording gets the verdict and reasons the station gives it. An FRF
+// file has no recording, and a noise recording (Welch) was not excited with the recipe's
+// multisine: for both the excitation-level conditions are listed under
+// verdict.conditions_not_evaluated instead of being judged.
 // A mobility FRF (f_hz,re,im[,sigma]) is fitted with the two-mass model instead (no verdict).
 // Exit codes: 0 a usable analysis (whatever the verdict), 1 the data cannot be analysed
 // (reason on stderr and in JSON "error"), 2 usage or file errors.
@@ -12,15 +16,18 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "analysis/fit/fit_json.h"
 #include "analysis/impedance_analysis.h"
 #include "analysis/model/two_mass.h"
 #include "analysis/signal/waveform.h"
 #include "analysis/signal/welch.h"
 #include "analysis/text.h"
+#include "db/test_record.h"
 #include "drivers/io/file_error.h"
 #include "drivers/io/measured_input.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/judge.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {
@@ -165,7 +172,7 @@ std::string Sci(double v) {
   return os.str();
 }
 
-json VerdictJson(const analysis::Verdict& v) {
+json VerdictJson(const Judgement& v) {
   json ms = json::array();
   for (const analysis::Measurement& m : v.measurements)
     ms.push_back({{"name", m.name},
@@ -176,7 +183,23 @@ json VerdictJson(const analysis::Verdict& v) {
                   {"hi", m.limit.hi ? json(*m.limit.hi) : json(nullptr)},
                   {"outcome", analysis::ToString(m.outcome)},
                   {"marginal", m.marginal}});
-  return {{"outcome", analysis::ToString(v.outcome)}, {"reasons", v.reasons}, {"measurements", ms}};
+  return {{"outcome", analysis::ToString(v.outcome)},
+          {"reasons", v.reasons},
+          {"measurements", ms},
+          {"conditions_not_evaluated", v.conditions_not_evaluated}};
+}
+
+// The station's verdict (station/judge.h) of the recipe's first phase pair; `recording` is
+// null for an FRF file. The conditions the judge evaluates go to out["conditions"].
+json JudgeJson(const Recipe& recipe, const analysis::ImpedanceAnalysis& result,
+               const analysis::Recording* recording, json& out, Judgement* judgement = nullptr) {
+  const PairMeasurement pair{recipe.phase_pair, &result, recording};
+  json conditions = json::object();
+  Judgement j = JudgeUnit(recipe, std::span<const PairMeasurement>(&pair, 1), conditions);
+  out["conditions"] = conditions;
+  json v = VerdictJson(j);
+  if (judgement) *judgement = std::move(j);
+  return v;
 }
 
 // Prints the failure on stderr (and as JSON on stdout) and returns the exit code.
@@ -266,10 +289,9 @@ int RunAnalyze(const AnalyzeArgs& a) {
                   {"message", w.message}};
     if (!w.usable) {
       if (recipe) {
-        analysis::Verdict v;
-        v.outcome = analysis::Outcome::kError;
-        v.reasons = {w.message};
-        out["verdict"] = VerdictJson(v);
+        analysis::ImpedanceAnalysis unusable;
+        unusable.message = w.message;
+        out["verdict"] = JudgeJson(*recipe, unusable, nullptr, out);
       }
       return Fail(a, out, 1, "invalid measurement: " + w.message);
     }
@@ -290,21 +312,14 @@ int RunAnalyze(const AnalyzeArgs& a) {
   const bool noise_estimated = !z.has_sigma();
   out["noise_estimated"] = noise_estimated;
   const analysis::FitSummary& fit = result.fit;
-  out["fit"] = {{"model", fit.model},
-                {"chi2", fit.chi2},
-                {"dof", fit.dof},
-                {"chi2_per_dof", fit.chi2_per_dof},
-                {"iterations", fit.iterations},
-                {"termination", fit.termination},
-                {"message", fit.message}};
+  out["fit"] = fit;  // analysis/fit/fit_json.h
   if (noise_estimated) out["estimated_sigma_ohm"] = fit.estimated_sigma;
+  // A noise recording (Welch) was not excited with the recipe's multisine: the recipe's
+  // excitation-level windows do not apply to it, so it is judged like an FRF file.
+  const analysis::Recording* recording =
+      in.kind == io::MeasuredKind::kRecording && a.welch_segment == 0 ? &in.recording : nullptr;
   if (!result.usable) {
-    if (recipe) {
-      analysis::Verdict v;
-      v.outcome = analysis::Outcome::kError;
-      v.reasons = {result.message};
-      out["verdict"] = VerdictJson(v);
-    }
+    if (recipe) out["verdict"] = JudgeJson(*recipe, result, recording, out);
     return Fail(a, out, 1, result.message);
   }
   json params = json::object();
@@ -314,11 +329,8 @@ int RunAnalyze(const AnalyzeArgs& a) {
   const analysis::FittedParameter& q = *fit.Find("Q");
   out["resonance"] = {
       {"f_hz", f0.value}, {"f_sigma_hz", f0.sigma}, {"q", q.value}, {"q_sigma", q.sigma}};
-  analysis::Verdict verdict;
-  if (recipe) {
-    verdict = analysis::Judge(recipe->limits, result.values);
-    out["verdict"] = VerdictJson(verdict);
-  }
+  Judgement verdict;
+  if (recipe) out["verdict"] = JudgeJson(*recipe, result, recording, out, &verdict);
   out["usable"] = true;
   if (a.json) {
     std::cout << out.dump() << std::endl;
@@ -338,11 +350,16 @@ int RunAnalyze(const AnalyzeArgs& a) {
     std::cout << "  " << p.name << " = " << Sci(p.value) << " +- " << Sci(p.sigma) << " " << p.unit
               << "\n";
   std::cout << "fit: " << fit.model << ", chi2/dof = " << Fixed(fit.chi2_per_dof, 3) << " (dof "
-            << fit.dof << "), " << fit.termination << " in " << fit.iterations << " iterations\n";
+            << fit.dof << "), " << analysis::ToString(fit.termination) << " in " << fit.iterations
+            << " iterations\n";
   if (recipe) {
     std::cout << "verdict (" << recipe->id << " v" << recipe->version
               << "): " << analysis::ToString(verdict.outcome) << "\n";
-    for (const std::string& r : verdict.reasons) std::cout << "  " << r << "\n";
+    for (const analysis::Reason& r : verdict.reasons)
+      std::cout << "  " << r.text << " [" << analysis::ToString(r.code) << "]\n";
+    for (const std::string& c : verdict.conditions_not_evaluated)
+      std::cout << "  condition " << c
+                << " not evaluated: no recording of the recipe's excitation\n";
   }
   return 0;
 }
@@ -355,7 +372,7 @@ void AddAnalyzeCommand(CLI::App& app) {
       "analyze",
       "Analyse a measured frequency response or raw recording offline: estimate Z(f) with its\n"
       "sigma (periodic recordings), fit the clamped motor's resonance by weighted maximum\n"
-      "likelihood and, with --recipe, judge it against the recipe's limits.\n"
+      "likelihood and, with --recipe, judge it as the station does (limits, masks, conditions).\n"
       "Files: FRF CSV (f_hz,re_ohm,im_ohm[,sigma_ohm]; f_hz,re,im[,sigma] for a mobility, fitted\n"
       "with the two-mass model), .zma (f, |Z|, phase deg), recording CSV (t_s,u_v,i_a), "
       "two-channel\n"

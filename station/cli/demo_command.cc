@@ -106,7 +106,7 @@ int RunDemo(const DemoArgs& a) {
     std::snprintf(line, sizeof line, "[%3d/%d] %-16s f0 = %7.2f Hz  %-7s truth: %-9s ", i, a.units,
                   serial, MeasurementValue(r, analysis::names::kResonanceFHz),
                   analysis::ToString(r.outcome), is_defective ? "defective" : "good");
-    out << line << (r.reasons.empty() ? "" : r.reasons.front()) << "\n" << std::flush;
+    out << line << (r.reasons.empty() ? "" : r.reasons.front().text) << "\n" << std::flush;
   }
   out << "summary: " << a.units << " units: " << pass << " PASS, " << fail << " FAIL, " << error
       << " ERROR; " << detected << " of " << defective << " defective rotors caught, "

@@ -58,7 +58,7 @@ void WriteCsv(std::ostream& out, const std::vector<db::TestRecord>& tests) {
       out << "," << v;
     }
     std::string reasons;
-    for (const auto& r : t.reasons) reasons += (reasons.empty() ? "" : "; ") + r;
+    for (const auto& r : t.reasons) reasons += (reasons.empty() ? "" : "; ") + r.text;
     out << "," << Csv(reasons) << "\n";
   }
 }

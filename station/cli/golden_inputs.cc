@@ -48,6 +48,9 @@ analysis::GoldenUnit FromMeasured(const std::string& path, const Recipe& recipe)
 analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string& path) {
   if (!j.value("usable", false))
     throw std::runtime_error(path + ": the analysis is not usable (\"usable\": false)");
+  if (j.contains("verdict") && j.at("verdict").value("outcome", "") != "PASS")
+    throw std::runtime_error(path + ": the verdict is " + j.at("verdict").value("outcome", "?") +
+                             ": only PASS units are golden units");
   static const std::map<std::string, std::string_view> kParams = {
       {"f0_hz", names::kResonanceFHz},
       {"Q", names::kResonanceQ},
@@ -70,6 +73,7 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
 std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>& paths,
                                                   const Recipe& recipe,
                                                   std::vector<std::string>* skipped) {
+  if (skipped) skipped->clear();  // nothing is skipped any more: unusable records are refused
   std::vector<analysis::GoldenUnit> units;
   for (const std::string& path : paths) {
     if (!EndsWith(path, ".json")) {
@@ -92,10 +96,19 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
         for (std::size_t i = 0; i < list.size(); ++i) {
           const db::TestRecord r = list[i].get<db::TestRecord>();
           const std::string label = path + "[" + std::to_string(i) + "] " + r.serial;
-          if (r.outcome == analysis::Outcome::kError || r.outcome == analysis::Outcome::kAborted) {
-            if (skipped) skipped->push_back(label + ": " + analysis::ToString(r.outcome));
-            continue;
-          }
+          // A golden unit is a good production unit tested with this very recipe: anything
+          // else would teach limits from what they must reject, or from another test.
+          if (r.outcome != analysis::Outcome::kPass)
+            throw std::runtime_error("record " + label + " is " + analysis::ToString(r.outcome) +
+                                     ": only PASS records are golden units");
+          if (r.kind != db::RecordKind::kProduction)
+            throw std::runtime_error("record " + label + " is a " + db::ToString(r.kind) +
+                                     " test (a master part), not a production unit");
+          if (r.recipe_hash != recipe.hash)
+            throw std::runtime_error("record " + label + " was tested with recipe hash " +
+                                     (r.recipe_hash.empty() ? "(none)" : r.recipe_hash) + ", not " +
+                                     recipe.hash + " (" + recipe.id + " v" +
+                                     std::to_string(recipe.version) + ")");
           units.push_back(GoldenFromRecord(r, label));
         }
       } else {

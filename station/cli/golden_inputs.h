@@ -4,8 +4,10 @@
 //                           excitation): analysed as `eol analyze --recipe` does;
 //   *.json                  `eol analyze --json` output (one unit: params and fit, no curve),
 //                           or `eol export --format json` (an array of records: each record's
-//                           measurements and its "impedance" curve; records whose outcome is
-//                           ERROR or ABORTED are skipped and listed in *skipped).
+//                           measurements and its "impedance" curve). Refused (throws, naming
+//                           the record): FAIL, ERROR or ABORTED records, masters (kind other
+//                           than "production") and records of another recipe hash than
+//                           `recipe`'s. *skipped is left empty (kept for callers' reports).
 // Throws std::runtime_error naming the file (and record) that cannot be used.
 #pragma once
 

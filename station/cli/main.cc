@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "eol - end-of-line test station for permanent-magnet motors.\n"
       "Clamps the shaft, excites a stator phase pair with a multisine, estimates the impedance\n"
-      "Z(f), fits the clamped rotor's torsional resonance and judges it against the recipe."};
+      "Z(f), fits the clamped rotor's torsional resonance and judges it against the recipe.",
+      "eol"};  // named, so usage lines never show the path the program was started by
   app.set_version_flag("--version", eol::station::SoftwareVersion());
   app.require_subcommand(1);
   eol::station::cli::AddDemoCommand(app);

@@ -150,9 +150,16 @@ void AddProductionBenchCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--coverage", args->options.teach.coverage, "Teaching coverage of good units")
       ->capture_default_str();
-  cmd->add_option("--method", args->options.teach.method, "tolerance_interval or mad")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"tolerance_interval", "mad"}));
+  std::vector<std::string> methods;  // the names of analysis/qc/teach.h
+  for (analysis::TeachMethod m : analysis::kAllTeachMethods)
+    methods.push_back(analysis::ToString(m));
+  cmd->add_option_function<std::string>(
+         "--method",
+         [args](const std::string& name) {
+           args->options.teach.method = analysis::ParseTeachMethod(name);
+         },
+         "tolerance_interval (default) or mad")
+      ->check(CLI::IsMember(methods));
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args] { RunGuarded("production-bench", [&] { return RunBench(*args); }); });
 }

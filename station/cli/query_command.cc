@@ -49,7 +49,8 @@ int RunQuery(const QueryArgs& a) {
       std::printf("          %-18s %12.6g %-4s [%s] %s\n", m.name.c_str(), m.value, m.unit.c_str(),
                   analysis::ToString(m.outcome), m.marginal ? "marginal" : "");
     }
-    for (const auto& r : t.reasons) std::printf("          reason: %s\n", r.c_str());
+    for (const auto& r : t.reasons)
+      std::printf("          reason (%s): %s\n", analysis::ToString(r.code), r.text.c_str());
   }
   return 0;
 }

@@ -88,6 +88,10 @@ int RunTeach(const TeachArgs& a) {
               << now.marginal << " (centre " << s.statistics[i].centre << ", scale "
               << s.statistics[i].scale << ")\n";
   }
+  std::cout << "expected false rejects " << 100.0 * s.expected_false_reject << " % ("
+            << 100.0 * a.options.confidence << " % interval " << 100.0 * s.false_reject_lo << "-"
+            << 100.0 * s.false_reject_hi << " %), target " << 100.0 * (1.0 - a.options.coverage)
+            << " %\n";
   for (const auto& m : s.masks)
     std::cout << "  mask " << m.name << ": " << m.points.size() / 2 << " segments "
               << m.points.front().f_hz << "-" << m.points.back().f_hz << " Hz on Re Z, guard "
@@ -106,9 +110,13 @@ void AddTeachCommand(CLI::App& app) {
   auto args = std::make_shared<TeachArgs>();
   CLI::App* cmd = app.add_subcommand(
       "teach",
-      "Learn a recipe's limits from good units: tolerance intervals (or median/MAD) for every\n"
-      "declared measurement and a Re Z mask over frequency, at a stated coverage of good units\n"
-      "and confidence. Writes a new recipe version (never overwrites without --force) and\n"
+      "Learn a recipe's limits from good units: one-sided tolerance bounds (or median/MAD) for\n"
+      "every declared measurement and a Re Z mask over frequency, at a stated false-reject\n"
+      "target (default 0.3 %) and confidence, the budget spent where defects move each\n"
+      "measurement; reports the expected false-reject rate with its interval. Refuses FAIL,\n"
+      "ERROR and ABORTED records, masters, records of another recipe, and fewer units than\n"
+      "needed (unless --allow-few-units). Writes a new recipe version (never overwrites without "
+      "--force) and\n"
       "prints its SHA-256 and how many golden units the stated confidence needs.\n"
       "Golden files: FRF CSV / .zma / recording CSV (analysed with the recipe), `eol analyze\n"
       "--json` output, or `eol export --format json` records.\n"
@@ -121,11 +129,30 @@ void AddTeachCommand(CLI::App& app) {
   cmd->add_option("--confidence", args->options.confidence, "Confidence of the tolerance intervals")
       ->capture_default_str();
   cmd->add_option("--coverage", args->options.coverage,
-                  "Share of good units that pass every taught bound together")
+                  "Share of good units that pass every taught bound together (1 - the "
+                  "false-reject target)")
       ->capture_default_str();
-  cmd->add_option("--method", args->options.method, "tolerance_interval or mad")
+  std::vector<std::string> methods;  // the names of analysis/qc/teach.h
+  for (analysis::TeachMethod m : analysis::kAllTeachMethods)
+    methods.push_back(analysis::ToString(m));
+  cmd->add_option_function<std::string>(
+         "--method",
+         [args](const std::string& name) {
+           args->options.method = analysis::ParseTeachMethod(name);
+         },
+         "tolerance_interval (default) or mad")
+      ->check(CLI::IsMember(methods));
+  cmd->add_option_function<double>(
+         "--false-reject", [args](double share) { args->options.coverage = 1.0 - share; },
+         "Target share of good units rejected (default 0.003; sets --coverage to 1 - it)")
+      ->excludes("--coverage");
+  cmd->add_option("--allocation", args->options.allocation,
+                  "How the false-reject budget is shared: physics (by the side a defect moves "
+                  "each measurement) or even (the same for every bound)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"tolerance_interval", "mad"}));
+      ->check(CLI::IsMember({"physics", "even"}));
+  cmd->add_flag("--allow-few-units", args->options.allow_few_units,
+                "Teach from fewer golden units than the method needs (the recipe says so)");
   cmd->add_option("--mask-segments", args->options.mask_segments,
                   "Segments of the taught Re Z mask (0: keep the recipe's masks)")
       ->capture_default_str();

@@ -40,6 +40,11 @@ function renderStates(current) {
   if (current === "safe_state") ol.appendChild(el("li", {class: "current"}, "safe state"));
 }
 
+// A reason is {code, text} (analysis/qc/measurement.h); the operator reads the text.
+function reasonText(r) {
+  return typeof r === "string" ? r : (r && r.text) || "";
+}
+
 function renderVerdict(outcome, serial, reasons) {
   const v = $("verdict");
   v.className = "verdict " + (outcome || "none");
@@ -47,7 +52,8 @@ function renderVerdict(outcome, serial, reasons) {
   $("serial").textContent = serial || "";
   const ul = $("reasons");
   ul.replaceChildren();
-  for (const r of reasons || []) ul.appendChild(el("li", {}, r));
+  for (const r of reasons || [])
+    ul.appendChild(el("li", {"data-code": (r && r.code) || ""}, reasonText(r)));
 }
 
 function renderHistory(status) {
@@ -100,7 +106,7 @@ function plotCurves(record) {
   const meas = (record.curves || []).find(c => c.name === "impedance");
   const model = (record.curves || []).find(c => c.name === "model");
   if (!meas) {
-    $("curve-note").textContent = "(no curve: " + (record.reasons || [""])[0] + ")";
+    $("curve-note").textContent = "(no curve: " + reasonText((record.reasons || [""])[0]) + ")";
     return;
   }
   $("curve-note").textContent = "— " + record.serial;

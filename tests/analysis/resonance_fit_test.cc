@@ -88,7 +88,7 @@ TEST(ResonanceFitTest, NoiseFreeRecoversParameters) {
   z.sigma.assign(z.size(), 0.02);
   const FitSummary s = FitMotionalResonance(z, ResonanceFitOptions{});
   ASSERT_TRUE(s.usable) << s.message;
-  EXPECT_EQ(s.termination, "converged");
+  EXPECT_EQ(s.termination, Termination::kConverged);
   ASSERT_EQ(s.params.size(), 5u);
   EXPECT_EQ(s.params[0].name, "R_ohm");
   EXPECT_EQ(s.params[1].name, "L_h");
@@ -243,26 +243,26 @@ TEST(ResonanceFitTest, InvalidInputsAreReportedNotThrown) {
   nan_value.value[17] = {std::nan(""), 0.0};
   FitSummary s = FitMotionalResonance(nan_value, ResonanceFitOptions{});
   EXPECT_FALSE(s.usable);
-  EXPECT_EQ(s.termination, "invalid_input");
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
   EXPECT_CONTAINS(s.message, "line 17");
   EXPECT_CONTAINS(s.message, "not finite");
 
   s = FitMotionalResonance(Frf{}, ResonanceFitOptions{});
   EXPECT_FALSE(s.usable);
-  EXPECT_EQ(s.termination, "invalid_input");
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
   EXPECT_CONTAINS(s.message, "no lines");
 
   Frf mobility = good;
   mobility.quantity = Quantity::kMobility;
   s = FitMotionalResonance(mobility, ResonanceFitOptions{});
   EXPECT_FALSE(s.usable);
-  EXPECT_EQ(s.termination, "invalid_input");
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
   EXPECT_CONTAINS(s.message, "quantity is mobility_rad_per_s_per_a");
 
   Frf few = truth.Evaluate(Lines(385.0, 393.0, 1.0));
   s = FitMotionalResonance(few, ResonanceFitOptions{});
   EXPECT_FALSE(s.usable);
-  EXPECT_EQ(s.termination, "invalid_input");
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
   EXPECT_CONTAINS(s.message, "9 lines, the fit needs at least 10");
 
   Frf bad_sigma = good;
@@ -275,7 +275,7 @@ TEST(ResonanceFitTest, InvalidInputsAreReportedNotThrown) {
   bad_options.q_min = 0.0;
   s = FitMotionalResonance(good, bad_options);
   EXPECT_FALSE(s.usable);
-  EXPECT_EQ(s.termination, "invalid_input");
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
   EXPECT_CONTAINS(s.message, "q_min");
 
   ResonanceFitOptions outside;
@@ -283,7 +283,7 @@ TEST(ResonanceFitTest, InvalidInputsAreReportedNotThrown) {
   outside.f0_max_hz = 2000.0;
   s = FitMotionalResonance(good, outside);
   EXPECT_FALSE(s.usable);
-  EXPECT_EQ(s.termination, "invalid_input");
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
   EXPECT_CONTAINS(s.message, "does not overlap the data band");
 }
 

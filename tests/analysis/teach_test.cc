@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include "analysis/qc/tolerance.h"
 
@@ -32,6 +33,18 @@ TEST(Tolerance, TwoSidedFactorMatchesTables) {
   EXPECT_GT(ToleranceFactorTwoSided(10, 0.99, 0.95), ToleranceFactorTwoSided(30, 0.99, 0.95));
 }
 
+// One-sided factors against scipy.stats.nct.ppf(gamma, n - 1, z_p sqrt(n)) / sqrt(n):
+// (30, 0.99, 0.95) 3.063901, (40, 0.9988, 0.95) 3.799182, (40, 0.997, 0.95) 3.450040.
+TEST(Tolerance, OneSidedFactorMatchesTheNoncentralT) {
+  EXPECT_NEAR(ToleranceFactorOneSided(30, 0.99, 0.95), 3.063901, 1e-4);
+  EXPECT_NEAR(ToleranceFactorOneSided(40, 0.9988, 0.95), 3.799182, 1e-4);
+  EXPECT_NEAR(ToleranceFactorOneSided(40, 0.997, 0.95), 3.450040, 1e-4);
+  EXPECT_NEAR(ToleranceFactorOneSided(1e7, 0.99, 0.95), NormalQuantile(0.99), 0.002);
+  const int n = OneSidedUnitsNeeded(0.9988, 0.95, 0.3);
+  EXPECT_LE(ToleranceFactorOneSided(n, 0.9988, 0.95), 1.3 * NormalQuantile(0.9988));
+  EXPECT_GT(ToleranceFactorOneSided(n - 1, 0.9988, 0.95), 1.3 * NormalQuantile(0.9988));
+}
+
 TEST(Tolerance, UnitsNeeded) {
   // Wilks: the range of 59 units covers 95 % with 95 % confidence (one-sided classic is 59;
   // two-sided range needs 93).
@@ -47,6 +60,14 @@ MeasurementSpec Spec(const std::string& name, bool lo, bool hi) {
   if (lo) s.limit.lo = -1e9;
   if (hi) s.limit.hi = 1e9;
   return s;
+}
+
+// The method before issue 12 (one budget share per bound, two-sided factor), from any count.
+TeachOptions Even() {
+  TeachOptions o;
+  o.allocation = "even";
+  o.allow_few_units = true;
+  return o;
 }
 
 std::vector<GoldenUnit> NormalUnits(int n, std::uint64_t seed, double mean, double sd) {
@@ -65,7 +86,7 @@ std::vector<GoldenUnit> NormalUnits(int n, std::uint64_t seed, double mean, doub
 // Teaching 400 times from 30 normal units: the limits cover at least the stated share of the
 // population in about `confidence` of the repetitions (binomial sd 1.1 %).
 TEST(Teach, StatedConfidenceHoldsOverRepetitions) {
-  TeachOptions o;
+  TeachOptions o = Even();
   o.coverage = 0.99;
   o.confidence = 0.95;
   o.mask_segments = 0;
@@ -85,7 +106,7 @@ TEST(Teach, StatedConfidenceHoldsOverRepetitions) {
 
 // Fresh good units pass the taught limits at the stated rate.
 TEST(Teach, FreshUnitsPassAtTheStatedRate) {
-  TeachOptions o;
+  TeachOptions o = Even();
   o.coverage = 0.99;
   o.mask_segments = 0;
   const TeachSummary s =
@@ -105,10 +126,11 @@ TEST(Teach, FreshUnitsPassAtTheStatedRate) {
 }
 
 TEST(Teach, CoverageIsSharedBetweenBounds) {
-  TeachOptions o;
+  TeachOptions o = Even();
   o.mask_segments = 0;
   std::vector<GoldenUnit> units = NormalUnits(40, 3, 390.0, 4.0);
   std::mt19937_64 rng(5);
+  o.coverage = 0.9973;
   std::normal_distribution<double> q(50.0, 5.0), chi2(1.0, 0.05);
   for (auto& u : units) {
     u.values["resonance_q"] = q(rng);
@@ -128,8 +150,105 @@ TEST(Teach, CoverageIsSharedBetweenBounds) {
   EXPECT_GT(s.units_needed_distribution_free, s.units_needed);
 }
 
-TEST(Teach, RejectsAnOutlierAndNamesIt) {
+std::vector<GoldenUnit> StationUnits(int n, std::uint64_t seed) {
+  std::vector<GoldenUnit> units = NormalUnits(n, seed, 390.0, 4.0);
+  std::mt19937_64 rng(seed + 1);
+  std::normal_distribution<double> q(50.0, 5.0), chi2(1.0, 0.05), r(0.5, 0.01);
+  for (auto& u : units) {
+    u.values["resonance_q"] = q(rng);
+    u.values["fit_chi2_per_dof"] = chi2(rng);
+    u.values["winding_r_ohm"] = r(rng);
+  }
+  return units;
+}
+
+const std::vector<MeasurementSpec> kStationSpecs = {
+    Spec("resonance_f_hz", true, true), Spec("resonance_q", true, true),
+    Spec("fit_chi2_per_dof", false, true), Spec("winding_r_ohm", true, true)};
+
+// The budget goes where defects move the measurements: f0 and Q low, chi2 high; the other
+// side of f0 and Q is a plausibility bound. Shares add up to the target.
+TEST(Teach, PhysicsAllocationSpendsTheBudgetOnTheDefectSide) {
   TeachOptions o;
+  o.mask_segments = 0;
+  const TeachSummary s = TeachLimits(kStationSpecs, StationUnits(40, 3), o);
+  ASSERT_TRUE(s.usable) << s.message;
+  ASSERT_EQ(s.taught_bounds.size(), 7u);
+  double total = 0.0, f0_lo = 0.0, f0_hi = 0.0, chi2_hi = 0.0, r_lo = 0.0;
+  for (const TaughtBound& b : s.taught_bounds) {
+    total += b.share;
+    if (b.statistic == "resonance_f_hz") (b.lo ? f0_lo : f0_hi) = b.share;
+    if (b.statistic == "fit_chi2_per_dof") chi2_hi = b.share;
+    if (b.statistic == "winding_r_ohm" && b.lo) r_lo = b.share;
+    if (b.statistic == "resonance_f_hz" || b.statistic == "resonance_q") {
+      EXPECT_EQ(b.defect_side, b.lo) << b.statistic;
+    }
+  }
+  EXPECT_NEAR(total, 1.0 - o.coverage, 1e-12);
+  EXPECT_GT(f0_lo, 100.0 * f0_hi);
+  EXPECT_GT(f0_lo, chi2_hi);
+  EXPECT_GT(chi2_hi, 10.0 * r_lo);
+  // Against an even split of the same budget: the lower f0 limit is tighter, the upper wider.
+  TeachOptions e = Even();
+  e.mask_segments = 0;
+  const TeachSummary t = TeachLimits(kStationSpecs, StationUnits(40, 3), e);
+  ASSERT_TRUE(t.usable) << t.message;
+  EXPECT_GT(*s.limits[0].limit.lo, *t.limits[0].limit.lo + 1.0);
+  EXPECT_GT(*s.limits[0].limit.hi, *t.limits[0].limit.hi);
+  EXPECT_NE(s.message.find("expected false rejects"), std::string::npos) << s.message;
+}
+
+// Over repeated teaching from 40 units, the true false-reject rate of the taught limits
+// (exact: the units are independent normals) lies in the reported interval about as often as
+// its confidence says, and within the target at least that often.
+TEST(Teach, ExpectedFalseRejectIntervalCoversTheTrueRate) {
+  TeachOptions o;
+  o.mask_segments = 0;
+  const int reps = 200;
+  int covered = 0, within_target = 0;
+  for (int r = 0; r < reps; ++r) {
+    const TeachSummary s = TeachLimits(kStationSpecs, StationUnits(40, 100 + 2 * r), o);
+    ASSERT_TRUE(s.usable) << s.message;
+    // StationUnits' true distributions, in kStationSpecs' order.
+    const double mean[] = {390.0, 50.0, 1.0, 0.5}, sd[] = {4.0, 5.0, 0.05, 0.01};
+    double pass = 1.0;
+    for (std::size_t i = 0; i < s.limits.size(); ++i) {
+      const auto& l = s.limits[i].limit;
+      double p = 1.0;
+      if (l.lo) p -= NormalCdf((*l.lo - mean[i]) / sd[i]);
+      if (l.hi) p -= 1.0 - NormalCdf((*l.hi - mean[i]) / sd[i]);
+      pass *= p;
+    }
+    const double rate = 1.0 - pass;
+    covered += rate >= s.false_reject_lo && rate <= s.false_reject_hi;
+    within_target += rate <= 1.0 - o.coverage;
+    EXPECT_LT(s.false_reject_lo, s.expected_false_reject);
+    EXPECT_GT(s.false_reject_hi, s.expected_false_reject);
+  }
+  EXPECT_NEAR(static_cast<double>(covered) / reps, 0.95, 0.05);
+  EXPECT_GE(static_cast<double>(within_target) / reps, 0.93);
+}
+
+TEST(Teach, RefusesFewerUnitsThanNeededUnlessAllowed) {
+  TeachOptions o;
+  o.mask_segments = 0;
+  TeachSummary s = TeachLimits(kStationSpecs, StationUnits(20, 7), o);
+  EXPECT_FALSE(s.usable);
+  EXPECT_NE(s.message.find("too few golden units: 20 used, " + std::to_string(s.units_needed) +
+                           " needed"),
+            std::string::npos)
+      << s.message;
+  EXPECT_GT(s.units_needed, 20);
+  EXPECT_LE(s.units_needed, 40);  // the README workflow's 40 golden units are enough
+  o.allow_few_units = true;
+  s = TeachLimits(kStationSpecs, StationUnits(20, 7), o);
+  ASSERT_TRUE(s.usable) << s.message;
+  EXPECT_TRUE(s.few_units_forced);
+  EXPECT_NE(s.message.find("fewer golden units than needed (forced)"), std::string::npos);
+}
+
+TEST(Teach, RejectsAnOutlierAndNamesIt) {
+  TeachOptions o = Even();
   o.mask_segments = 0;
   std::vector<GoldenUnit> units = NormalUnits(30, 11, 390.0, 4.0);
   units[7].values["resonance_f_hz"] = 350.0;  // a defective unit among the golden ones
@@ -144,9 +263,10 @@ TEST(Teach, RejectsAnOutlierAndNamesIt) {
 TEST(Teach, MadIsWiderThanTheIntervalForTheSameUnits) {
   TeachOptions o;
   o.mask_segments = 0;
+  o.allow_few_units = true;  // mad needs 0.37 times the units
   const auto units = NormalUnits(40, 21, 390.0, 4.0);
   const TeachSummary t = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
-  o.method = "mad";
+  o.method = TeachMethod::kMad;
   const TeachSummary m = TeachLimits({Spec("resonance_f_hz", true, true)}, units, o);
   ASSERT_TRUE(t.usable && m.usable) << t.message << m.message;
   EXPECT_GT(m.k_factor, t.k_factor);
@@ -221,6 +341,22 @@ TEST(Teach, MaskFromCurvesPassesGoodAndCatchesAShiftedPeak) {
   ASSERT_TRUE(t.usable);
   EXPECT_TRUE(t.masks.empty());
   EXPECT_NE(t.message.find("unit-5"), std::string::npos) << t.message;
+}
+
+TEST(Teach, MethodNamesAreTheApiStringsAndAnUnknownOneIsRefusedByName) {
+  for (TeachMethod m : kAllTeachMethods)
+    EXPECT_EQ(nlohmann::json(ToString(m)).get<TeachMethod>(), m);
+  EXPECT_STREQ(ToString(TeachMethod::kToleranceInterval), "tolerance_interval");
+  EXPECT_STREQ(ToString(TeachMethod::kMad), "mad");
+  // As POST /api/teach reads it: body.value("method", default).
+  const nlohmann::json body = {{"method", "robust"}};
+  try {
+    (void)body.value("method", TeachMethod::kToleranceInterval);
+    FAIL() << "method 'robust' was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "method: unknown value 'robust' (accepted: tolerance_interval, mad)");
+  }
+  EXPECT_THROW((void)nlohmann::json(1).get<TeachMethod>(), std::invalid_argument);
 }
 
 }  // namespace

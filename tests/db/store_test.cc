@@ -25,6 +25,7 @@ namespace fs = std::filesystem;
 using analysis::Measurement;
 using analysis::MeasurementOutcome;
 using analysis::Outcome;
+using analysis::ReasonCode;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -100,13 +101,14 @@ TestRecord MakeRecord(const std::string& serial, const std::string& started_at,
   r.started_at = started_at;
   r.finished_at = started_at.substr(0, 17) + "59.999Z";
   r.outcome = outcome;
-  if (outcome == Outcome::kFail) r.reasons = {"winding_r_ohm 1.9 above 1.5"};
+  if (outcome == Outcome::kFail) r.reasons = {{ReasonCode::kLimit, "winding_r_ohm 1.9 above 1.5"}};
   return r;
 }
 
 TestRecord MakeFullRecord(const std::string& serial, const std::string& started_at) {
   TestRecord r = MakeRecord(serial, started_at, Outcome::kFail);
-  r.reasons = {"winding_r_ohm 1.9 above 1.5", "resonance_f_hz marginal"};
+  r.reasons = {{ReasonCode::kLimit, "winding_r_ohm 1.9 above 1.5"},
+               {ReasonCode::kMask, "resonance_f_hz marginal"}};
   r.measurements = {
       Meas("resonance_f_hz", 1234.5678901234567, 0.25, 1000.0, 1500.0, MeasurementOutcome::kPass,
            /*marginal=*/true),
@@ -346,8 +348,9 @@ TEST_F(StoreTest, RunningTestIsHiddenAndBecomesAbortedAfterACrash) {
   EXPECT_EQ(aborted->outcome, Outcome::kAborted);
   EXPECT_EQ(aborted->serial, "M-42");
   EXPECT_EQ(aborted->recipe_hash, r.recipe_hash);
-  EXPECT_EQ(aborted->reasons,
-            std::vector<std::string>{"interrupted: station stopped before the test finished"});
+  const analysis::Reason interrupted{ReasonCode::kAborted,
+                                     "interrupted: station stopped before the test finished"};
+  EXPECT_EQ(aborted->reasons, std::vector<analysis::Reason>{interrupted});
   EXPECT_TRUE(std::regex_match(aborted->finished_at,
                                std::regex(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z)")))
       << aborted->finished_at;
@@ -475,7 +478,7 @@ TEST_F(StoreTest, ValuesAreBoundNotSpliced) {
   for (const std::string& serial : serials) {
     TestRecord r = MakeRecord(serial, "2024-05-01T10:00:00.000Z");
     r.station_id = serial;
-    r.reasons = {serial};
+    r.reasons = {{ReasonCode::kLimit, serial}};
     store->Insert(r);
     ids.push_back(r.id);
   }
@@ -485,7 +488,7 @@ TEST_F(StoreTest, ValuesAreBoundNotSpliced) {
     EXPECT_EQ(found[0].id, ids[i]);
     EXPECT_EQ(found[0].serial, serials[i]);
     EXPECT_EQ(found[0].station_id, serials[i]);
-    EXPECT_EQ(found[0].reasons, std::vector<std::string>{serials[i]});
+    EXPECT_EQ(found[0].reasons, (std::vector<analysis::Reason>{{ReasonCode::kLimit, serials[i]}}));
     TestQuery q;
     q.serial = serials[i];
     EXPECT_EQ(store->Tests(q).size(), 1u) << serials[i];
@@ -623,6 +626,49 @@ TEST_F(StoreMigrationTest, VersionOneFileMigratesToTwoKeepingItsTests) {
             std::vector<std::string>{std::to_string(Store::kSchemaVersion)});
   EXPECT_EQ(store->TestsOfSerial("OLD-1").size(), 1u);
   EXPECT_TRUE(store->AuditLog().empty());
+}
+
+// Before reasons had codes, the reasons column and the record JSON held plain strings; such
+// rows read back with the code "legacy" and their text unchanged.
+TEST_F(StoreMigrationTest, PlainStringReasonsOfAnOldFileReadAsLegacy) {
+  const fs::path path = dir_ / "old-reasons.sqlite";
+  {
+    RawDb raw(path);
+    raw.Exec(schema::kSchemaV1);
+    raw.Exec("PRAGMA application_id = " + std::to_string(schema::kApplicationId) +
+             "; PRAGMA user_version = 1");
+    raw.Exec(
+        "INSERT INTO tests (serial, station_id, recipe_id, recipe_version, recipe_hash, "
+        "software_version, started_at, finished_at, outcome, reasons, record) VALUES ('OLD-R', "
+        "'s', 'r', 1, 'h', 'v', '2025-01-01T00:00:00.000Z', '2025-01-01T00:00:01.000Z', 'FAIL', "
+        "'[\"resonance_f_hz = 352 Hz below lower limit 370\", \"mask m: worst line\"]', "
+        "'{\"serial\": \"OLD-R\", \"recipe\": {\"id\": \"r\"}, \"outcome\": \"FAIL\", "
+        "\"reasons\": [\"resonance_f_hz = 352 Hz below lower limit 370\"]}')");
+  }
+  auto store = Store::Open(path.string());
+  const auto tests = store->TestsOfSerial("OLD-R");
+  ASSERT_EQ(tests.size(), 1u);
+  EXPECT_EQ(tests[0].outcome, Outcome::kFail);
+  const std::vector<analysis::Reason> want = {
+      {ReasonCode::kLegacy, "resonance_f_hz = 352 Hz below lower limit 370"},
+      {ReasonCode::kLegacy, "mask m: worst line"}};
+  EXPECT_EQ(tests[0].reasons, want);
+  // The record JSON alone (an export of that time) reads the same way.
+  const TestRecord from_json = nlohmann::json::parse(
+                                   R"({"serial": "OLD-R", "recipe": {"id": "r"}, "outcome": "FAIL",
+                                       "reasons": ["mask m: worst line"]})")
+                                   .get<TestRecord>();
+  EXPECT_EQ(from_json.reasons, std::vector<analysis::Reason>{want[1]});
+  // New records are written as {code, text}.
+  EXPECT_EQ(nlohmann::json(want[0]).dump(),
+            R"({"code":"legacy","text":"resonance_f_hz = 352 Hz below lower limit 370"})");
+  try {
+    (void)nlohmann::json::parse(R"({"code": "nope", "text": "x"})").get<analysis::Reason>();
+    FAIL() << "an unknown reason code was accepted";
+  } catch (const nlohmann::json::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("reasons: unknown code 'nope'"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST_F(StoreMigrationTest, AuditLogRoundTripsNewestFirst) {

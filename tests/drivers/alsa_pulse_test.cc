@@ -5,79 +5,25 @@
 // back on both input channels after the server's latency. Contracts: the played multisine
 // comes back (delay found, correlation and amplitude sane); a stalled reader is reported as
 // an xrun naming the device and the frame; an excitation beyond the output's full scale is
-// refused before anything is played.
+// refused before anything is played. Lifecycle, sample count, abort, calibration and errors
+// naming the device are the DAQ contract's (tests/support/daq_contract.h, daq_contract_test).
 #include <gtest/gtest.h>
-#include <sys/socket.h>
-#include <sys/un.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
-#include <thread>
 
 #include "analysis/signal/multisine.h"
 #include "drivers/daq/alsa_daq.h"
 #include "drivers/factory/daq_config.h"
-#include "tests/support/child_process.h"
+#include "tests/support/pulse_server.h"
 
 #if EOL_WITH_ALSA  // else the driver is not built: nothing to test
 namespace eol::drivers {
 namespace {
 
-using eol::testing::ChildProcess;
-using eol::testing::TempDir;
+using eol::testing::PulseServer;
 
 constexpr double kRateHz = 48000.0;
-
-bool CanConnect(const std::string& socket_path) {
-  const int fd = socket(AF_UNIX, SOCK_STREAM, 0);
-  if (fd < 0) return false;
-  sockaddr_un addr{};
-  addr.sun_family = AF_UNIX;
-  std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", socket_path.c_str());
-  const bool ok = connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0;
-  close(fd);
-  return ok;
-}
-
-// A PulseAudio server with one null sink "eol_null", owned by the test. As root it needs its
-// own HOME and XDG_RUNTIME_DIR, no idle exit, and no shared memory.
-class PulseServer {
- public:
-  PulseServer() {
-    socket_ = dir_ / "native";
-    const std::string pulse = "/usr/bin/pulseaudio";
-    if (!std::filesystem::exists(pulse)) return;
-    server_ = std::make_unique<ChildProcess>(std::vector<std::string>{
-        "/usr/bin/env", "HOME=" + dir_.path(), "XDG_RUNTIME_DIR=" + dir_.path(), pulse,
-        "--daemon=no", "--exit-idle-time=-1", "-n", "--use-pid-file=no", "--disable-shm=yes",
-        "--log-target=stderr",
-        "--load=module-null-sink sink_name=eol_null rate=48000 channels=2 format=float32le",
-        "--load=module-native-protocol-unix auth-anonymous=1 socket=" + socket_});
-    for (int i = 0; i < 100 && !ready_; ++i) {
-      ready_ = CanConnect(socket_);
-      if (!ready_) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    }
-    if (ready_) setenv("PULSE_SERVER", ("unix:" + socket_).c_str(), 1);
-  }
-  ~PulseServer() {
-    unsetenv("PULSE_SERVER");
-    if (server_) server_->Stop(SIGTERM, std::chrono::milliseconds(5000));
-  }
-  bool ready() const { return ready_; }
-  std::string why_not() const {
-    if (!server_) return "pulseaudio is not installed (Debian package pulseaudio)";
-    return "pulseaudio did not open " + socket_ + ": " + server_->output();
-  }
-
- private:
-  TempDir dir_;
-  std::string socket_;
-  std::unique_ptr<ChildProcess> server_;
-  bool ready_ = false;
-};
 
 AlsaDaqSettings PulseSettings() {
   AlsaDaqSettings s;
@@ -234,28 +180,6 @@ TEST(AlsaPulse, ExcitationBeyondFullScaleIsRefusedBeforePlaying) {
   ASSERT_FALSE(result.ok());
   EXPECT_NE(result.status().message().find("exceeds the line output's full scale 0.4"),
             std::string::npos)
-      << result.status().message();
-}
-
-TEST(AlsaPulse, AbortStopsTheAcquisition) {
-  PulseServer server;
-  if (!server.ready()) GTEST_SKIP() << server.why_not();
-  AlsaDaq daq(PulseSettings());
-  ASSERT_TRUE(daq.Connect().ok());
-  const analysis::Excitation ex = Multisine();
-  AcquisitionRequest req;
-  req.sample_rate_hz = kRateHz;
-  req.period_samples = ex.period_samples;
-  req.excitation_v = ex.Repeat(100);  // 10 s unless aborted
-  std::atomic<bool> abort{false};
-  std::thread stopper([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    abort = true;
-  });
-  const auto result = daq.Acquire(req, abort);
-  stopper.join();
-  ASSERT_FALSE(result.ok());
-  EXPECT_NE(result.status().message().find("aborted"), std::string::npos)
       << result.status().message();
 }
 

@@ -61,7 +61,7 @@ class ConditionsTest : public ::testing::Test {
 
   static std::string Reasons(const db::TestRecord& r) {
     std::string all;
-    for (const auto& s : r.reasons) all += s + " | ";
+    for (const auto& s : r.reasons) all += s.text + " | ";
     return all;
   }
 
@@ -105,9 +105,10 @@ TEST_F(ConditionsTest, HotWindingIsAnErrorNotAPassAndNotAFail) {
   const db::TestRecord r = Test("COND-HOT", 62.0);
   EXPECT_EQ(r.outcome, Outcome::kError) << Reasons(r);
   ASSERT_FALSE(r.reasons.empty());
-  EXPECT_EQ(r.reasons.front().rfind("condition out of window: winding temperature 6", 0), 0u)
+  EXPECT_EQ(r.reasons.front().code, analysis::ReasonCode::kCondition);
+  EXPECT_EQ(r.reasons.front().text.rfind("condition out of window: winding temperature 6", 0), 0u)
       << Reasons(r);
-  EXPECT_NE(r.reasons.front().find("outside 0.0..45.0 degC"), std::string::npos) << Reasons(r);
+  EXPECT_NE(r.reasons.front().text.find("outside 0.0..45.0 degC"), std::string::npos) << Reasons(r);
   const auto stored = store_->Test(r.id, false);
   ASSERT_TRUE(stored);
   EXPECT_EQ(stored->outcome, Outcome::kError);
@@ -126,9 +127,9 @@ TEST_F(ConditionsTest, ExcitationLevelOutOfWindowIsAnError) {
   const db::TestRecord r = Test("COND-LEVEL");
   EXPECT_EQ(r.outcome, Outcome::kError) << Reasons(r);
   ASSERT_FALSE(r.reasons.empty());
-  EXPECT_EQ(r.reasons.front().rfind("condition out of window: excitation level 1.", 0), 0u)
+  EXPECT_EQ(r.reasons.front().text.rfind("condition out of window: excitation level 1.", 0), 0u)
       << Reasons(r);
-  EXPECT_NE(r.reasons.front().find("outside 1.500..1.600 V rms"), std::string::npos);
+  EXPECT_NE(r.reasons.front().text.find("outside 1.500..1.600 V rms"), std::string::npos);
 }
 
 TEST_F(ConditionsTest, RecordPolicyKeepsTheVerdictAndRecordsTheExcursion) {

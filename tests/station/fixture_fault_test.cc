@@ -120,8 +120,8 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
     ASSERT_EQ(tests.size(), 1u);
     EXPECT_EQ(tests.front().outcome, analysis::Outcome::kError);
     ASSERT_FALSE(tests.front().reasons.empty());
-    EXPECT_NE(tests.front().reasons.front().find(c.cause), std::string::npos)
-        << tests.front().reasons.front();
+    EXPECT_NE(tests.front().reasons.front().text.find(c.cause), std::string::npos)
+        << tests.front().reasons.front().text;
   }
 
   // Excitation off at the fixture: read once the fixture answers again.

@@ -94,7 +94,8 @@ TEST(KillAtRandom, DatabaseStaysConsistentAndInterruptedTestsBecomeAborted) {
     if (tests.front().outcome == analysis::Outcome::kAborted) {
       ++aborted;
       EXPECT_EQ(tests.front().reasons.front(),
-                "interrupted: station stopped before the test finished");
+                (analysis::Reason{analysis::ReasonCode::kAborted,
+                                  "interrupted: station stopped before the test finished"}));
     } else {
       ++finished;
     }

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <sstream>
+#include <string>
 
 #include "../support/child_process.h"
 
@@ -31,6 +33,20 @@ TEST(DebianPackage, HoldsProgramUnitConfigRecipesAndPage) {
                         "./usr/share/eol/web/index.html", "./usr/share/eol/web/app.js"})
     EXPECT_NE(contents.output().find(f), std::string::npos) << f << " missing:\n"
                                                             << contents.output();
+
+  // The packaged program is stripped: "-rwxr-xr-x root/root 3564736 2026-11-24 13:30
+  // ./usr/bin/eol".
+  std::istringstream listing(contents.output());
+  std::string line;
+  long long program_bytes = -1;
+  while (std::getline(listing, line)) {
+    if (line.size() < 13 || line.compare(line.size() - 13, 13, "./usr/bin/eol") != 0) continue;
+    std::istringstream fields(line);
+    std::string perms, owner;
+    fields >> perms >> owner >> program_bytes;
+  }
+  EXPECT_GT(program_bytes, 0) << contents.output();
+  EXPECT_LT(program_bytes, 15ll * 1024 * 1024) << "the packaged program is not stripped";
 
   eol::testing::ChildProcess control({"/usr/bin/dpkg-deb", "-I", deb});
   ASSERT_EQ(control.Wait(60s).value_or(-1), 0);

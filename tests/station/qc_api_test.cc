@@ -89,7 +89,8 @@ TEST_F(QcApi, EngineersTeachFromStoredUnitsAndTheProposalIsAValidNextVersion) {
     serials.push_back(serial);
   }
   serials.push_back("NEVER-TESTED");
-  const std::string body = nlohmann::json{{"serials", serials}}.dump();
+  // Eight units are fewer than the method needs: the engineer forces it (the recipe says so).
+  const std::string body = nlohmann::json{{"serials", serials}, {"allow_few_units", true}}.dump();
 
   auto res = http_->Post("/api/teach", body, "application/json");
   ASSERT_TRUE(res);
@@ -110,15 +111,18 @@ TEST_F(QcApi, EngineersTeachFromStoredUnitsAndTheProposalIsAValidNextVersion) {
   EXPECT_NE(taught["skipped"][0].get<std::string>().find("NEVER-TESTED: no test stored"),
             std::string::npos);
   EXPECT_EQ(taught["recipe"]["version"], 2);
-  // The learned resonance window is centred on the golden units (all near 390 Hz) and, with
-  // only 8 of them, wide: the summary says how many units the stated confidence needs.
+  // The learned resonance window brackets the golden units (all near 390 Hz) and, with only 8
+  // of them, is wide: the summary says how many units the stated confidence needs. The budget
+  // is spent by physics (analysis/qc/teach.h): the lower bound, where a soft bond moves f0,
+  // gets most of it and sits closer to the units than the plausibility upper bound.
   bool saw_f0 = false;
   for (const auto& l : taught["recipe"]["limits"]) {
     if (l["name"] != "resonance_f_hz") continue;
     saw_f0 = true;
     EXPECT_LT(l["lo"].get<double>(), 389.0);
     EXPECT_GT(l["hi"].get<double>(), 391.0);
-    EXPECT_NEAR(0.5 * (l["lo"].get<double>() + l["hi"].get<double>()), 390.0, 5.0);
+    EXPECT_GT(l["lo"].get<double>(), 340.0);
+    EXPECT_LT(390.0 - l["lo"].get<double>(), l["hi"].get<double>() - 390.0);
   }
   EXPECT_TRUE(saw_f0);
   EXPECT_GT(taught["units_needed"].get<int>(), 8);

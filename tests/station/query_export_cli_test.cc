@@ -36,7 +36,8 @@ db::TestRecord Record(const std::string& serial, const std::string& t, analysis:
   m.outcome = f0 >= 370 ? analysis::MeasurementOutcome::kPass : analysis::MeasurementOutcome::kFail;
   r.measurements.push_back(m);
   if (o == analysis::Outcome::kFail)
-    r.reasons.push_back("resonance_f_hz = 352 Hz, below 370, \"low\"");
+    r.reasons.push_back(
+        {analysis::ReasonCode::kLimit, "resonance_f_hz = 352 Hz, below 370, \"low\""});
   return r;
 }
 
@@ -72,7 +73,8 @@ TEST_F(QueryExportTest, QueryShowsHistoryNewestFirstWithRetestLink) {
   const CliRun text = Eol({"query", "--db", db_, "--serial", "SN-1"});
   EXPECT_EQ(text.code, 0);
   EXPECT_NE(text.out.find("SN-1: 2 test(s), latest PASS"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("reason: resonance_f_hz = 352 Hz"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("reason (limit): resonance_f_hz = 352 Hz"), std::string::npos)
+      << text.out;
 }
 
 TEST_F(QueryExportTest, UnknownSerialExitsOneAndBadSerialIsRefused) {

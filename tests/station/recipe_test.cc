@@ -153,3 +153,49 @@ TEST(RecipeMasks, ShippedMaskParsesAndBadMasksNameTheirPath) {
 
 }  // namespace
 }  // namespace eol::station
+
+namespace eol::station {
+namespace {
+
+// Every key of `part` is in `whole` with the same value (arrays element by element).
+void ExpectContained(const nlohmann::json& part, const nlohmann::json& whole,
+                     const std::string& path) {
+  if (part.is_object()) {
+    ASSERT_TRUE(whole.is_object()) << path << ": not an object in " << whole.dump();
+    for (const auto& [key, value] : part.items()) {
+      ASSERT_TRUE(whole.contains(key)) << path << "/" << key << " is not written";
+      ExpectContained(value, whole.at(key), path + "/" + key);
+    }
+  } else if (part.is_array()) {
+    ASSERT_TRUE(whole.is_array() && whole.size() == part.size()) << path;
+    for (std::size_t i = 0; i < part.size(); ++i)
+      ExpectContained(part[i], whole[i], path + "/" + std::to_string(i));
+  } else if (part.is_number()) {
+    EXPECT_DOUBLE_EQ(part.get<double>(), whole.get<double>()) << path;
+  } else {
+    EXPECT_EQ(part, whole) << path;
+  }
+}
+
+TEST(RecipeJson, OneFieldListReadsAndWritesEveryKey) {
+  nlohmann::json source = io::ReadJsonFile(kRecipe);
+  source["excitation"].erase("phase_pair");
+  source["excitation"]["phase_pairs"] = {0, 2};
+  source["retest"] = {{"max_tests_per_serial", 5}};
+  source["conditions"] = {
+      {"winding_temperature_c", {{"r_ref_ohm", 0.5}, {"t_ref_c", 21.0}, {"lo", 5.0}, {"hi", 45.0}}},
+      {"excitation_v_rms", {{"lo", 0.1}}},
+      {"excitation_a_rms", {{"hi", 3.0}}},
+      {"out_of_window", "record"}};
+  const Recipe r = ParseRecipe(source, "test");
+  const nlohmann::json written = RecipeToJson(r);
+  ExpectContained(source, written, "");  // nothing the file said is lost or changed
+  const Recipe again = ParseRecipe(written, "written");
+  EXPECT_EQ(RecipeToJson(again), written);  // and what is written reads back the same
+  EXPECT_EQ(again.phase_pairs, r.phase_pairs);
+  EXPECT_EQ(again.masks.size(), r.masks.size());
+  EXPECT_FALSE(again.conditions.error_when_out);
+}
+
+}  // namespace
+}  // namespace eol::station

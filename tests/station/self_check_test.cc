@@ -47,7 +47,7 @@ class SelfCheckTest : public ::testing::Test {
 
   static std::string Reasons(const db::TestRecord& r) {
     std::string all;
-    for (const auto& s : r.reasons) all += s + " | ";
+    for (const auto& s : r.reasons) all += s.text + " | ";
     return all;
   }
 
@@ -67,14 +67,14 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
     const db::TestRecord refused = s.RunTest("U-1");
     EXPECT_EQ(refused.outcome, Outcome::kError);
     ASSERT_FALSE(refused.reasons.empty());
-    EXPECT_EQ(refused.reasons.front().rfind("station locked out: no self-check", 0), 0u)
+    EXPECT_EQ(refused.reasons.front().text.rfind("station locked out: no self-check", 0), 0u)
         << Reasons(refused);
     EXPECT_TRUE(s.store().TestsOfSerial("U-1").empty());
     EXPECT_FALSE(s.bench()->output(drivers::FixtureOutput::kClampCmd));
 
     const db::TestRecord good = s.RunTest("MASTER-G");
     EXPECT_EQ(good.outcome, Outcome::kPass) << Reasons(good);
-    EXPECT_EQ(good.kind, "self_check");
+    EXPECT_EQ(good.kind, db::RecordKind::kSelfCheck);
     EXPECT_TRUE(good.self_check.at("passed").get<bool>()) << Reasons(good);
     EXPECT_TRUE(Lockout(s).at("locked").get<bool>());  // the limit master is still due
     const db::TestRecord limit = s.RunTest("MASTER-L");
@@ -88,7 +88,7 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
 
     const db::TestRecord unit = s.RunTest("U-1");
     EXPECT_EQ(unit.outcome, Outcome::kPass) << Reasons(unit);
-    EXPECT_EQ(s.store().Test(unit.id)->kind, "production");
+    EXPECT_EQ(s.store().Test(unit.id)->kind, db::RecordKind::kProduction);
   }
   std::string failed_at;
   {
@@ -107,9 +107,9 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
     const db::TestRecord refused = s.RunTest("U-2");
     EXPECT_EQ(refused.outcome, Outcome::kError);
     ASSERT_FALSE(refused.reasons.empty());
-    EXPECT_EQ(refused.reasons.front().rfind("station locked out: self-check failed at " +
-                                                failed_at + ": limit master MASTER-L PASSed",
-                                            0),
+    EXPECT_EQ(refused.reasons.front().text.rfind("station locked out: self-check failed at " +
+                                                     failed_at + ": limit master MASTER-L PASSed",
+                                                 0),
               0u)
         << Reasons(refused);
     EXPECT_TRUE(s.store().TestsOfSerial("U-2").empty());
@@ -155,9 +155,10 @@ TEST_F(SelfCheckTest, ACheckIsDueAfterEveryNTestsAndAfterEveryHours) {
     const db::TestRecord due = s.RunTest("U-3");
     EXPECT_EQ(due.outcome, Outcome::kError);
     ASSERT_FALSE(due.reasons.empty());
-    EXPECT_NE(due.reasons.front().find("station locked out: self-check due: 2 production tests "
-                                       "since the last check"),
-              std::string::npos)
+    EXPECT_NE(
+        due.reasons.front().text.find("station locked out: self-check due: 2 production tests "
+                                      "since the last check"),
+        std::string::npos)
         << Reasons(due);
     // Both masters again: the older check sets the window, so one master is not enough.
     EXPECT_EQ(s.RunTest("MASTER-G").outcome, Outcome::kPass);
@@ -174,9 +175,9 @@ TEST_F(SelfCheckTest, ACheckIsDueAfterEveryNTestsAndAfterEveryHours) {
     const db::TestRecord due = s.RunTest("U-4");
     EXPECT_EQ(due.outcome, Outcome::kError);
     ASSERT_FALSE(due.reasons.empty());
-    EXPECT_NE(due.reasons.front().find("self-check due: the last check"), std::string::npos)
+    EXPECT_NE(due.reasons.front().text.find("self-check due: the last check"), std::string::npos)
         << Reasons(due);
-    EXPECT_NE(due.reasons.front().find("is older than 0.0001 h"), std::string::npos)
+    EXPECT_NE(due.reasons.front().text.find("is older than 0.0001 h"), std::string::npos)
         << Reasons(due);
   }
 }

@@ -50,7 +50,7 @@ class SequencerTest : public ::testing::Test {
 
   static bool HasReason(const db::TestRecord& r, const std::string& text) {
     for (const auto& reason : r.reasons)
-      if (reason.find(text) != std::string::npos) return true;
+      if (reason.text.find(text) != std::string::npos) return true;
     return false;
   }
 
@@ -77,7 +77,7 @@ class SequencerTest : public ::testing::Test {
 TEST_F(SequencerTest, GoodRotorPassesAndIsStoredWithEverything) {
   Build(0.0);
   const db::TestRecord r = Test("GOOD-1", false);
-  EXPECT_EQ(r.outcome, Outcome::kPass) << (r.reasons.empty() ? "" : r.reasons.front());
+  EXPECT_EQ(r.outcome, Outcome::kPass) << (r.reasons.empty() ? "" : r.reasons.front().text);
   ExpectStored(r);
   const auto stored = store_->Test(r.id);
   ASSERT_TRUE(stored);
@@ -128,7 +128,8 @@ TEST_F(SequencerTest, EveryPhasePairOfTheRecipeIsMeasuredInOneClamping) {
   sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
                                            std::make_shared<const Recipe>(recipe_), *board_, o);
   const db::TestRecord good = Test("PAIRS-GOOD", false);
-  EXPECT_EQ(good.outcome, Outcome::kPass) << (good.reasons.empty() ? "" : good.reasons.front());
+  EXPECT_EQ(good.outcome, Outcome::kPass)
+      << (good.reasons.empty() ? "" : good.reasons.front().text);
   EXPECT_EQ(good.measurements.size(), 3 * recipe_.Specs().size());
   std::vector<std::string> curves;
   const auto stored = store_->Test(good.id);
@@ -154,7 +155,8 @@ TEST_F(SequencerTest, PoorlyCementedRotorFailsOnResonance) {
   Build(0.0);
   const db::TestRecord r = Test("BAD-1", true);
   EXPECT_EQ(r.outcome, Outcome::kFail);
-  EXPECT_TRUE(HasReason(r, "resonance_f_hz")) << r.reasons.front();
+  EXPECT_TRUE(HasReason(r, "resonance_f_hz")) << r.reasons.front().text;
+  EXPECT_EQ(r.reasons.front().code, analysis::ReasonCode::kLimit);
   ExpectStored(r);
   EXPECT_TRUE(bench_->output(FixtureOutput::kLampFail));
 }
@@ -165,7 +167,7 @@ TEST_F(SequencerTest, ClampLostDuringExcitationIsErrorWithExcitationCutFast) {
   const db::TestRecord r = Test("DROP-1", false);
   EXPECT_EQ(r.outcome, Outcome::kError);
   EXPECT_TRUE(HasReason(r, "interlock lost during excitation: clamp not confirmed"))
-      << r.reasons.front();
+      << r.reasons.front().text;
   ExpectStored(r);
   EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
   // The watchdog, not the end of the stream, opened the relay (the 50 ms target is measured by
@@ -197,12 +199,13 @@ TEST_F(SequencerTest, FixtureThatStopsAnsweringIsErrorAndStationRecovers) {
   bench_->InjectFault(SimFault::kStopsAnswering, 100ms);
   const db::TestRecord r = Test("DEAD-1", false);
   EXPECT_EQ(r.outcome, Outcome::kError);
-  EXPECT_TRUE(HasReason(r, "fixture not answering during excitation")) << r.reasons.front();
+  EXPECT_TRUE(HasReason(r, "fixture not answering during excitation")) << r.reasons.front().text;
   EXPECT_FALSE(bench_->excitation_connected());
   ExpectStored(r);
   bench_->ClearFaults();
   const db::TestRecord next = Test("GOOD-3", false);
-  EXPECT_EQ(next.outcome, Outcome::kPass) << (next.reasons.empty() ? "" : next.reasons.front());
+  EXPECT_EQ(next.outcome, Outcome::kPass)
+      << (next.reasons.empty() ? "" : next.reasons.front().text);
 }
 
 TEST_F(SequencerTest, FrozenHeartbeatIsError) {
@@ -210,7 +213,7 @@ TEST_F(SequencerTest, FrozenHeartbeatIsError) {
   bench_->InjectFault(SimFault::kHeartbeatFreezes, 0ms);
   const db::TestRecord r = Test("HB-1", false);
   EXPECT_EQ(r.outcome, Outcome::kError);
-  EXPECT_TRUE(HasReason(r, "heartbeat frozen")) << r.reasons.front();
+  EXPECT_TRUE(HasReason(r, "heartbeat frozen")) << r.reasons.front().text;
   EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
 }
 
@@ -219,7 +222,8 @@ TEST_F(SequencerTest, AcquisitionFailureIsError) {
   bench_->InjectFault(SimFault::kDaqFails, 0ms);
   const db::TestRecord r = Test("DAQ-1", false);
   EXPECT_EQ(r.outcome, Outcome::kError);
-  EXPECT_TRUE(HasReason(r, "acquisition failed")) << r.reasons.front();
+  EXPECT_TRUE(HasReason(r, "acquisition failed")) << r.reasons.front().text;
+  EXPECT_EQ(r.reasons.front().code, analysis::ReasonCode::kAcquisition);
   EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
   ExpectStored(r);
 }
@@ -229,7 +233,8 @@ TEST_F(SequencerTest, PressureOutOfWindowIsError) {
   bench_->InjectFault(SimFault::kPressureLow, 150ms);
   const db::TestRecord r = Test("P-1", false);
   EXPECT_EQ(r.outcome, Outcome::kError);
-  EXPECT_TRUE(HasReason(r, "clamp pressure 1.00 bar outside 4.50..6.50 bar")) << r.reasons.front();
+  EXPECT_TRUE(HasReason(r, "clamp pressure 1.00 bar outside 4.50..6.50 bar"))
+      << r.reasons.front().text;
 }
 
 TEST_F(SequencerTest, NoPartIsErrorBeforeClamping) {

@@ -28,7 +28,8 @@ const std::string kHashA(64, 'a');  // the known-answer recipe
 const std::string kHashD(64, 'd');  // a drifting one
 
 db::TestRecord Record(const std::string& serial, int minute, Outcome o, double f0,
-                      const std::string& hash = kHashA, const std::string& kind = "production") {
+                      const std::string& hash = kHashA,
+                      db::RecordKind kind = db::RecordKind::kProduction) {
   char t[32];
   std::snprintf(t, sizeof t, "2026-11-20T%02d:%02d:00.000Z", 8 + minute / 60, minute % 60);
   db::TestRecord r;
@@ -42,7 +43,8 @@ db::TestRecord Record(const std::string& serial, int minute, Outcome o, double f
   r.finished_at = t;
   r.outcome = o;
   r.kind = kind;
-  if (kind == "self_check") r.self_check = {{"master", "good"}, {"passed", true}, {"detail", ""}};
+  if (kind == db::RecordKind::kSelfCheck)
+    r.self_check = {{"master", "good"}, {"passed", true}, {"detail", ""}};
   analysis::Measurement m;
   m.name = "resonance_f_hz";
   m.unit = "Hz";
@@ -85,7 +87,7 @@ class StatsKnownAnswer : public ::testing::Test {
     // Cg = 0.2 * 50 / (6 s) = 2.04124145; reference 389.5, bias 0.5:
     // Cgk = (5 - 0.5) / (3 s) = 1.83711731.
     for (double f : {389.0, 390.0, 391.0, 390.0, 389.0, 391.0, 390.0, 390.0, 389.0, 391.0}) {
-      auto r = Record("MASTER-G", minute++, Outcome::kPass, f, kHashA, "self_check");
+      auto r = Record("MASTER-G", minute++, Outcome::kPass, f, kHashA, db::RecordKind::kSelfCheck);
       store->Insert(r);
     }
     // Recipe D drifts: 380 + i + 0.5 (-1)^i over 20 passing tests (+19 Hz, 38 % of 50 Hz).
@@ -227,7 +229,7 @@ nlohmann::json DriftRun(const eol::testing::TempDir& dir, const std::string& nam
     std::snprintf(serial, sizeof serial, "W-%03d", i);
     const db::TestRecord r = s.RunTest(serial);
     EXPECT_NE(r.outcome, Outcome::kError)
-        << serial << ": " << (r.reasons.empty() ? "" : r.reasons[0]);
+        << serial << ": " << (r.reasons.empty() ? "" : r.reasons[0].text);
   }
   return station::StatsReport(s.store(), {});
 }

@@ -48,7 +48,9 @@ class TeachCli : public ::testing::Test {
           Simulated(dir_, "g" + std::to_string(i) + ".csv", 100 + i, "none", 1.0 + 0.5 * (i % 4)));
   }
   std::vector<std::string> TeachArgs(const std::string& out) {
-    std::vector<std::string> a = {"teach", "--recipe", kRecipe, "--out", out, "--golden"};
+    // 12 units: fewer than the method needs for the default budget, so forced.
+    std::vector<std::string> a = {"teach", "--recipe",          kRecipe,   "--out",
+                                  out,     "--allow-few-units", "--golden"};
     a.insert(a.end(), golden_.begin(), golden_.end());
     return a;
   }
@@ -105,8 +107,9 @@ TEST_F(TeachCli, WritesANewVersionAndRefusesToOverwrite) {
 }
 
 TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
-  std::vector<std::string> args = {"teach",         "--recipe", kRecipe,   "--out",
-                                   dir_ / "j.json", "--json",   "--golden"};
+  std::vector<std::string> args = {
+      "teach",  "--recipe",          kRecipe,   "--out", dir_ / "j.json",
+      "--json", "--allow-few-units", "--golden"};
   for (std::size_t i = 0; i < 6; ++i) {
     const CliRun a = Eol({"analyze", "--measured", golden_[i], "--json"}, false);
     ASSERT_EQ(a.code, 0) << a.out;
@@ -124,35 +127,67 @@ TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
   EXPECT_GT(j["units_needed"].get<int>(), 6);
 }
 
-// `eol export --format json` records: every finished record is a golden unit, ERROR records
-// are skipped and listed.
-TEST_F(TeachCli, ReadsExportedRecords) {
-  nlohmann::json list = nlohmann::json::array();
-  const char* names[] = {"resonance_f_hz", "resonance_q", "winding_r_ohm", "winding_l_h",
-                         "fit_chi2_per_dof"};
-  for (int i = 0; i < 10; ++i) {
-    db::TestRecord r;
-    r.serial = "SN" + std::to_string(i);
-    r.outcome = i == 4 ? analysis::Outcome::kError : analysis::Outcome::kPass;
-    const double values[] = {390.0 + 0.7 * (i % 5) - 1.4, 50.0 + (i % 3), 0.5 + 0.002 * (i % 4),
-                             2e-3 * (1.0 + 0.01 * (i % 2)), 1.0 + 0.02 * (i % 3)};
-    for (int k = 0; k < 5 && i != 4; ++k) {
-      analysis::Measurement m;
-      m.name = names[k];
-      m.value = values[k];
-      r.measurements.push_back(m);
+// `eol export --format json` records: PASS production records of this recipe are golden
+// units; a FAIL, ERROR or ABORTED record, a master's self-check and a record of another recipe
+// hash are refused, naming the record.
+TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
+  const std::string hash = station::LoadRecipe(kRecipe).hash;
+  auto records = [&](auto spoil) {
+    nlohmann::json list = nlohmann::json::array();
+    const char* names[] = {"resonance_f_hz", "resonance_q", "winding_r_ohm", "winding_l_h",
+                           "fit_chi2_per_dof"};
+    for (int i = 0; i < 10; ++i) {
+      db::TestRecord r;
+      r.serial = "SN" + std::to_string(i);
+      r.outcome = analysis::Outcome::kPass;
+      r.recipe_hash = hash;
+      const double values[] = {390.0 + 0.7 * (i % 5) - 1.4, 50.0 + (i % 3), 0.5 + 0.002 * (i % 4),
+                               2e-3 * (1.0 + 0.01 * (i % 2)), 1.0 + 0.02 * (i % 3)};
+      for (int k = 0; k < 5; ++k) {
+        analysis::Measurement m;
+        m.name = names[k];
+        m.value = values[k];
+        r.measurements.push_back(m);
+      }
+      if (i == 4) spoil(r);
+      list.push_back(r);
     }
-    list.push_back(r);
-  }
-  const std::string path = dir_ / "export.json";
-  std::ofstream(path) << list.dump(1);
-  const CliRun r = Eol({"teach", "--recipe", kRecipe, "--out", dir_ / "e.json", "--golden", path});
+    const std::string path = dir_ / "export.json";
+    std::ofstream(path) << list.dump(1);
+    return path;
+  };
+  auto teach = [&](const std::string& path) {
+    return Eol({"teach", "--recipe", kRecipe, "--out", dir_ / "e.json", "--force",
+                "--allow-few-units", "--golden", path});
+  };
+  std::string path = records([](db::TestRecord&) {});
+  CliRun r = teach(path);
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("skipped " + path + "[4] SN4: ERROR"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("9 of 9 golden units used"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("10 of 10 golden units used"), std::string::npos) << r.out;
   const station::Recipe taught = station::LoadRecipe(dir_ / "e.json");
   EXPECT_LT(*taught.limits[0].limit.lo, 388.6);
   EXPECT_GT(*taught.limits[0].limit.hi, 391.4);
+  EXPECT_NE(taught.description.find("FORCED: 10 golden units"), std::string::npos);
+
+  for (auto outcome :
+       {analysis::Outcome::kFail, analysis::Outcome::kError, analysis::Outcome::kAborted}) {
+    path = records([&](db::TestRecord& rec) { rec.outcome = outcome; });
+    r = teach(path);
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_NE(r.out.find("record " + path + "[4] SN4 is " + analysis::ToString(outcome) +
+                         ": only PASS records are golden units"),
+              std::string::npos)
+        << r.out;
+  }
+  path = records([](db::TestRecord& rec) { rec.kind = db::RecordKind::kSelfCheck; });
+  r = teach(path);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("SN4 is a self_check test (a master part)"), std::string::npos) << r.out;
+  path = records([](db::TestRecord& rec) { rec.recipe_hash = "abc123"; });
+  r = teach(path);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("SN4 was tested with recipe hash abc123, not " + hash), std::string::npos)
+      << r.out;
 }
 
 TEST_F(TeachCli, ErrorsNameTheFile) {
@@ -166,6 +201,15 @@ TEST_F(TeachCli, ErrorsNameTheFile) {
       {"teach", "--recipe", kRecipe, "--out", dir_ / "x.json", "--golden", golden_[0], golden_[1]});
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_NE(r.out.find("too few golden units"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "x.json"));
+  // Twelve units are fewer than the default budget needs: refused without --allow-few-units.
+  std::vector<std::string> args = {"teach", "--recipe",      kRecipe,
+                                   "--out", dir_ / "x.json", "--golden"};
+  args.insert(args.end(), golden_.begin(), golden_.end());
+  r = Eol(args);
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("too few golden units: 12 used, "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--allow-few-units"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.json"));
 }
 

@@ -1,0 +1,40 @@
+#include "station/http/reply.h"
+
+#include <httplib.h>
+
+namespace eol::station::http {
+
+int HttpStatus(ApiErrorKind kind) {
+  switch (kind) {
+    case ApiErrorKind::kBadRequest:
+      return 400;
+    case ApiErrorKind::kUnauthorized:
+      return 401;
+    case ApiErrorKind::kForbidden:
+      return 403;
+    case ApiErrorKind::kNotFound:
+      return 404;
+    case ApiErrorKind::kConflict:
+      return 409;
+    case ApiErrorKind::kTooLarge:
+      return 413;
+    case ApiErrorKind::kUnprocessable:
+      return 422;
+    case ApiErrorKind::kInternal:
+      return 500;
+  }
+  return 500;
+}
+
+HttpReply ToReply(const ApiError& error) {
+  return {HttpStatus(error.kind), {{"error", {{"code", error.code}, {"message", error.message}}}}};
+}
+
+void Send(httplib::Response& res, const HttpReply& reply) {
+  res.status = reply.status;
+  res.set_content(reply.body.dump(), "application/json");
+}
+
+void Send(httplib::Response& res, const ApiError& error) { Send(res, ToReply(error)); }
+
+}  // namespace eol::station::http

@@ -1,0 +1,43 @@
+// Reading a request: who is asking (bearer tokens and roles) and its JSON body. Each returns
+// what was asked for or the ApiError to answer with, so a handler's first lines are
+//
+//   const auto who = RequireRole(req, tokens, Role::kEngineer, "change recipes");
+//   if (const ApiError* e = std::get_if<ApiError>(&who)) return Send(res, *e);
+#pragma once
+
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "station/config.h"
+#include "station/http/reply.h"
+
+namespace httplib {
+struct Request;
+}
+
+namespace eol::station::http {
+
+// Request bodies are small JSON documents (a serial, a recipe, a list of serials).
+inline constexpr std::size_t kMaxBodyBytes = 64 * 1024;
+
+// The token of "Authorization: Bearer <token>", or "" when the header is absent or other.
+std::string BearerToken(const httplib::Request& req);
+
+// The configured token the request presents, if its role is at least `role`.
+//   no or unknown token: 401 "unauthorized", except that operator routes are open while no
+//     tokens are configured (then the caller is {"anonymous", operator});
+//   a token of a lower role: 403 "forbidden", "only engineers may <action>".
+// Engineer routes always need a token. Token values never appear in messages.
+std::variant<ApiToken, ApiError> RequireRole(const httplib::Request& req,
+                                             const std::vector<ApiToken>& tokens, Role role,
+                                             std::string_view action);
+
+// The body as JSON: 413 "too_large" above `max_bytes`, 400 "bad_json" when it does not parse.
+std::variant<nlohmann::json, ApiError> ParseBody(const httplib::Request& req,
+                                                 std::size_t max_bytes = kMaxBodyBytes);
+
+}  // namespace eol::station::http

@@ -1,0 +1,30 @@
+// The API's routes by resource (the list with their contracts is in station/http_api.h), and
+// the mapping of the station's typed results to HTTP statuses and JSON.
+#pragma once
+
+#include "station/http/context.h"
+#include "station/http/reply.h"
+#include "station/qc_service.h"
+#include "station/recipe_change.h"
+
+namespace eol::station::http {
+
+// GET /api/status, GET /api/events, GET /metrics, GET / and /static (station/http/board_routes.cc)
+void AddBoardRoutes(httplib::Server& s, ApiContext& c);
+// GET /api/recipe, PUT /api/recipe, GET /api/recipe/audit (station/http/recipe_routes.cc)
+void AddRecipeRoutes(httplib::Server& s, ApiContext& c);
+// GET /api/units/{serial}, GET /api/tests/{id}, GET /api/tests, POST /api/tests
+void AddTestRoutes(httplib::Server& s, ApiContext& c);
+// GET /api/stats, GET /api/detectability, POST /api/teach (station/http/qc_routes.cc)
+void AddQcRoutes(httplib::Server& s, ApiContext& c);
+
+// kChanged: 200 with {id, version, hash, path, previous: {version, hash, kept_as}};
+// kInvalid: 400 "invalid_recipe"; kBusy: 409 "busy"; kWrongRecipe: 409 "wrong_recipe";
+// kVersionNotIncreased: 409 "version_not_increased"; kIoError: 500 "recipe_not_written".
+HttpReply RecipeChangeReply(const RecipeChange& change);
+
+// kProposed: 200 with the report; kNotUsable: 422 with the report (it says why);
+// kBadSerial: 400 "bad_serial"; kInvalidRecipe: 422 "invalid_recipe".
+HttpReply TeachReply(const TeachResult& result);
+
+}  // namespace eol::station::http

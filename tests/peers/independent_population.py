@@ -1,0 +1,230 @@
+#!/usr/bin/python3
+"""Independent production population of clamped ten-pole rotors, written from the physics.
+
+Shares no code or model with analysis/ (issue 12): its own chain topology, its own spreads,
+its own damping law and its own measurement simulation. Only the nominal numbers are chosen so
+that the station's shipped recipe (recipes/pmsm-10pole.json) sees the same band: good rotors
+ring near 390 Hz in the fixture (NOTES.md section 2: 706 Hz rigid shaft, 529 Hz with every
+magnet bonded on one side only, 390 Hz in the real fixture).
+
+Mechanics: a clamped torsional chain, N = 14 degrees of freedom (angles, rad):
+  magnets m1..m10 (J_m each) --bond k_b,i + c_b,i--> pole body (J_p, the laminated poles)
+  pole body --bridges (ten in parallel, k_br each)--> hub (J_h)
+  hub --shaft k_s--> clamp collar (J_c) --fixture k_f--> ground.
+Equation of motion, torque vector tau:  (K - w^2 M + j w C) theta = tau.
+Every spring has a hysteretic-like damper c = eta k / w_ref (w_ref = 2 pi 390 rad/s), eta
+per material: adhesive 0.03 (poor bond 0.06), steel 0.01, fixture contact 0.03.
+The electromagnetic torque acts on the magnets: torque T i shared 1/10 per magnet, and the
+back-EMF is T times the mean magnet velocity, so with the mobility Y(w) = j w (K - w^2 M +
+j w C)^-1 (rad/s per N m) and b = (1/10, ..., 1/10, 0, ...):
+  Z(w) = R + j w L + T^2 b^T Y(w) b            (the paper's eq. 12-14, T^2 / Z_m).
+
+Production spread (per unit, independent normal unless stated): magnet inertia 2 %, pole body
+1.5 %, hub 1 %, clamp collar 2 %, bond stiffness 12 % lognormal and bond loss factor 20 % per
+magnet, each bridge 3 %, shaft 2 %; the clamp: fixture stiffness proportional to
+(F / 5.5 bar)^(1/3) with clamp pressure F ~ N(5.5, 0.3) bar clipped to 4.5-6.5 bar, times a
+2 % lognormal seat/wear factor. Electrical: R = 0.5 ohm (1 +- 1 %) (1 + 0.00393 (T_w - 20)),
+winding temperature T_w uniform 15-35 degC; L = 2 mH (2 %); torque constant T = 0.05 N m/A (4 %).
+
+Bond softness (defects), a continuum: a soft magnet keeps a fraction r of its bond stiffness
+with log10(r) uniform on [log10 0.01, log10 0.06] (r = 0.04 is the paper's one-side-cemented
+case, 888 -> 37 N m/rad), i.e. a stiffness loss 1 - r between 94 % and 99 %. Classes: good (no
+soft magnet), one_soft, three_soft (three distinct magnets), all_soft (all ten, each its own r).
+
+Measurement: periodic Schroeder multisine over 200-800 Hz at 1 Hz spacing (601 lines), 2 V
+peak with crest factor 1.7 (line amplitude A = 2 / (1.7 sqrt(601 / 2)) V), sampled at 8 kHz,
+P = 4 periods of 1 s. The DAQ adds white noise of 2 mV (voltage) and 1 mA (current) rms per
+sample: per period and line the DFT error is complex Gaussian with E|e|^2 = 4 s^2 / N
+(N = 8000 samples). Z = mean U / mean I; its sigma from the period-to-period scatter (NOTES.md
+section 3), var Z = |Z|^2 / P (s_U^2 / |U|^2 + s_I^2 / |I|^2 - 2 Re(s_UI / (U I*))), the
+sample (co)variances pooled over 11 neighbouring lines (4 periods alone give 3 degrees of
+freedom per line).
+
+Output in --out: unit-NNNN.csv (f_hz,re_ohm,im_ohm,sigma_ohm), and truth.csv: unit, class,
+first_mode_hz (lowest mode of the undamped chain; with a very soft bond it is that
+magnet's local mode), k_fixture, and the bond stiffness fraction r of
+each magnet (1 for a good bond; loss = 1 - r).
+"""
+import argparse
+import csv
+import os
+import sys
+
+import numpy as np
+import scipy.linalg
+
+W_REF = 2.0 * np.pi * 390.0
+MAGNETS = 10
+
+# Nominal parts. Bond and bridge stiffness were set so that the rigidly clamped chain rings at
+# about 706 Hz and at about 530 Hz with every bond at 4 %, and the fixture so that the clamped
+# good rotor rings at about 390 Hz (main() --nominal prints these).
+NOMINAL = dict(
+    j_magnet=2.5e-6, j_pole=6.5e-5, j_hub=1.0e-5, j_clamp=5.0e-6,  # kg m^2
+    k_bond=918.0, k_bridge=502.0, k_shaft=3000.0, k_fixture=891.0,  # N m/rad
+    eta_bond=0.03, eta_poor=0.06, eta_steel=0.01, eta_fixture=0.03,
+    r_ohm=0.5, l_h=2.0e-3, t_nm_per_a=0.05)
+
+CLASSES = {"good": 0, "one_soft": 1, "three_soft": 3, "all_soft": MAGNETS}
+
+
+def chain_matrices(p, r_bond, rigid=False):
+    """M, K, C of the chain for part values p and bond stiffness fractions r_bond (10,)."""
+    n = MAGNETS + 2 + (0 if rigid else 1)
+    pole, hub, clamp = MAGNETS, MAGNETS + 1, MAGNETS + 2
+    m = np.zeros(n)
+    m[:MAGNETS] = p["j_magnets"]
+    m[pole], m[hub] = p["j_pole"], p["j_hub"]
+    if not rigid:
+        m[clamp] = p["j_clamp"]
+    k = np.zeros((n, n))
+    c = np.zeros((n, n))
+
+    def spring(a, b, kk, eta):
+        cc = eta * kk / W_REF
+        for mat, v in ((k, kk), (c, cc)):
+            mat[a, a] += v
+            if b is not None:
+                mat[b, b] += v
+                mat[a, b] -= v
+                mat[b, a] -= v
+
+    for i in range(MAGNETS):
+        poor = r_bond[i] < 1.0
+        spring(i, pole, p["k_bonds"][i] * r_bond[i],
+               (NOMINAL["eta_poor"] if poor else p["eta_bonds"][i]))
+    spring(pole, hub, float(np.sum(p["k_bridges"])), NOMINAL["eta_steel"])
+    if rigid:
+        spring(hub, None, p["k_shaft"], NOMINAL["eta_steel"])
+    else:
+        spring(hub, clamp, p["k_shaft"], NOMINAL["eta_steel"])
+        spring(clamp, None, p["k_fixture"], NOMINAL["eta_fixture"])
+    return np.diag(m), k, c
+
+
+def first_mode_hz(p, r_bond, rigid=False):
+    m, k, _ = chain_matrices(p, r_bond, rigid)
+    w2 = scipy.linalg.eigh(k, m, eigvals_only=True)
+    return float(np.sqrt(w2[0]) / (2.0 * np.pi))
+
+
+def impedance(p, r_bond, f_hz):
+    m, k, c = chain_matrices(p, r_bond)
+    b = np.zeros(m.shape[0])
+    b[:MAGNETS] = 1.0 / MAGNETS
+    z = np.empty(f_hz.size, dtype=complex)
+    for i, f in enumerate(f_hz):
+        w = 2.0 * np.pi * f
+        theta = np.linalg.solve(k - w * w * m + 1j * w * c, b)  # rad per N m of total torque
+        z[i] = p["t"] ** 2 * (1j * w * (b @ theta))
+    return p["r"] + 1j * 2.0 * np.pi * f_hz * p["l"] + z
+
+
+def nominal_parts():
+    n = NOMINAL
+    return dict(j_magnets=np.full(MAGNETS, n["j_magnet"]), j_pole=n["j_pole"], j_hub=n["j_hub"],
+                j_clamp=n["j_clamp"], k_bonds=np.full(MAGNETS, n["k_bond"]),
+                eta_bonds=np.full(MAGNETS, n["eta_bond"]),
+                k_bridges=np.full(MAGNETS, n["k_bridge"]), k_shaft=n["k_shaft"],
+                k_fixture=n["k_fixture"], r=n["r_ohm"], l=n["l_h"], t=n["t_nm_per_a"])
+
+
+def draw_parts(rng):
+    n = NOMINAL
+    g = lambda rel, size=None: 1.0 + rel * rng.standard_normal(size)
+    pressure = float(np.clip(rng.normal(5.5, 0.3), 4.5, 6.5))
+    temp_c = rng.uniform(15.0, 35.0)
+    return dict(
+        j_magnets=n["j_magnet"] * g(0.02, MAGNETS), j_pole=n["j_pole"] * g(0.015),
+        j_hub=n["j_hub"] * g(0.01), j_clamp=n["j_clamp"] * g(0.02),
+        k_bonds=n["k_bond"] * np.exp(0.12 * rng.standard_normal(MAGNETS)),
+        eta_bonds=n["eta_bond"] * g(0.2, MAGNETS).clip(0.3),
+        k_bridges=n["k_bridge"] * g(0.03, MAGNETS), k_shaft=n["k_shaft"] * g(0.02),
+        k_fixture=n["k_fixture"] * (pressure / 5.5) ** (1.0 / 3.0)
+        * np.exp(0.02 * rng.standard_normal()),
+        r=n["r_ohm"] * g(0.01) * (1.0 + 0.00393 * (temp_c - 20.0)),
+        l=n["l_h"] * g(0.02), t=n["t_nm_per_a"] * g(0.04))
+
+
+def draw_bonds(rng, soft_count):
+    r = np.ones(MAGNETS)
+    which = rng.choice(MAGNETS, size=soft_count, replace=False)
+    r[which] = 10.0 ** rng.uniform(np.log10(0.01), np.log10(0.06), size=soft_count)
+    return r
+
+
+def measure(z, rng, periods=4, f_lines=601, peak_v=2.0, crest=1.7, s_u=2e-3, s_i=1e-3,
+            n_samples=8000, pool=11):
+    """Z estimate and its sigma from P periods of a periodic multisine (docstring)."""
+    k = np.arange(1, z.size + 1)
+    amp = peak_v / (crest * np.sqrt(f_lines / 2.0))
+    u0 = amp * np.exp(-1j * np.pi * k * (k - 1) / f_lines)  # Schroeder phases
+    i0 = u0 / z
+    def noise(s):
+        return np.sqrt(2.0 * s * s / n_samples) * (rng.standard_normal((periods, z.size))
+                                                   + 1j * rng.standard_normal((periods, z.size)))
+    up = u0 + noise(s_u)
+    ip = i0 + noise(s_i)
+    um, im = up.mean(axis=0), ip.mean(axis=0)
+    zh = um / im
+    du, di = up - um, ip - im
+    var_u = (np.abs(du) ** 2).sum(axis=0) / (periods - 1)
+    var_i = (np.abs(di) ** 2).sum(axis=0) / (periods - 1)
+    cov_ui = (du * np.conj(di)).sum(axis=0) / (periods - 1)
+    rel = (var_u / np.abs(um) ** 2 + var_i / np.abs(im) ** 2
+           - 2.0 * np.real(cov_ui / (um * np.conj(im))))
+    kernel = np.ones(pool) / pool
+    rel = np.convolve(np.pad(rel, pool // 2, mode="edge"), kernel, mode="valid")
+    sigma = np.abs(zh) * np.sqrt(np.maximum(rel, 0.0) / periods)
+    return zh, sigma
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (created)")
+    ap.add_argument("--seed", type=int, default=1)
+    for name, default in (("good", 100), ("one_soft", 20), ("three_soft", 20),
+                          ("all_soft", 20)):
+        ap.add_argument("--" + name.replace("_", "-"), type=int, default=default,
+                        dest=name, help="units of class " + name)
+    ap.add_argument("--nominal", action="store_true",
+                    help="print the nominal chain's first modes and exit")
+    a = ap.parse_args()
+    f_hz = np.arange(200.0, 800.0 + 0.5, 1.0)
+
+    if a.nominal:
+        p = nominal_parts()
+        soft = np.full(MAGNETS, 0.04)
+        print("rigid shaft end: %.1f Hz good, %.1f Hz all bonds at 4 %%" %
+              (first_mode_hz(p, np.ones(MAGNETS), True), first_mode_hz(p, soft, True)))
+        print("in the fixture:  %.1f Hz good, %.1f Hz all bonds at 4 %%" %
+              (first_mode_hz(p, np.ones(MAGNETS)), first_mode_hz(p, soft)))
+        return 0
+    if not a.out:
+        ap.error("--out is required")
+
+    os.makedirs(a.out, exist_ok=True)
+    rng = np.random.default_rng(a.seed)
+    plan = [c for c in CLASSES for _ in range(getattr(a, c))]
+    order = rng.permutation(len(plan))  # classes interleaved, as on a line
+    with open(os.path.join(a.out, "truth.csv"), "w", newline="") as tf:
+        tw = csv.writer(tf)
+        tw.writerow(["unit", "class", "first_mode_hz", "k_fixture_nm_per_rad"]
+                    + ["r_bond_%d" % (i + 1) for i in range(MAGNETS)])
+        for idx, j in enumerate(order):
+            cls = plan[j]
+            p = draw_parts(rng)
+            r = draw_bonds(rng, CLASSES[cls])
+            zh, sigma = measure(impedance(p, r, f_hz), rng)
+            name = "unit-%04d" % (idx + 1)
+            with open(os.path.join(a.out, name + ".csv"), "w") as f:
+                f.write("f_hz,re_ohm,im_ohm,sigma_ohm\n")
+                for fk, zk, sk in zip(f_hz, zh, sigma):
+                    f.write("%.1f,%.9g,%.9g,%.6g\n" % (fk, zk.real, zk.imag, sk))
+            tw.writerow([name, cls, "%.3f" % first_mode_hz(p, r), "%.2f" % p["k_fixture"]]
+                        + ["%.4f" % x for x in r])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
