@@ -36,8 +36,7 @@ Pooled Pool(const NominalNetwork& n, std::span<const AppliedEffect> effects,
   Pooled p;
   for (const GapUnit& u : units)
     for (std::size_t k = 0; k < u.size(); ++k) {
-      const Cplx d = u.value[k] - EvaluateNetwork(n, effects, u.freq_hz[k]);
-      const double r2 = std::norm(d) / (u.sigma[k] * u.sigma[k]);
+      const double r2 = std::norm(LineResidual(u, k, EvaluateNetwork(n, effects, u.freq_hz[k])));
       const NoiseLine line = NoiseTerms(r2, u.sigma_dof);
       auto& a = acc[u.freq_hz[k]];
       a.first += line.chi2;
@@ -81,7 +80,8 @@ RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit) {
   r.effects = fit.effects;
   r.effect = JoinNames(fit.effects);
   r.chi2 = fit.chi2;
-  r.score = fit.chi2 + fit.n_params * std::log(std::max(fit.residuals, 1));
+  r.cost = fit.cost;
+  r.score = fit.cost + fit.n_params * std::log(std::max(fit.residuals, 1));
   r.gap_after = fit.residuals > 0 ? std::sqrt(fit.chi2 / fit.residuals) : 0.0;
   r.converged = fit.converged;
   for (std::size_t e = 0; e < fit.effects.size(); ++e) {
@@ -158,6 +158,8 @@ HeldOutGap HeldOut(const EffectFitter& fitter, const std::vector<AppliedEffect>&
     int m = 0;
     after += fitter.Chi2(fit.effects, predict, &m);
     before += fitter.Chi2({}, predict);
+    h.cost_after += fitter.Cost(fit.effects, predict);
+    h.cost_before += fitter.Cost({}, predict);
     n += m;
   }
   h.gap_before = n > 0 ? std::sqrt(before / n) : 0.0;
@@ -216,8 +218,7 @@ std::vector<double> NormalisedResidual(const NominalNetwork& nominal,
                                        const GapUnit& unit) {
   std::vector<double> r(unit.size());
   for (std::size_t k = 0; k < unit.size(); ++k)
-    r[k] = std::abs(unit.value[k] - EvaluateNetwork(nominal, effects, unit.freq_hz[k])) /
-           unit.sigma[k];
+    r[k] = std::abs(LineResidual(unit, k, EvaluateNetwork(nominal, effects, unit.freq_hz[k])));
   return r;
 }
 
@@ -237,11 +238,22 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
     s.message = "invalid measurement: " + why;
     return s;
   }
-  const EffectFitter fitter(nominal, units);
+  std::vector<GapUnit> formed = units;
+  int admittance = 0;
+  for (GapUnit& u : formed) {
+    u.admittance = nominal.quantity == Quantity::kImpedanceOhm &&
+                   (o.residual_form == ResidualForm::kAdmittance ||
+                    (o.residual_form == ResidualForm::kAuto && CurrentNoiseDominates(u)));
+    admittance += u.admittance ? 1 : 0;
+  }
+  s.residual_form = admittance == 0                                 ? "impedance"
+                    : admittance == static_cast<int>(formed.size()) ? "admittance"
+                                                                    : "mixed";
+  const EffectFitter fitter(nominal, formed);
   const LineMask all;
   s.chi2_before = fitter.Chi2({}, all, &s.residuals);
   s.gap_before = std::sqrt(s.chi2_before / s.residuals);
-  const Pooled pooled_before = Pool(nominal, {}, units);
+  const Pooled pooled_before = Pool(nominal, {}, formed);
   s.noise_z_before = pooled_before.Z();
   s.sigma_scale = pooled_before.SigmaScale();
   const std::vector<GapBand> bands_before =
@@ -269,7 +281,8 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
   RankedEffect none;
   none.effect = "none";
   none.chi2 = s.chi2_before;
-  none.score = s.chi2_before;
+  none.cost = fitter.Cost({}, all);
+  none.score = none.cost;
   none.gap_after = s.gap_before;
   std::vector<RankedEffect> ranking = singles;
   ranking.push_back(none);
@@ -282,7 +295,7 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
 
   // Pairs, when the best single leaves a residual inconsistent with the noise.
   if (best && o.try_pairs && library.size() >= 2) {
-    const Pooled after = Pool(nominal, best->effects, units);
+    const Pooled after = Pool(nominal, best->effects, formed);
     const bool consistent = FindGapBands(after.f, after.chi2, after.dof, o.bands).empty() &&
                             (after.Z() <= o.noise_z_max || after.SigmaScale() <= o.max_sigma_scale);
     if (!consistent) {
@@ -303,9 +316,25 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
         if (fit.effects.size() == 2) pair_ranks.push_back(Rank(fitter, fit));
       }
       std::sort(pair_ranks.begin(), pair_ranks.end(), BetterRank);
-      if (!pair_ranks.empty() && pair_ranks.front().plausible &&
-          pair_ranks.front().score <= winner.score - o.min_score_gain)
-        winner = pair_ranks.front();
+      // Each member significant on its own: against each member's single fit in sample, and
+      // against the winner on held-out lines.
+      auto single_score = [&](EffectKind kind) {
+        for (const RankedEffect& r : singles)
+          if (r.effects.front().kind == kind) return r.score;
+        return none.score;
+      };
+      const HeldOutGap winner_heldout = HeldOut(fitter, best->effects, o);
+      for (const RankedEffect& pair : pair_ranks) {
+        if (!pair.plausible || pair.score > winner.score - o.min_score_gain) break;
+        if (pair.score > single_score(pair.effects[0].kind) - o.min_score_gain ||
+            pair.score > single_score(pair.effects[1].kind) - o.min_score_gain)
+          continue;
+        const HeldOutGap h = HeldOut(fitter, pair.effects, o);
+        if (h.cost_after <= winner_heldout.cost_after - o.min_score_gain) {
+          winner = pair;
+          break;
+        }
+      }
       ranking.insert(ranking.end(), pair_ranks.begin(), pair_ranks.end());
     }
   }
@@ -320,14 +349,14 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
   }
   s.chi2_after = winner.effect == "none" ? s.chi2_before : winner.chi2;
   s.gap_after = std::sqrt(s.chi2_after / s.residuals);
-  const Pooled pooled_after = Pool(nominal, s.winner, units);
+  const Pooled pooled_after = Pool(nominal, s.winner, formed);
   s.noise_z_after = pooled_after.Z();
   s.where = WithGaps(bands_before, pooled_before, pooled_after);
   s.where_after =
       WithGaps(FindGapBands(pooled_after.f, pooled_after.chi2, pooled_after.dof, o.bands),
                pooled_before, pooled_after);
   for (std::size_t u = 0; u < units.size(); ++u) {
-    const LineMask m = UnitMask(units, u, false);
+    const LineMask m = UnitMask(formed, u, false);
     int n = 0;
     const double before = fitter.Chi2({}, m, &n);
     const double after = fitter.Chi2(s.winner, m);

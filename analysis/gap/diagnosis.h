@@ -11,8 +11,11 @@
 // Which (the nominal's parameters stay at the simulation's values):
 //   1. every effect of the library (effects.h) is fitted on top of the nominal, its
 //      parameters shared by all units (one fixture, one cable);
-//   2. score = BIC = chi2 + p ln(2K) (p fitted parameters; "none" scores chi2 of the
-//      nominal); a fit outside its plausibility bounds, or not converged, is rejected;
+//   2. score = BIC = cost + p ln(2K) (p fitted parameters; cost = -2 ln L of the residual,
+//      effect_fit.h: chi2 for exact sigma, the Student t's for sigma on few degrees of
+//      freedom; "none" scores the nominal's cost); a fit outside its plausibility bounds, or
+//      not converged, is rejected. The residual's form (impedance or admittance, effect_fit.h)
+//      is chosen per unit from its noise (options.residual_form);
 //   3. the best plausible single effect is named when it lowers the score by at least
 //      min_score_gain below "none" (10: very strong evidence on the BIC scale). Otherwise the
 //      answer is "none" when the nominal's residual is consistent with the noise (no
@@ -20,8 +23,11 @@
 //      and "unexplained" when it is not;
 //   4. when the winner still leaves a residual inconsistent with the noise, pairs are fitted
 //      (the pair_candidates best singles among themselves, and the winner with every other
-//      effect); a plausible pair wins when it lowers the score by min_score_gain more. Its
-//      name joins the two with "+" in EffectKind order ("second_mode+channel_delay").
+//      effect); a plausible pair wins when each member is significant on its own: the pair
+//      scores min_score_gain below each member's own single fit, and on held-out lines (below)
+//      its predictive cost is min_score_gain below the winner's (so a delay or a series
+//      resistance cannot ride along on a mis-modelled effect). Its name joins the two with "+"
+//      in EffectKind order ("second_mode+channel_delay").
 // Held out: one unit -> two-fold interleaved lines (fit the winner on the even lines, predict
 // the odd ones, and the reverse; every line is predicted by a fit that did not see it);
 // several units -> leave-one-unit-out. gap_before there is the nominal's g on the same lines.
@@ -38,8 +44,13 @@
 
 namespace eol::analysis {
 
+enum class ResidualForm { kAuto, kImpedance, kAdmittance };
+
 struct GapOptions {
   BandSearchOptions bands;
+  // kAuto: admittance for a unit whose noise is the current's (CurrentNoiseDominates,
+  // effect_fit.h), else impedance. Mobility is always fitted as measured.
+  ResidualForm residual_form = ResidualForm::kAuto;
   double min_score_gain = 10.0;  // BIC units
   // chi2 test of "consistent with the noise": z at most this. High (near the band threshold)
   // because sigma is itself estimated: from 4 periods pooled over 11 lines (periodic_frf.h)
@@ -71,6 +82,7 @@ struct RankedEffect {
   std::vector<AppliedEffect> effects;
   std::vector<NamedValue> params;  // fitted, then derived (effects.h)
   double chi2 = 0.0;
+  double cost = 0.0;   // -2 ln L (effect_fit.h)
   double score = 0.0;  // BIC
   double gap_after = 0.0;
   bool plausible = true;
@@ -87,7 +99,8 @@ struct BandGap {
 struct HeldOutGap {
   double gap_before = 0.0;
   double gap_after = 0.0;
-  std::string method;  // "interleaved-2fold", "leave-one-unit-out", "none"
+  std::string method;                          // "interleaved-2fold", "leave-one-unit-out", "none"
+  double cost_before = 0.0, cost_after = 0.0;  // predictive -2 ln L on the held-out lines
 };
 
 struct UnitGap {
@@ -107,7 +120,8 @@ struct GapSummary {
   int residuals = 0;                                 // 2K
   double noise_z_before = 0.0, noise_z_after = 0.0;  // noise test z (residual.h), with
                                                      // each unit's sigma_dof
-  double sigma_scale = 1.0;  // sqrt(mean |r|^2 / E|r|^2) of the nominal (residual.h)
+  double sigma_scale = 1.0;                 // sqrt(mean |r|^2 / E|r|^2) of the nominal (residual.h)
+  std::string residual_form = "impedance";  // "impedance", "admittance" or "mixed" (units)
   HeldOutGap heldout;
   std::vector<BandGap> where;
   std::vector<BandGap> where_after;

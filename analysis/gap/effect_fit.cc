@@ -23,8 +23,10 @@ double TwoPi() { return 2.0 * std::numbers::pi; }
 struct Lines {
   std::vector<double> f;
   std::vector<Cplx> meas, base;
-  std::vector<double> weight;  // 2 / sigma^2
-  double chi2 = 0.0;           // of the base
+  std::vector<double> weight;        // 2 / sigma^2
+  std::vector<const GapUnit*> unit;  // for the residual in the unit's form
+  std::vector<std::size_t> index;
+  double chi2 = 0.0;  // of the base
 };
 
 Lines Collect(const NominalNetwork& n, const std::vector<GapUnit>& units,
@@ -38,6 +40,8 @@ Lines Collect(const NominalNetwork& n, const std::vector<GapUnit>& units,
       l.meas.push_back(unit.value[k]);
       l.base.push_back(EvaluateNetwork(n, base, unit.freq_hz[k]));
       l.weight.push_back(2.0 / (unit.sigma[k] * unit.sigma[k]));
+      l.unit.push_back(&unit);
+      l.index.push_back(k);
       l.chi2 += l.weight.back() * std::norm(l.meas.back() - l.base.back());
     }
   }
@@ -96,7 +100,12 @@ struct Layout {
       for (std::size_t p = 0; p < effects[e].params.size(); ++p, ++i) {
         const EffectParamSpec& ps = specs[e].params[p];
         const double v = effects[e].params[p];
-        t(i) = ps.log_scale ? std::log(std::max(v, 1e-9 * ps.scale)) : v / ps.scale;
+        if (ps.bounded) {
+          const double u = std::clamp((v - ps.lo) / (ps.hi - ps.lo), 1e-6, 1.0 - 1e-6);
+          t(i) = std::log(u / (1.0 - u));
+        } else {
+          t(i) = ps.log_scale ? std::log(std::max(v, 1e-9 * ps.scale)) : v / ps.scale;
+        }
       }
     return t;
   }
@@ -106,13 +115,20 @@ struct Layout {
     for (std::size_t e = 0; e < out.size(); ++e)
       for (std::size_t p = 0; p < out[e].params.size(); ++p, ++i) {
         const EffectParamSpec& ps = specs[e].params[p];
-        out[e].params[p] = ps.log_scale ? std::exp(t(i)) : t(i) * ps.scale;
+        if (ps.bounded)
+          out[e].params[p] = ps.lo + (ps.hi - ps.lo) / (1.0 + std::exp(-t(i)));
+        else
+          out[e].params[p] = ps.log_scale ? std::exp(t(i)) : t(i) * ps.scale;
       }
     return out;
   }
   // d natural / d theta at the point.
   double Slope(const std::vector<AppliedEffect>& at, std::size_t e, std::size_t p) const {
     const EffectParamSpec& ps = specs[e].params[p];
+    if (ps.bounded) {
+      const double u = (at[e].params[p] - ps.lo) / (ps.hi - ps.lo);
+      return (ps.hi - ps.lo) * u * (1.0 - u);
+    }
     return ps.log_scale ? at[e].params[p] : ps.scale;
   }
 };
@@ -123,9 +139,14 @@ void Residual(const NominalNetwork& n, const Lines& lines, const Layout& layout,
   r->resize(static_cast<long>(2 * lines.f.size()));
   const std::vector<AppliedEffect> e = layout.FromTheta(theta);
   for (std::size_t k = 0; k < lines.f.size(); ++k) {
-    const Cplx d = (EvaluateNetwork(n, e, lines.f[k]) - lines.meas[k]) * std::sqrt(lines.weight[k]);
-    (*r)(static_cast<long>(2 * k)) = d.real();
-    (*r)(static_cast<long>(2 * k + 1)) = d.imag();
+    const GapUnit& u = *lines.unit[k];
+    const Cplx res = LineResidual(u, lines.index[k], EvaluateNetwork(n, e, lines.f[k]));
+    const double r2 = std::norm(res);
+    // Scaled so that the squared norm is the line's cost rho(|r|^2).
+    const double gain = r2 > 1e-300 ? std::sqrt(LineCost(r2, u.sigma_dof) / r2)
+                                    : std::sqrt(LineCost(1.0, u.sigma_dof) / 1.0);
+    (*r)(static_cast<long>(2 * k)) = gain * res.real();
+    (*r)(static_cast<long>(2 * k + 1)) = gain * res.imag();
   }
 }
 
@@ -146,6 +167,33 @@ void Jacobian(const NominalNetwork& n, const Lines& lines, const Layout& layout,
 }
 
 }  // namespace
+
+std::complex<double> LineResidual(const GapUnit& u, std::size_t k, std::complex<double> h) {
+  if (u.admittance) return (1.0 / u.value[k] - 1.0 / h) * (std::norm(u.value[k]) / u.sigma[k]);
+  return (u.value[k] - h) / u.sigma[k];
+}
+
+double LineCost(double r2, double sigma_dof) {
+  if (!(sigma_dof > 0.0) || !std::isfinite(sigma_dof)) return 2.0 * r2;
+  return (sigma_dof + 2.0) * std::log1p(2.0 * r2 / sigma_dof);
+}
+
+bool CurrentNoiseDominates(const GapUnit& u) {
+  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  const double n = static_cast<double>(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    const double x = std::log(std::abs(u.value[k]));
+    const double y = std::log(u.sigma[k]) - x;
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+  }
+  const double var = sxx - sx * sx / n;
+  // |H| flat over the band: no lever to tell the channels apart; keep the impedance form.
+  if (!(var > 1e-6 * n)) return false;
+  return (sxy - sx * sy / n) / var >= 0.5;
+}
 
 bool Selected(const LineMask& mask, std::size_t unit, std::size_t line) {
   return mask.empty() || (unit < mask.size() && line < mask[unit].size() && mask[unit][line]);
@@ -171,13 +219,26 @@ double EffectFitter::Chi2(std::span<const AppliedEffect> effects, const LineMask
     const GapUnit& unit = units_[u];
     for (std::size_t k = 0; k < unit.size(); ++k) {
       if (!Selected(mask, u, k)) continue;
-      const Cplx d = unit.value[k] - EvaluateNetwork(nominal_, effects, unit.freq_hz[k]);
-      chi2 += 2.0 * std::norm(d) / (unit.sigma[k] * unit.sigma[k]);
+      chi2 += 2.0 *
+              std::norm(LineResidual(unit, k, EvaluateNetwork(nominal_, effects, unit.freq_hz[k])));
       n += 2;
     }
   }
   if (residuals) *residuals = n;
   return chi2;
+}
+
+double EffectFitter::Cost(std::span<const AppliedEffect> effects, const LineMask& mask) const {
+  double cost = 0.0;
+  for (std::size_t u = 0; u < units_.size(); ++u) {
+    const GapUnit& unit = units_[u];
+    for (std::size_t k = 0; k < unit.size(); ++k) {
+      if (!Selected(mask, u, k)) continue;
+      const Cplx r = LineResidual(unit, k, EvaluateNetwork(nominal_, effects, unit.freq_hz[k]));
+      cost += LineCost(std::norm(r), unit.sigma_dof);
+    }
+  }
+  return cost;
 }
 
 std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
@@ -235,7 +296,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       for (double kappa : LogSpace(0.02, 30.0, 24)) kappas.push_back(kappa);
       for (double kappa : kappas) {
         trial.back().params = {kappa, FixtureLossKeepingQ(kappa, m.q)};
-        c.push_back({-Chi2(trial, mask), trial.back().params});
+        c.push_back({-Cost(trial, mask), trial.back().params});
       }
       return Best(c, 2);
     }
@@ -257,16 +318,38 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       // it is the coupled mode's anti-resonance; far above, J2 acts as added inertia), times
       // a few mass ratios and losses; every trial is the full network, so the first mode's
       // shift, its Q and height and the coupled mode are all scored together.
+      // The node: at the rotor, or on the support between the rotor spring and the fixture
+      // (the shaft end); at a node the same J2 loads the first mode less, so the mass ratios
+      // reach higher there.
       std::vector<Candidate> c;
       std::vector<AppliedEffect> trial(base.begin(), base.end());
-      trial.push_back({kind, {0.1, 1.0, 30.0}});
-      for (double f2 : LogSpace(0.6 * f_lo_, 4.0 * f_hi_, 48))
-        for (double mu : {0.02, 0.05, 0.1, 0.2, 0.5, 1.0})
-          for (double q2 : {10.0, 40.0, 150.0}) {
-            trial.back().params = {mu, f2, q2};
-            c.push_back({-Chi2(trial, mask), trial.back().params});
+      trial.push_back({kind, {0.1, 1.0, 30.0, 0.0}});
+      for (double x : {0.0, 0.3, 0.55, 0.8})
+        for (double f2 : LogSpace(0.6 * f_lo_, 4.0 * f_hi_, 40))
+          for (double mu : {0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0})
+            for (double q2 : {10.0, 40.0, 150.0}) {
+              trial.back().params = {mu, f2, q2, x};
+              c.push_back({-Cost(trial, mask), trial.back().params});
+            }
+      // The best start at the rotor and at each node, so LM sees every basin.
+      std::sort(c.begin(), c.end(),
+                [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
+      std::vector<std::vector<double>> out;
+      for (double x : {0.0, 0.3, 0.55, 0.8})
+        for (const Candidate& cand : c)
+          if (cand.params[3] == x) {
+            out.push_back(cand.params);
+            break;
           }
-      return Best(c, 3);
+      std::sort(out.begin(), out.end(), [&](const auto& a, const auto& b) {
+        auto red = [&](const std::vector<double>& p) {
+          for (const Candidate& cand : c)
+            if (cand.params == p) return cand.reduction;
+          return -std::numeric_limits<double>::infinity();
+        };
+        return red(a) > red(b);
+      });
+      return out;
     }
     case EffectKind::kAdhesiveCreep: {
       std::vector<Candidate> c;
@@ -274,7 +357,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       trial.push_back({kind, {0.0}});
       for (double lambda : {0.003, 0.01, 0.03, 0.1, 0.25}) {
         trial.back().params[0] = lambda;
-        c.push_back({-Chi2(trial, mask), {lambda}});
+        c.push_back({-Cost(trial, mask), {lambda}});
       }
       return Best(c, 2);
     }
@@ -327,6 +410,7 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   out.n_params = layout.size();
   if (out.n_params == 0 || lines.f.empty()) {
     out.chi2 = Chi2(start, mask);
+    out.cost = Cost(start, mask);
     out.converged = true;
     return out;
   }
@@ -350,7 +434,8 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   out.effects = layout.FromTheta(theta);
   Eigen::VectorXd r;
   problem.residual(theta, &r);
-  out.chi2 = r.squaredNorm();
+  out.cost = r.squaredNorm();
+  out.chi2 = Chi2(out.effects, mask);
   // Covariance in theta from the Jacobian at the optimum, then natural units.
   Eigen::MatrixXd jac;
   problem.jacobian(theta, &jac);
@@ -392,10 +477,10 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
     }
   }
   EffectFit best;
-  best.chi2 = std::numeric_limits<double>::infinity();
+  best.chi2 = best.cost = std::numeric_limits<double>::infinity();
   for (const auto& s : starts) {
     EffectFit f = Fit(s, mask, max_iterations);
-    if (std::isfinite(f.chi2) && f.chi2 < best.chi2) best = std::move(f);
+    if (std::isfinite(f.cost) && f.cost < best.cost) best = std::move(f);
   }
   return best;
 }

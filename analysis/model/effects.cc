@@ -63,8 +63,11 @@ Cplx MotionalWithEffects(const MotionalImpedance& m, const AppliedEffect* creep,
   if (coupled) {
     const double c2 = Param(coupled, 0) * cp;
     const double w2 = TwoPi() * Param(coupled, 1);
+    const double x = std::clamp(Param(coupled, 3), 0.0, 0.999);
     const Cplx spring2 = w2 * c2 / Param(coupled, 2) + w2 * w2 * c2 / s;
-    support += 1.0 / (1.0 / (s * c2) + 1.0 / spring2);
+    const Cplx branch = 1.0 / (1.0 / (s * c2) + 1.0 / spring2);
+    support =
+        x > 0.0 ? 1.0 / (x / support + 1.0 / (support / (1.0 - x) + branch)) : support + branch;
   }
   return 1.0 / (s * cp + support);
 }
@@ -184,10 +187,11 @@ EffectSpec DescribeEffect(EffectKind kind, const NominalNetwork& n, double f_lo,
     case EffectKind::kCoupledInertia:
       s.equation =
           "Ym' = Ym + 1 / (1 / (s mass_ratio Cp) + 1 / (w2 mass_ratio Cp / q2 + w2^2 mass_ratio "
-          "Cp / s)), w2 = 2 pi f2_hz";
+          "Cp / s)), w2 = 2 pi f2_hz, on the support node node_compliance_share";
       s.params = {{"mass_ratio", "1", 1e-3, 10.0, true, 0.1},
                   {"f2_hz", "Hz", 0.5 * f_lo, 5.0 * f_hi, true, std::sqrt(f_lo * f_hi)},
-                  {"q2", "1", 0.5, 3000.0, true, 30.0}};
+                  {"q2", "1", 0.5, 3000.0, true, 30.0},
+                  {"node_compliance_share", "1", 0.0, 0.95, false, 0.3, true}};
       break;
     case EffectKind::kAdhesiveCreep:
       s.equation = "C(f) = C0 (1 - creep_lambda log10(f / f0)) (causal power law)";

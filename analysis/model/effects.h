@@ -12,7 +12,8 @@
 //   support  Ys = Gp + 1 / (s Lp c(s))                       rotor spring + damper (+ creep)
 //            Ys' = 1 / (1/Ys + s Lp / (kappa (1 + j eta)))    fixture spring in series
 //   coupled  Yb = 1 / (1 / (s C2) + 1 / (G2 + 1 / (s L2)))     second inertia J2 on k2 (c2)
-//   motional Zm' = 1 / (s Cp + Ys' + Yb)
+//            at a node x of the support: Ys'' = 1 / (x / Ys' + 1 / (Ys' / (1 - x) + Yb))
+//   motional Zm' = 1 / (s Cp + Ys'')
 //   winding  Zw = R + dR + R a (f / 1 kHz)^2 + s L - s^2 L2^2 / (s L2 + R2)
 //               + b L (w_r^(1 - n) (j w)^n - s)       (fractional, w_r = 2 pi 1 kHz)
 //   mode     Z2 = H2 / (1 + Q2 (s/w2 + w2/s))
@@ -56,18 +57,24 @@
 //                       term). f in [0.5 f_lo, 2 f_hi], 0.5 <= q <= 3000,
 //                       0 < height <= 100 max|Z0|.
 //   coupled_inertia     mass_ratio mu = J2 / J, f2_hz = sqrt(k2 / J2) / (2 pi) (J2 alone on its
-//                       spring), q2 = sqrt(k2 J2) / c2: a second inertia (coupling hub, fan,
-//                       encoder disc) on a spring k2 with damper c2 at the rotor, where the
-//                       torque acts. Seen through T^2 its branch is the series of C2 = mu Cp
-//                       with (G2 + 1 / (s L2)), L2 = 1 / (w2^2 C2), G2 = w2 C2 / q2, in
-//                       parallel with the motional C-G-L. Unlike second_mode it is coupled to
-//                       the measured mode: the first mode always moves down (to
-//                       f0 / sqrt(1 + mu) when f2 >> f0, where Q rises by sqrt(1 + mu) and the
-//                       peak height Rp stays; a fixture spring keeps Q and lowers the height
-//                       with its loss) and the coupled mode rings above with its own
-//                       anti-resonance at f2. 1e-3 <= mu <= 10, f2 in [0.5 f_lo, 5 f_hi],
-//                       0.5 <= q2 <= 3000. second_mode remains the model of a mode that is
-//                       not coupled to the measured one (another path, another part).
+//                       spring), q2 = sqrt(k2 J2) / c2, node_compliance_share x: a second
+//                       inertia (coupling hub, fan, encoder disc) on a spring k2 with damper c2,
+//                       hung on a node of the support: x = 0 at the rotor, where the torque
+//                       acts; x > 0 a node between the rotor spring and the fixture (the shaft
+//                       end), with the share x of the support's compliance between the rotor
+//                       and the node (x = k / k_rotor; the support's damping is taken
+//                       stiffness-proportional, so each part is (k/s + c) / share). Seen through
+//                       T^2 its branch is the series of C2 = mu Cp with (G2 + 1 / (s L2)),
+//                       L2 = 1 / (w2^2 C2), G2 = w2 C2 / q2. At x > 0 the node moves (1 - x)
+//                       times the rotor in the first mode, so J2 loads it about (1 - x)^2 as
+//                       much and its own mode rings against both springs. Unlike second_mode it is
+//                       coupled to the measured mode: the first mode always moves down (to f0 /
+//                       sqrt(1 + mu) when f2 >> f0, where Q rises by sqrt(1 + mu) and the peak
+//                       height Rp stays; a fixture spring keeps Q and lowers the height with its
+//                       loss) and the coupled mode rings above with its own anti-resonance at f2.
+//                       1e-3 <= mu <= 10, f2 in [0.5 f_lo, 5 f_hi], 0.5 <= q2 <= 3000, 0 <= x <=
+//                       0.95. second_mode remains the model of a mode that is not coupled to the
+//                       measured one (another path, another part).
 //   adhesive_creep      creep_lambda lambda: viscoelastic adhesive, the rotor compliance
 //                       C(f) = C0 (1 - lambda log10(f / f0)), written causally as the power law
 //                       c(s) = (s / w0)^(-n), n = lambda / ln 10 (the same real part to first
@@ -141,6 +148,9 @@ struct EffectParamSpec {
   // approach "no effect" but never cross to the unphysical sign); else as value / scale.
   bool log_scale = false;
   double scale = 1.0;  // typical magnitude, natural units
+  // Fitted as logit((value - lo) / (hi - lo)): a share that must stay inside its bounds and
+  // may sit at a bound (overrides log_scale and scale).
+  bool bounded = false;
 };
 
 struct EffectSpec {
