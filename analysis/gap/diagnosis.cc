@@ -81,7 +81,8 @@ RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit) {
   r.effect = JoinNames(fit.effects);
   r.chi2 = fit.chi2;
   r.cost = fit.cost;
-  r.score = fit.cost + fit.n_params * std::log(std::max(fit.residuals, 1));
+  r.bic = fit.cost + fit.n_params * std::log(std::max(fit.residuals, 1));
+  r.score = fit.cost + fit.occam;
   r.gap_after = fit.residuals > 0 ? std::sqrt(fit.chi2 / fit.residuals) : 0.0;
   r.converged = fit.converged;
   for (std::size_t e = 0; e < fit.effects.size(); ++e) {
@@ -282,15 +283,18 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
   none.effect = "none";
   none.chi2 = s.chi2_before;
   none.cost = fitter.Cost({}, all);
-  none.score = none.cost;
+  none.score = none.bic = none.cost;
   none.gap_after = s.gap_before;
   std::vector<RankedEffect> ranking = singles;
   ranking.push_back(none);
 
+  // Whether: BIC, min_score_gain below none; which: the best evidence among those.
   const RankedEffect* best = nullptr;
-  if (!singles.empty() && singles.front().plausible &&
-      singles.front().score <= none.score - o.min_score_gain)
-    best = &singles.front();
+  for (const RankedEffect& r : singles)
+    if (r.plausible && r.bic <= none.bic - o.min_score_gain) {
+      best = &r;
+      break;
+    }
   RankedEffect winner = best ? *best : none;
 
   // Pairs, when the best single leaves a residual inconsistent with the noise.
@@ -318,16 +322,16 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
       std::sort(pair_ranks.begin(), pair_ranks.end(), BetterRank);
       // Each member significant on its own: against each member's single fit in sample, and
       // against the winner on held-out lines.
-      auto single_score = [&](EffectKind kind) {
+      auto single_bic = [&](EffectKind kind) {
         for (const RankedEffect& r : singles)
-          if (r.effects.front().kind == kind) return r.score;
-        return none.score;
+          if (r.effects.front().kind == kind) return r.bic;
+        return none.bic;
       };
       const HeldOutGap winner_heldout = HeldOut(fitter, best->effects, o);
       for (const RankedEffect& pair : pair_ranks) {
-        if (!pair.plausible || pair.score > winner.score - o.min_score_gain) break;
-        if (pair.score > single_score(pair.effects[0].kind) - o.min_score_gain ||
-            pair.score > single_score(pair.effects[1].kind) - o.min_score_gain)
+        if (!pair.plausible || pair.score >= winner.score) break;
+        if (pair.bic > single_bic(pair.effects[0].kind) - o.min_score_gain ||
+            pair.bic > single_bic(pair.effects[1].kind) - o.min_score_gain)
           continue;
         const HeldOutGap h = HeldOut(fitter, pair.effects, o);
         if (h.cost_after <= winner_heldout.cost_after - o.min_score_gain) {

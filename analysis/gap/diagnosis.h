@@ -11,20 +11,22 @@
 // Which (the nominal's parameters stay at the simulation's values):
 //   1. every effect of the library (effects.h) is fitted on top of the nominal, its
 //      parameters shared by all units (one fixture, one cable);
-//   2. score = BIC = cost + p ln(2K) (p fitted parameters; cost = -2 ln L of the residual,
-//      effect_fit.h: chi2 for exact sigma, the Student t's for sigma on few degrees of
-//      freedom; "none" scores the nominal's cost); a fit outside its plausibility bounds, or
-//      not converged, is rejected. The residual's form (impedance or admittance, effect_fit.h)
-//      is chosen per unit from its noise (options.residual_form);
-//   3. the best plausible single effect is named when it lowers the score by at least
-//      min_score_gain below "none" (10: very strong evidence on the BIC scale). Otherwise the
+//   2. cost = -2 ln L of the residual (effect_fit.h: chi2 for exact sigma, the Student t's
+//      for sigma on few degrees of freedom; "none" is the nominal's cost); whether an effect
+//      is there is judged by BIC = cost + p ln(2K) (p fitted parameters), which effect by the
+//      Laplace evidence score = cost + occam (effect_fit.h). A fit outside its plausibility
+//      bounds, or not converged, is rejected. The residual's form (impedance or admittance,
+//      effect_fit.h) is chosen per unit from its noise (options.residual_form);
+//   3. among the plausible singles whose BIC is at least min_score_gain below "none" (10:
+//      very strong evidence on the BIC scale), the best score is named. Otherwise the
 //      answer is "none" when the nominal's residual is consistent with the noise (no
 //      significant band, and noise test z <= noise_z_max or sigma_scale <= max_sigma_scale)
 //      and "unexplained" when it is not;
 //   4. when the winner still leaves a residual inconsistent with the noise, pairs are fitted
 //      (the pair_candidates best singles among themselves, and the winner with every other
-//      effect); a plausible pair wins when each member is significant on its own: the pair
-//      scores min_score_gain below each member's own single fit, and on held-out lines (below)
+//      effect); a plausible pair with a better score wins when each member is significant on
+//      its own: the pair's BIC is min_score_gain below each member's single fit, and on
+//      held-out lines (below)
 //      its predictive cost is min_score_gain below the winner's (so a delay or a series
 //      resistance cannot ride along on a mis-modelled effect). Its name joins the two with "+"
 //      in EffectKind order ("second_mode+channel_delay").
@@ -83,7 +85,8 @@ struct RankedEffect {
   std::vector<NamedValue> params;  // fitted, then derived (effects.h)
   double chi2 = 0.0;
   double cost = 0.0;   // -2 ln L (effect_fit.h)
-  double score = 0.0;  // BIC
+  double bic = 0.0;    // cost + p ln(2K): whether there is an effect
+  double score = 0.0;  // cost + occam (effect_fit.h, Laplace evidence): which effect
   double gap_after = 0.0;
   bool plausible = true;
   bool converged = true;

@@ -16,6 +16,7 @@ namespace {
 using Cplx = std::complex<double>;
 
 constexpr double kLmTol = 1e-10;
+constexpr double kSettledCost = 0.01;  // -2 ln L units
 
 double TwoPi() { return 2.0 * std::numbers::pi; }
 
@@ -83,6 +84,17 @@ std::vector<std::vector<double>> Best(std::vector<Candidate> c, std::size_t n) {
   return out;
 }
 
+// A bounded parameter's place in its bounds, 0 at lo and 1 at hi (in ln(value) when
+// log-scaled), and back.
+double BoundedShare(const EffectParamSpec& ps, double v) {
+  if (ps.log_scale) return std::log(std::max(v, ps.lo) / ps.lo) / std::log(ps.hi / ps.lo);
+  return (v - ps.lo) / (ps.hi - ps.lo);
+}
+double FromShare(const EffectParamSpec& ps, double u) {
+  if (ps.log_scale) return ps.lo * std::exp(u * std::log(ps.hi / ps.lo));
+  return ps.lo + u * (ps.hi - ps.lo);
+}
+
 // theta <-> natural parameters of a list of effects.
 struct Layout {
   std::vector<EffectSpec> specs;
@@ -101,7 +113,7 @@ struct Layout {
         const EffectParamSpec& ps = specs[e].params[p];
         const double v = effects[e].params[p];
         if (ps.bounded) {
-          const double u = std::clamp((v - ps.lo) / (ps.hi - ps.lo), 1e-6, 1.0 - 1e-6);
+          const double u = std::clamp(BoundedShare(ps, v), 1e-6, 1.0 - 1e-6);
           t(i) = std::log(u / (1.0 - u));
         } else {
           t(i) = ps.log_scale ? std::log(std::max(v, 1e-9 * ps.scale)) : v / ps.scale;
@@ -116,7 +128,7 @@ struct Layout {
       for (std::size_t p = 0; p < out[e].params.size(); ++p, ++i) {
         const EffectParamSpec& ps = specs[e].params[p];
         if (ps.bounded)
-          out[e].params[p] = ps.lo + (ps.hi - ps.lo) / (1.0 + std::exp(-t(i)));
+          out[e].params[p] = FromShare(ps, 1.0 / (1.0 + std::exp(-t(i))));
         else
           out[e].params[p] = ps.log_scale ? std::exp(t(i)) : t(i) * ps.scale;
       }
@@ -126,8 +138,9 @@ struct Layout {
   double Slope(const std::vector<AppliedEffect>& at, std::size_t e, std::size_t p) const {
     const EffectParamSpec& ps = specs[e].params[p];
     if (ps.bounded) {
-      const double u = (at[e].params[p] - ps.lo) / (ps.hi - ps.lo);
-      return (ps.hi - ps.lo) * u * (1.0 - u);
+      const double u = BoundedShare(ps, at[e].params[p]);
+      const double dv_du = ps.log_scale ? at[e].params[p] * std::log(ps.hi / ps.lo) : ps.hi - ps.lo;
+      return dv_du * u * (1.0 - u);
     }
     return ps.log_scale ? at[e].params[p] : ps.scale;
   }
@@ -164,6 +177,36 @@ void Jacobian(const NominalNetwork& n, const Lines& lines, const Layout& layout,
     Residual(n, lines, layout, t, &down);
     jac->col(i) = (up - down) / (2.0 * h);
   }
+}
+
+// The prior width of each theta: uniform in ln(value) over [lo, hi] for a log-scaled
+// parameter (lo = 0 taken as 1e-6 hi), uniform in value otherwise (in theta units at the point
+// for a bounded one).
+double PriorWidth(const Layout& layout, const std::vector<AppliedEffect>& at, std::size_t e,
+                  std::size_t p) {
+  const EffectParamSpec& ps = layout.specs[e].params[p];
+  const double slope = std::max(layout.Slope(at, e, p), 1e-300);
+  if (ps.bounded && ps.log_scale)
+    return std::log(ps.hi / ps.lo) * std::max(at[e].params[p], 1e-300) / slope;
+  if (ps.bounded) return (ps.hi - ps.lo) / slope;
+  if (ps.log_scale) return std::log(ps.hi / std::max(ps.lo, 1e-6 * ps.hi));
+  return (ps.hi - ps.lo) / ps.scale;
+}
+
+// sum_i max(0, ln(lambda_i / 2 pi)) over the eigenvalues of W A W (effect_fit.h).
+double OccamPenalty(const Layout& layout, const std::vector<AppliedEffect>& at,
+                    const Eigen::MatrixXd& information) {
+  const long n = information.rows();
+  Eigen::VectorXd w(n);
+  long i = 0;
+  for (std::size_t e = 0; e < at.size(); ++e)
+    for (std::size_t p = 0; p < at[e].params.size(); ++p, ++i) w(i) = PriorWidth(layout, at, e, p);
+  const Eigen::MatrixXd scaled = w.asDiagonal() * information * w.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled, Eigen::EigenvaluesOnly);
+  double penalty = 0.0;
+  for (long k = 0; k < n; ++k)
+    penalty += std::max(0.0, std::log(eig.eigenvalues()(k) / (2.0 * std::numbers::pi)));
+  return std::isfinite(penalty) ? penalty : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace
@@ -325,7 +368,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       std::vector<AppliedEffect> trial(base.begin(), base.end());
       trial.push_back({kind, {0.1, 1.0, 30.0, 0.0}});
       for (double x : {0.0, 0.3, 0.55, 0.8})
-        for (double f2 : LogSpace(0.6 * f_lo_, 4.0 * f_hi_, 40))
+        for (double f2 : LogSpace(0.6 * f_lo_, 15.0 * f_hi_, 44))
           for (double mu : {0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0})
             for (double q2 : {10.0, 40.0, 150.0}) {
               trial.back().params = {mu, f2, q2, x};
@@ -428,9 +471,22 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   settings.ftol = kLmTol;
   settings.xtol = kLmTol;
   Eigen::VectorXd theta = layout.ToTheta(start);
-  const LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, &theta, settings);
+  LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, &theta, settings);
   out.iterations = outcome.iterations;
   out.converged = outcome.converged;
+  if (!out.converged && outcome.termination == Termination::kMaxIterations) {
+    // A parameter that drifts along a flat direction (a bounded one towards its bound, where
+    // the logit's steps never meet xtol) keeps LM from stopping though the cost has settled:
+    // one more run, and a cost that moved by less than kSettledCost in it counts as converged
+    // (far below anything the model selection resolves).
+    Eigen::VectorXd r0;
+    problem.residual(theta, &r0);
+    outcome = MinimizeLeastSquares(problem, &theta, settings);
+    out.iterations += outcome.iterations;
+    Eigen::VectorXd r1;
+    problem.residual(theta, &r1);
+    out.converged = outcome.converged || r0.squaredNorm() - r1.squaredNorm() < kSettledCost;
+  }
   out.effects = layout.FromTheta(theta);
   Eigen::VectorXd r;
   problem.residual(theta, &r);
@@ -442,7 +498,9 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(problem.parameters, problem.parameters,
                                                   std::numeric_limits<double>::quiet_NaN());
   Eigen::MatrixXd inverse;
-  if (InvertInformation(jac.transpose() * jac, &inverse)) cov = inverse;
+  const Eigen::MatrixXd information = jac.transpose() * jac;
+  if (InvertInformation(information, &inverse)) cov = inverse;
+  out.occam = OccamPenalty(layout, out.effects, information);
   int i = 0;
   out.sigma.resize(out.effects.size());
   for (std::size_t e = 0; e < out.effects.size(); ++e)

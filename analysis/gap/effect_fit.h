@@ -17,6 +17,14 @@
 // buying a narrow mode; nu = 0 (exact sigma) gives rho = 2 u, the chi2. The fits minimise
 // the cost (Levenberg-Marquardt on the residual scaled by sqrt(rho(u) / u)), and the model
 // selection (diagnosis.h) scores it.
+// Evidence (Laplace): -2 ln p(data | effect) ~ cost + occam, with
+//   occam = sum_i max(0, ln(lambda_i / 2 pi)),  lambda_i the eigenvalues of W A W,
+// A = J^T J the information in theta at the optimum and W the prior widths of the thetas
+// (uniform in ln(value) over the plausibility bounds for log-scaled parameters, in value for
+// the others). A parameter the data pin down pays ln of (prior width / posterior width)^2; one
+// they leave as open as its prior pays nothing (where BIC charges every parameter ln(2K)):
+// an effect whose shape predicts a relation (a coupled inertia keeps the peak height while it
+// lowers f0 and raises Q) is not charged for parameters the data do not need.
 // Parameters are fitted as ln(value) (positive, wide-ranging ones) or value / scale, with
 // analysis::MinimizeLeastSquares (fit/least_squares.h: MINPACK Levenberg-Marquardt) on
 // central-difference Jacobians; the covariance (Jr^T Jr)^-1 at the optimum
@@ -72,6 +80,7 @@ struct EffectFit {
                                            // not determined)
   double chi2 = 0.0;                       // on the selected lines
   double cost = 0.0;                       // sum rho (above), what the fit minimised
+  double occam = 0.0;                      // the Laplace evidence's penalty (above)
   int residuals = 0;                       // 2 x selected lines
   int n_params = 0;
   bool converged = false;

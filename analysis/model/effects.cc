@@ -188,9 +188,9 @@ EffectSpec DescribeEffect(EffectKind kind, const NominalNetwork& n, double f_lo,
       s.equation =
           "Ym' = Ym + 1 / (1 / (s mass_ratio Cp) + 1 / (w2 mass_ratio Cp / q2 + w2^2 mass_ratio "
           "Cp / s)), w2 = 2 pi f2_hz, on the support node node_compliance_share";
-      s.params = {{"mass_ratio", "1", 1e-3, 10.0, true, 0.1},
-                  {"f2_hz", "Hz", 0.5 * f_lo, 5.0 * f_hi, true, std::sqrt(f_lo * f_hi)},
-                  {"q2", "1", 0.5, 3000.0, true, 30.0},
+      s.params = {{"mass_ratio", "1", 1e-3, 10.0, true, 0.1, true},
+                  {"f2_hz", "Hz", 0.5 * f_lo, 20.0 * f_hi, true, std::sqrt(f_lo * f_hi), true},
+                  {"q2", "1", 0.5, 3000.0, true, 30.0, true},
                   {"node_compliance_share", "1", 0.0, 0.95, false, 0.3, true}};
       break;
     case EffectKind::kAdhesiveCreep:

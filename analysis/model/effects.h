@@ -72,9 +72,10 @@
 //                       sqrt(1 + mu) when f2 >> f0, where Q rises by sqrt(1 + mu) and the peak
 //                       height Rp stays; a fixture spring keeps Q and lowers the height with its
 //                       loss) and the coupled mode rings above with its own anti-resonance at f2.
-//                       1e-3 <= mu <= 10, f2 in [0.5 f_lo, 5 f_hi], 0.5 <= q2 <= 3000, 0 <= x <=
-//                       0.95. second_mode remains the model of a mode that is not coupled to the
-//                       measured one (another path, another part).
+//                       1e-3 <= mu <= 10, f2 in [0.5 f_lo, 20 f_hi] (at the top J2 is rigid on
+//                       its node over the band: an added inertia), 0.5 <= q2 <= 3000,
+//                       0 <= x <= 0.95. second_mode remains the model of a mode that is not coupled
+//                       to the measured one (another path, another part).
 //   adhesive_creep      creep_lambda lambda: viscoelastic adhesive, the rotor compliance
 //                       C(f) = C0 (1 - lambda log10(f / f0)), written causally as the power law
 //                       c(s) = (s / w0)^(-n), n = lambda / ln 10 (the same real part to first
@@ -148,8 +149,9 @@ struct EffectParamSpec {
   // approach "no effect" but never cross to the unphysical sign); else as value / scale.
   bool log_scale = false;
   double scale = 1.0;  // typical magnitude, natural units
-  // Fitted as logit((value - lo) / (hi - lo)): a share that must stay inside its bounds and
-  // may sit at a bound (overrides log_scale and scale).
+  // Fitted as logit((value - lo) / (hi - lo)) (with log_scale: of ln(value / lo) /
+  // ln(hi / lo)): a parameter that must stay inside its bounds and may sit at one, as a
+  // coupling that is rigid over the band (overrides scale).
   bool bounded = false;
 };
 

@@ -96,6 +96,8 @@ json GapReportJson(const GapReport& r) {
                        {"params", ParamsValue(e.params)},
                        {"params_sigma", ParamsSigma(e.params)},
                        {"score", Num(e.score)},
+                       {"bic", Num(e.bic)},
+                       {"cost", Num(e.cost)},
                        {"gap_after", Num(e.gap_after)},
                        {"plausible", e.plausible},
                        {"rejected", e.rejected}});
@@ -158,8 +160,10 @@ json GapReportJson(const GapReport& r) {
                        {"message", p.message}};
   }
   j["score_rule"] =
-      "BIC = chi2 + p ln(2K), chi2 = 2 sum |H_meas - H_model|^2 / sigma^2; an effect is named "
-      "when it scores at least 10 below none";
+      "cost = -2 ln L of the normalised residual (chi2, or the Student t's for sigma on few "
+      "degrees of freedom); an effect is there when its BIC = cost + p ln(2K) is at least 10 "
+      "below none's; which one: the lowest score = cost + Laplace Occam penalty";
+  j["residual_form"] = g.residual_form;
   j["message"] = g.message;
   return j;
 }
@@ -217,12 +221,14 @@ std::string GapReportText(const GapReport& r) {
   if (const analysis::RankedEffect* w = Winner(g)) {
     for (const auto& p : w->params) os << "               " << ParamText(p) << "\n";
   }
-  os << "  ranking (score = BIC; an effect needs 10 below none):\n";
+  os << "  ranking (score = evidence: cost + Occam; an effect needs its BIC 10 below none's; "
+     << g.residual_form << " residual):\n";
   int rank = 0;
   for (const auto& e : g.ranking) {
     os << "  " << Fmt("%3.0f", ++rank) << ". " << e.effect;
     for (std::size_t pad = e.effect.size(); pad < 36; ++pad) os << ' ';
-    os << Fmt("%12.1f", e.score) << "   g " << Fmt("%.3f", e.gap_after);
+    os << Fmt("%12.1f", e.score) << "  BIC " << Fmt("%9.1f", e.bic) << "   g "
+       << Fmt("%.3f", e.gap_after);
     if (!e.plausible) os << "   rejected: " << e.rejected;
     os << "\n";
   }

@@ -16,7 +16,10 @@
 //                       is the Gaussian-equivalent z of the band's chi2 (residual.h)
 //   where_after         the bands that remain after the winner
 //   ranking             [{effect, params {name: value}, params_sigma {name: sigma}, score
-//                       (BIC), gap_after, plausible, rejected}], best first, "none" included
+//                       (cost + Laplace Occam penalty: which effect), bic (cost + p ln(2K):
+//                       whether an effect), cost (-2 ln L), gap_after, plausible, rejected}],
+//                       best first, "none" included
+//   residual_form       "impedance", "admittance" or "mixed" (effect_fit.h)
 //   features            [{measurement, name, simulated, measured, gap, sigma, significance}]
 //                       names f0_hz, q, peak_height_ohm, r_ohm, l_h (impedance) or
 //                       gain_rad_per_s2_per_a, damping_per_s (mobility)
