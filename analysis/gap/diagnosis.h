@@ -64,7 +64,7 @@ struct GapOptions {
   // by a few percent (a calibration, a dof not given) is not a model gap.
   double max_sigma_scale = 1.1;
   bool try_pairs = true;
-  int pair_candidates = 4;
+  int pair_candidates = 6;
   int max_iterations = 200;
   bool heldout = true;
   std::vector<EffectKind> effects;  // the library to try; empty: EffectsFor(quantity)
@@ -106,6 +106,27 @@ struct HeldOutGap {
   double cost_before = 0.0, cost_after = 0.0;  // predictive -2 ln L on the held-out lines
 };
 
+// Calibration and structure apart (impedance only): the excess X(g) = g^2 - E|r|^2 over the
+// noise, split in the order a person would fix it:
+//   calibration  the nominal's own parameters (R, L, Rp, f0, Q) refitted to the measurement:
+//                share_calibration = (X(g_nominal) - X(g_refit)) / X(g_nominal)
+//   structure    the winner's effect on top, fitted together with the nominal's parameters:
+//                share_structure = (X(g_refit) - X(g_refit_effect)) / X(g_nominal)
+//   left         share_left = X(g_refit_effect) / X(g_nominal)
+// (shares NaN when the nominal's g is within the noise). heldout_g_refit_effect: the two
+// together on held-out lines (as HeldOutGap), against heldout_g_nominal on the same lines.
+struct GapSplit {
+  bool available = false;
+  std::string message;  // why not, when not
+  double g_nominal = 0.0, g_refit = 0.0, g_refit_effect = 0.0;
+  double share_calibration = 0.0, share_structure = 0.0, share_left = 0.0;
+  double heldout_g_nominal = 0.0, heldout_g_refit_effect = 0.0;
+  std::string heldout_method;
+  MotionalImpedance refit;         // the nominal alone, refitted
+  MotionalImpedance refit_effect;  // refitted together with the effect
+  std::vector<AppliedEffect> effect;
+};
+
 struct UnitGap {
   std::string name;
   int lines = 0;
@@ -130,6 +151,7 @@ struct GapSummary {
   std::vector<BandGap> where_after;
   std::vector<RankedEffect> ranking;  // best score first; rejected fits last
   std::vector<UnitGap> units;
+  GapSplit split;
 };
 
 // Never throws for bad data; usable == false with the reason (bad units, no lines, invalid

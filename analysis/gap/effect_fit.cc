@@ -344,17 +344,20 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       return Best(c, 2);
     }
     case EffectKind::kFractionalInductance: {
-      // The share is linear for a given order: B = L (w_r^(1-n) (j w)^n - s).
+      // The share is linear for a given order and match frequency:
+      // B = L (w_m^(1-n) (j w)^n - s).
       std::vector<Candidate> c;
-      for (double order : {0.4, 0.5, 0.6, 0.7, 0.8, 0.9}) {
-        const double share = Amplitude(
-            l,
-            Shape(l, [&](double f, Cplx) { return m.l_h * (FractionalShape(order, f) - s_of(f)); }),
-            &red);
-        if (share > 0.0) c.push_back({red, {std::min(share, 0.9), order}});
-      }
-      if (c.empty()) c.push_back({0.0, {0.05, 0.7}});
-      return Best(c, 2);
+      for (double order : {0.4, 0.5, 0.6, 0.7, 0.8, 0.9})
+        for (double fm : LogSpace(0.2 * f_lo_, 5.0 * f_hi_, 8)) {
+          const double share = Amplitude(
+              l,
+              Shape(l, [&](double f,
+                           Cplx) { return m.l_h * (FractionalShape(order, f, fm) - s_of(f)); }),
+              &red);
+          if (share > 0.0) c.push_back({red, {std::min(share, 0.9), order, fm}});
+        }
+      if (c.empty()) c.push_back({0.0, {0.05, 0.7, std::sqrt(f_lo_ * f_hi_)}});
+      return Best(c, 3);
     }
     case EffectKind::kCoupledInertia: {
       // The second inertia's own frequency on a log grid over and beyond the band (above f0
@@ -506,6 +509,92 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   for (std::size_t e = 0; e < out.effects.size(); ++e)
     for (std::size_t p = 0; p < out.effects[e].params.size(); ++p, ++i)
       out.sigma[e].push_back(std::abs(layout.Slope(out.effects, e, p)) * std::sqrt(cov(i, i)));
+  return out;
+}
+
+namespace {
+
+constexpr int kNominalParams = 5;
+
+NominalNetwork WithMotional(NominalNetwork n, const Eigen::VectorXd& t) {
+  n.motional = {std::exp(t(0)), std::exp(t(1)), std::exp(t(2)), std::exp(t(3)), std::exp(t(4))};
+  return n;
+}
+
+}  // namespace
+
+double EffectFitter::Chi2With(const NominalNetwork& nominal, std::span<const AppliedEffect> effects,
+                              const LineMask& mask, double* cost) const {
+  double chi2 = 0.0, c = 0.0;
+  for (std::size_t u = 0; u < units_.size(); ++u) {
+    const GapUnit& unit = units_[u];
+    for (std::size_t k = 0; k < unit.size(); ++k) {
+      if (!Selected(mask, u, k)) continue;
+      const Cplx r = LineResidual(unit, k, EvaluateNetwork(nominal, effects, unit.freq_hz[k]));
+      chi2 += 2.0 * std::norm(r);
+      c += LineCost(std::norm(r), unit.sigma_dof);
+    }
+  }
+  if (cost) *cost = c;
+  return chi2;
+}
+
+EffectFit EffectFitter::FitWithNominal(const NominalNetwork& nominal,
+                                       const std::vector<AppliedEffect>& start,
+                                       const LineMask& mask, int max_iterations,
+                                       NominalNetwork* refitted) const {
+  EffectFit out;
+  out.effects = start;
+  *refitted = nominal;
+  const Lines lines = Collect(nominal_, units_, {}, mask);
+  out.residuals = static_cast<int>(2 * lines.f.size());
+  Layout layout;
+  layout.shape = start;
+  for (const AppliedEffect& e : start) layout.specs.push_back(Spec(e.kind));
+  out.n_params = kNominalParams + layout.size();
+  if (nominal.quantity != Quantity::kImpedanceOhm || lines.f.empty()) {
+    out.chi2 = Chi2With(nominal, start, mask, &out.cost);
+    return out;
+  }
+  const MotionalImpedance& m = nominal.motional;
+  Eigen::VectorXd theta(out.n_params);
+  theta.head(kNominalParams) << std::log(m.r_ohm), std::log(m.l_h), std::log(m.rp_ohm),
+      std::log(m.f0_hz), std::log(m.q);
+  if (layout.size() > 0) theta.tail(layout.size()) = layout.ToTheta(start);
+  auto split = [&](const Eigen::VectorXd& t) {
+    return layout.size() > 0 ? layout.FromTheta(t.tail(layout.size()))
+                             : std::vector<AppliedEffect>{};
+  };
+  LeastSquaresProblem problem;
+  problem.parameters = out.n_params;
+  problem.residuals = out.residuals;
+  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
+    const Eigen::VectorXd effects = t.tail(layout.size());
+    Residual(WithMotional(nominal, t), lines, layout, effects, r);
+  };
+  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jac) {
+    jac->resize(out.residuals, t.size());
+    Eigen::VectorXd up, down;
+    for (long i = 0; i < t.size(); ++i) {
+      const double h = 1e-6 * std::max(1.0, std::abs(t(i)));
+      Eigen::VectorXd x = t;
+      x(i) = t(i) + h;
+      problem.residual(x, &up);
+      x(i) = t(i) - h;
+      problem.residual(x, &down);
+      jac->col(i) = (up - down) / (2.0 * h);
+    }
+  };
+  LeastSquaresSettings settings;
+  settings.max_iterations = max_iterations;
+  settings.ftol = kLmTol;
+  settings.xtol = kLmTol;
+  const LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, &theta, settings);
+  out.iterations = outcome.iterations;
+  out.converged = outcome.converged;
+  *refitted = WithMotional(nominal, theta);
+  out.effects = split(theta);
+  out.chi2 = Chi2With(*refitted, out.effects, mask, &out.cost);
   return out;
 }
 

@@ -112,6 +112,17 @@ class EffectFitter {
   EffectFit Fit(const std::vector<AppliedEffect>& start, const LineMask& mask,
                 int max_iterations) const;
 
+  // Calibration and structure together: as Fit, with the nominal's own parameters free too
+  // (impedance: ln R, ln L, ln Rp, ln f0, ln Q; started from `nominal`, which must be an
+  // impedance network). The refitted nominal goes to *refitted; the effects' parameters to the
+  // result (start may be empty: a refit of the nominal alone). n_params counts both.
+  EffectFit FitWithNominal(const NominalNetwork& nominal, const std::vector<AppliedEffect>& start,
+                           const LineMask& mask, int max_iterations,
+                           NominalNetwork* refitted) const;
+  // chi2 / cost of another nominal + effects on the selected lines (as Chi2 and Cost).
+  double Chi2With(const NominalNetwork& nominal, std::span<const AppliedEffect> effects,
+                  const LineMask& mask, double* cost = nullptr) const;
+
   // The best of the fits started from Starts(kind) for each kind in `kinds`, the kinds
   // fitted jointly; for a pair the second kind's starts are taken on top of `seeds` (the
   // kinds' single fits, same order as kinds) and vice versa.

@@ -74,10 +74,9 @@ Cplx MotionalWithEffects(const MotionalImpedance& m, const AppliedEffect* creep,
 
 }  // namespace
 
-std::complex<double> FractionalShape(double order, double f_hz) {
-  const double w_r = TwoPi() * kFractionalReferenceHz;
-  return w_r * std::pow(f_hz / kFractionalReferenceHz, order) *
-         std::polar(1.0, order * std::numbers::pi / 2.0);
+std::complex<double> FractionalShape(double order, double f_hz, double ref_hz) {
+  const double w_r = TwoPi() * ref_hz;
+  return w_r * std::pow(f_hz / ref_hz, order) * std::polar(1.0, order * std::numbers::pi / 2.0);
 }
 
 std::complex<double> RigidShaftMobility::At(double f_hz) const {
@@ -180,9 +179,10 @@ EffectSpec DescribeEffect(EffectKind kind, const NominalNetwork& n, double f_lo,
     }
     case EffectKind::kFractionalInductance:
       s.equation =
-          "Z = Z0 + inductance_share L (w_r^(1 - order) (j w)^order - s), w_r = 2 pi 1 kHz";
+          "Z = Z0 + inductance_share L (w_m^(1 - order) (j w)^order - s), w_m = 2 pi match_hz";
       s.params = {{"inductance_share", "1", 0.0, 0.95, true, 0.1},
-                  {"order", "1", 0.3, 0.98, false, 0.1}};
+                  {"order", "1", 0.3, 0.98, false, 0.1},
+                  {"match_hz", "Hz", 0.1 * f_lo, 10.0 * f_hi, true, std::sqrt(f_lo * f_hi), true}};
       break;
     case EffectKind::kCoupledInertia:
       s.equation =
@@ -255,7 +255,10 @@ std::complex<double> EvaluateNetwork(const NominalNetwork& n,
       winding -= s * s * l2 * l2 / (s * l2 + Param(eddy, 1));
     }
     if (const AppliedEffect* frac = FindEffect(effects, EffectKind::kFractionalInductance))
-      winding += m.l_h * Param(frac, 0) * (FractionalShape(Param(frac, 1), f_hz) - s);
+      winding += m.l_h * Param(frac, 0) *
+                 (FractionalShape(Param(frac, 1), f_hz,
+                                  Param(frac, 2) > 0.0 ? Param(frac, 2) : kFractionalReferenceHz) -
+                  s);
     const AppliedEffect* creep = FindEffect(effects, EffectKind::kAdhesiveCreep);
     const AppliedEffect* fixture = FindEffect(effects, EffectKind::kFixtureCompliance);
     const AppliedEffect* coupled = FindEffect(effects, EffectKind::kCoupledInertia);

@@ -33,12 +33,16 @@
 //                       low frequency and L - L2 far above the corner R2 / (2 pi L2), where the
 //                       resistance has risen by R2). 0 < L2 <= 0.9 L; corner in
 //                       [0.1 f_lo, 100 f_hi].
-//   fractional_inductance  inductance_share b, order n: eddy currents in laminations as a
-//                       fractional-order (semi-)inductance: the share b of L becomes
-//                       b L w_r^(1 - n) (j w)^n (same |Z| at w_r = 2 pi 1 kHz; phase n 90 deg,
-//                       so Re Z rises as w^n and Im Z / w falls as w^(n - 1)), where the L2-R2
-//                       branch has one corner. The selection between them is by evidence (both
-//                       have two parameters). 0 <= b <= 0.95, 0.3 <= n <= 0.98.
+//   fractional_inductance  inductance_share b, order n, match_hz f_m: eddy currents in
+//                       laminations as a fractional-order (semi-)inductance
+//                       Z_L = s L (1 - b) + K (j w)^n, K = b L w_m^(1 - n): the share b of L
+//                       becomes a (semi-)inductance with the same |Z| at w_m = 2 pi f_m (phase
+//                       n 90 deg, so Re Z rises as w^n and Im Z / w falls as w^(n - 1)), where
+//                       the L2-R2 branch has one corner. L (1 - b), K and n are three free
+//                       numbers (a measured curve fixes all three over a wide band); f_m only
+//                       names K in a unit that reads as a share. The selection between them is by
+//                       evidence (both have two parameters). 0 <= b <= 0.95, 0.3 <= n <= 0.98, f_m
+//                       in [0.1 f_lo, 10 f_hi].
 //   skin_effect         skin_r_rise_at_1khz a: skin/proximity effect below the skin-depth
 //                       transition, R(f) = R (1 + a (f / 1 kHz)^2). 0 <= a <= 3.
 //   fixture_compliance  k_fixture_ratio kappa = k_fixture / k_nominal, fixture_loss_factor eta:
@@ -187,7 +191,8 @@ Frf EvaluateNetwork(const NominalNetwork& nominal, std::span<const AppliedEffect
                     const std::vector<double>& freq_hz);
 
 // w_r^(1 - n) (j w)^n at f_hz, w_r = 2 pi 1 kHz: the fractional inductance's shape (H -> ohm).
-std::complex<double> FractionalShape(double order, double f_hz);
+// w_m^(1 - n) (j w)^n with w_m = 2 pi ref_hz (default 1 kHz).
+std::complex<double> FractionalShape(double order, double f_hz, double ref_hz = 1000.0);
 
 // The fixture_loss_factor that keeps the nominal Q for stiffness ratio kappa (see above).
 double FixtureLossKeepingQ(double kappa, double q);

@@ -122,6 +122,33 @@ json GapReportJson(const GapReport& r) {
   }
   j["features"] = features;
   j["refit"] = refit;
+  const analysis::GapSplit& sp = g.split;
+  if (sp.available) {
+    auto motional = [](const analysis::MotionalImpedance& m) {
+      return json{{"R_ohm", Num(m.r_ohm)},
+                  {"L_h", Num(m.l_h)},
+                  {"Rp_ohm", Num(m.rp_ohm)},
+                  {"f0_hz", Num(m.f0_hz)},
+                  {"Q", Num(m.q)}};
+    };
+    json eff = json::array();
+    for (const auto& e : sp.effect)
+      eff.push_back({{"effect", analysis::ToString(e.kind)}, {"params", e.params}});
+    j["split"] = {{"g_nominal", Num(sp.g_nominal)},
+                  {"g_refit", Num(sp.g_refit)},
+                  {"g_refit_effect", Num(sp.g_refit_effect)},
+                  {"share_calibration", Num(sp.share_calibration)},
+                  {"share_structure", Num(sp.share_structure)},
+                  {"share_left", Num(sp.share_left)},
+                  {"heldout_g_nominal", Num(sp.heldout_g_nominal)},
+                  {"heldout_g_refit_effect", Num(sp.heldout_g_refit_effect)},
+                  {"heldout_method", sp.heldout_method},
+                  {"refit", motional(sp.refit)},
+                  {"refit_effect", motional(sp.refit_effect)},
+                  {"effect", eff}};
+  } else {
+    j["split"] = {{"message", sp.message}};
+  }
   j["calibration"] = {{"simulation", r.simulation.source},
                       {"kind", r.simulation.kind},
                       {"note", r.simulation.note},
@@ -235,6 +262,21 @@ std::string GapReportText(const GapReport& r) {
   os << "HOW FAR      g " << Fmt("%.3f", g.gap_before) << " -> " << Fmt("%.3f", g.gap_after)
      << " overall; held out (" << g.heldout.method << ") " << Fmt("%.3f", g.heldout.gap_before)
      << " -> " << Fmt("%.3f", g.heldout.gap_after) << "\n";
+  if (g.split.available) {
+    const analysis::GapSplit& sp = g.split;
+    auto pct = [](double v) { return std::isfinite(v) ? Fmt("%.1f %%", 100.0 * v) : "n/a"; };
+    os << "CALIBRATION AND STRUCTURE (share of the excess g^2 - E|r|^2)\n"
+       << "  nominal (simulation)                g " << Fmt("%.3f", sp.g_nominal) << "\n"
+       << "  refit of the nominal's parameters   g " << Fmt("%.3f", sp.g_refit) << "   closes "
+       << pct(sp.share_calibration) << " (calibration)\n"
+       << "  + " << (g.winner.empty() ? std::string("no effect") : g.effect)
+       << " fitted together   g " << Fmt("%.3f", sp.g_refit_effect) << "   closes "
+       << pct(sp.share_structure) << " (structure); left " << pct(sp.share_left) << "\n"
+       << "  held out (" << sp.heldout_method << "): " << Fmt("%.3f", sp.heldout_g_nominal)
+       << " -> " << Fmt("%.3f", sp.heldout_g_refit_effect) << " (calibration + structure)\n";
+  } else if (!g.split.message.empty()) {
+    os << "CALIBRATION AND STRUCTURE  " << g.split.message << "\n";
+  }
   if (!g.where_after.empty())
     os << "  still significant after it: " << g.where_after.size() << " band(s), the first "
        << Fmt("%.1f", g.where_after.front().band.f_lo_hz) << " - "

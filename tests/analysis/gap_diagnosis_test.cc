@@ -123,7 +123,11 @@ TEST(GapDiagnosis, TwoEffectsGiveThePair) {
                                             {EffectKind::kFixtureCompliance, {0.44, 0.03}}};
   const GapSummary s = DiagnoseGap(n, {Measure(n, truth, 5)}, GapOptions{});
   ASSERT_TRUE(s.usable) << s.message;
-  EXPECT_EQ(s.effect, "channel_delay+fixture_compliance") << s.message;
+  std::string ranking;
+  for (const auto& r : s.ranking)
+    ranking += "\n  " + r.effect + " score " + std::to_string(r.score) + " bic " +
+               std::to_string(r.bic) + " g " + std::to_string(r.gap_after) + " " + r.rejected;
+  EXPECT_EQ(s.effect, "channel_delay+fixture_compliance") << s.message << ranking;
   EXPECT_LT(s.gap_after, 1.1);
   EXPECT_LT(s.heldout.gap_after, 1.15);
 }
