@@ -193,13 +193,10 @@ GapSplit SplitGap(const EffectFitter& fitter, const std::vector<AppliedEffect>& 
                   const GapOptions& o) {
   GapSplit s;
   const NominalNetwork& nominal = fitter.nominal();
-  if (nominal.quantity != Quantity::kImpedanceOhm) {
-    s.message = "calibration and structure are split for impedance only";
-    return s;
-  }
   std::vector<NominalNetwork> starts = {nominal};
   const GapUnit& first = fitter.units().front();
   Frf h;
+  h.quantity = nominal.quantity;
   h.freq_hz = first.freq_hz;
   h.value = first.value;
   h.sigma = first.sigma;
@@ -207,6 +204,7 @@ GapSplit SplitGap(const EffectFitter& fitter, const std::vector<AppliedEffect>& 
   if (fresh.usable) {
     NominalNetwork n = nominal;
     n.motional = fresh.nominal.motional;
+    n.rigid = fresh.nominal.rigid;
     starts.push_back(n);
   }
   const LineMask all;
@@ -218,14 +216,14 @@ GapSplit SplitGap(const EffectFitter& fitter, const std::vector<AppliedEffect>& 
     expected += ExpectedR2(u.sigma_dof) * static_cast<double>(u.size());
   expected /= lines;
   const Refit cal = BestRefit(fitter, starts, {}, all, o.max_iterations);
-  s.refit = cal.nominal.motional;
+  s.refit = cal.nominal;
   Refit both = cal;
   if (!winner.empty()) {
     // From the simulation's nominal (the effect as diagnosed) and from the refitted one.
     both = BestRefit(fitter, {nominal, cal.nominal}, winner, all, o.max_iterations);
     if (!(both.fit.cost <= cal.fit.cost)) both = cal;  // the effect may not make it worse
   }
-  s.refit_effect = both.nominal.motional;
+  s.refit_effect = both.nominal;
   s.effect = both.fit.effects;
   s.g_nominal = std::sqrt(chi2_nominal / residuals);
   s.g_refit = std::sqrt(cal.fit.chi2 / residuals);

@@ -106,9 +106,9 @@ struct HeldOutGap {
   double cost_before = 0.0, cost_after = 0.0;  // predictive -2 ln L on the held-out lines
 };
 
-// Calibration and structure apart (impedance only): the excess X(g) = g^2 - E|r|^2 over the
+// Calibration and structure apart: the excess X(g) = g^2 - E|r|^2 over the
 // noise, split in the order a person would fix it:
-//   calibration  the nominal's own parameters (R, L, Rp, f0, Q) refitted to the measurement:
+//   calibration  the nominal's own parameters (R, L, Rp, f0, Q; mobility g, a) refitted:
 //                share_calibration = (X(g_nominal) - X(g_refit)) / X(g_nominal)
 //   structure    the winner's effect on top, fitted together with the nominal's parameters:
 //                share_structure = (X(g_refit) - X(g_refit_effect)) / X(g_nominal)
@@ -122,8 +122,8 @@ struct GapSplit {
   double share_calibration = 0.0, share_structure = 0.0, share_left = 0.0;
   double heldout_g_nominal = 0.0, heldout_g_refit_effect = 0.0;
   std::string heldout_method;
-  MotionalImpedance refit;         // the nominal alone, refitted
-  MotionalImpedance refit_effect;  // refitted together with the effect
+  NominalNetwork refit;         // the nominal alone, refitted
+  NominalNetwork refit_effect;  // refitted together with the effect
   std::vector<AppliedEffect> effect;
 };
 

@@ -514,10 +514,25 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
 
 namespace {
 
-constexpr int kNominalParams = 5;
+// The nominal's own parameters as logarithms: impedance R, L, Rp, f0, Q; mobility g, a.
+int NominalParams(const NominalNetwork& n) { return n.quantity == Quantity::kMobility ? 2 : 5; }
+
+Eigen::VectorXd NominalTheta(const NominalNetwork& n) {
+  Eigen::VectorXd t(NominalParams(n));
+  if (n.quantity == Quantity::kMobility) {
+    t << std::log(n.rigid.gain_rad_per_s2_per_a), std::log(std::max(n.rigid.damping_per_s, 1e-9));
+  } else {
+    const MotionalImpedance& m = n.motional;
+    t << std::log(m.r_ohm), std::log(m.l_h), std::log(m.rp_ohm), std::log(m.f0_hz), std::log(m.q);
+  }
+  return t;
+}
 
 NominalNetwork WithMotional(NominalNetwork n, const Eigen::VectorXd& t) {
-  n.motional = {std::exp(t(0)), std::exp(t(1)), std::exp(t(2)), std::exp(t(3)), std::exp(t(4))};
+  if (n.quantity == Quantity::kMobility)
+    n.rigid = {std::exp(t(0)), std::exp(t(1))};
+  else
+    n.motional = {std::exp(t(0)), std::exp(t(1)), std::exp(t(2)), std::exp(t(3)), std::exp(t(4))};
   return n;
 }
 
@@ -551,15 +566,14 @@ EffectFit EffectFitter::FitWithNominal(const NominalNetwork& nominal,
   Layout layout;
   layout.shape = start;
   for (const AppliedEffect& e : start) layout.specs.push_back(Spec(e.kind));
-  out.n_params = kNominalParams + layout.size();
-  if (nominal.quantity != Quantity::kImpedanceOhm || lines.f.empty()) {
+  const int own = NominalParams(nominal);
+  out.n_params = own + layout.size();
+  if (lines.f.empty()) {
     out.chi2 = Chi2With(nominal, start, mask, &out.cost);
     return out;
   }
-  const MotionalImpedance& m = nominal.motional;
   Eigen::VectorXd theta(out.n_params);
-  theta.head(kNominalParams) << std::log(m.r_ohm), std::log(m.l_h), std::log(m.rp_ohm),
-      std::log(m.f0_hz), std::log(m.q);
+  theta.head(own) = NominalTheta(nominal);
   if (layout.size() > 0) theta.tail(layout.size()) = layout.ToTheta(start);
   auto split = [&](const Eigen::VectorXd& t) {
     return layout.size() > 0 ? layout.FromTheta(t.tail(layout.size()))

@@ -113,8 +113,8 @@ class EffectFitter {
                 int max_iterations) const;
 
   // Calibration and structure together: as Fit, with the nominal's own parameters free too
-  // (impedance: ln R, ln L, ln Rp, ln f0, ln Q; started from `nominal`, which must be an
-  // impedance network). The refitted nominal goes to *refitted; the effects' parameters to the
+  // (impedance: ln R, ln L, ln Rp, ln f0, ln Q; mobility: ln g, ln a; started from
+  // `nominal`). The refitted nominal goes to *refitted; the effects' parameters to the
   // result (start may be empty: a refit of the nominal alone). n_params counts both.
   EffectFit FitWithNominal(const NominalNetwork& nominal, const std::vector<AppliedEffect>& start,
                            const LineMask& mask, int max_iterations,

@@ -124,7 +124,11 @@ json GapReportJson(const GapReport& r) {
   j["refit"] = refit;
   const analysis::GapSplit& sp = g.split;
   if (sp.available) {
-    auto motional = [](const analysis::MotionalImpedance& m) {
+    auto motional = [](const analysis::NominalNetwork& n) {
+      if (n.quantity == analysis::Quantity::kMobility)
+        return json{{"gain_rad_per_s2_per_a", Num(n.rigid.gain_rad_per_s2_per_a)},
+                    {"damping_per_s", Num(n.rigid.damping_per_s)}};
+      const analysis::MotionalImpedance& m = n.motional;
       return json{{"R_ohm", Num(m.r_ohm)},
                   {"L_h", Num(m.l_h)},
                   {"Rp_ohm", Num(m.rp_ohm)},

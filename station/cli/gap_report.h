@@ -30,8 +30,8 @@
 //   split               calibration and structure apart (diagnosis.h GapSplit): {g_nominal,
 //                       g_refit, g_refit_effect, share_calibration, share_structure,
 //                       share_left, heldout_g_nominal, heldout_g_refit_effect, heldout_method,
-//                       refit {R_ohm, L_h, Rp_ohm, f0_hz, Q}, refit_effect {...}, effect
-//                       [{effect, params}]}; {message} for mobility
+//                       refit {R_ohm, L_h, Rp_ohm, f0_hz, Q | gain_rad_per_s2_per_a,
+//                       damping_per_s}, refit_effect {...}, effect [{effect, params}]}
 //   measurements        [{source, kind, note, lines, sigma_estimated, gap_before, gap_after}]
 //   sigma_pool_lines    the --sigma-pool half-width used (0: the files' sigma as given)
 //   sigma_dof           degrees of freedom of each line's sigma^2 after pooling (0: exact)
