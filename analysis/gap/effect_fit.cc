@@ -16,7 +16,7 @@ namespace {
 using Cplx = std::complex<double>;
 
 constexpr double kLmTol = 1e-10;
-constexpr double kSettledCost = 0.01;  // -2 ln L units
+constexpr double kSettledCost = 0.5;  // -2 ln L units, against min_score_gain 10
 
 double TwoPi() { return 2.0 * std::numbers::pi; }
 
@@ -377,16 +377,52 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
               trial.back().params = {mu, f2, q2, x};
               c.push_back({-Cost(trial, mask), trial.back().params});
             }
+      // The coupled mode is a few percent wide: a fine scan of f2 over the band's lines (at
+      // most 200) puts it where the data show it, which the coarse grid above cannot.
+      std::vector<double> fs = l.f;
+      std::sort(fs.begin(), fs.end());
+      fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+      const std::size_t stride = std::max<std::size_t>(1, fs.size() / 200);
+      // The mass ratio follows from the first mode's shift: J2 rigid on the rotor (f2 at the
+      // top) gives mu_rigid; below that, J2 on its spring loads the first mode as
+      // mu / (1 - (f0 / f2)^2), and at a node as (1 - x)^2 of that.
+      double mu_rigid = 0.1, best_cost = std::numeric_limits<double>::infinity();
+      for (double mu : LogSpace(1e-3, 3.0, 40)) {
+        trial.back().params = {mu, 19.0 * f_hi_, 30.0, 0.0};
+        const double cost = Cost(trial, mask);
+        if (cost < best_cost) {
+          best_cost = cost;
+          mu_rigid = mu;
+        }
+      }
+      for (std::size_t i = 0; i < fs.size(); i += stride) {
+        const double r = m.f0_hz / fs[i];
+        if (r > 0.9) continue;
+        for (double x : {0.0, 0.55})
+          for (double q2 : {15.0, 40.0, 100.0}) {
+            const double mu =
+                std::clamp(mu_rigid * (1.0 - r * r) / ((1.0 - x) * (1.0 - x)), 1e-3, 10.0);
+            trial.back().params = {mu, fs[i], q2, x};
+            c.push_back({-Cost(trial, mask), trial.back().params});
+          }
+      }
       // The best start at the rotor and at each node, so LM sees every basin.
       std::sort(c.begin(), c.end(),
                 [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
+      // Two per node, at clearly different f2 (the coupled mode's own basin and the added
+      // inertia's are far apart).
       std::vector<std::vector<double>> out;
-      for (double x : {0.0, 0.3, 0.55, 0.8})
-        for (const Candidate& cand : c)
-          if (cand.params[3] == x) {
-            out.push_back(cand.params);
-            break;
-          }
+      for (double x : {0.0, 0.3, 0.55, 0.8}) {
+        int taken = 0;
+        double f2_taken = 0.0;
+        for (const Candidate& cand : c) {
+          if (cand.params[3] != x) continue;
+          if (taken == 1 && std::abs(std::log(cand.params[1] / f2_taken)) < 0.2) continue;
+          out.push_back(cand.params);
+          f2_taken = cand.params[1];
+          if (++taken == 2) break;
+        }
+      }
       std::sort(out.begin(), out.end(), [&](const auto& a, const auto& b) {
         auto red = [&](const std::vector<double>& p) {
           for (const Candidate& cand : c)
