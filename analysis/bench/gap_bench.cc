@@ -215,14 +215,20 @@ GapBenchCase RunCase(const GapBenchOptions& o, const Excitation& ex, int index,
   c.heldout_after = s.heldout.gap_after;
 
   // Oracle.
-  const EffectFitter fitter(cal.nominal, {u});
+  // The oracle scores as the diagnosis does (diagnosis.h: the evidence, on the residual form
+  // the diagnosis chose for this unit).
+  GapUnit formed = u;
+  formed.admittance =
+      cal.nominal.quantity == Quantity::kImpedanceOhm &&
+      o.gap.residual_form != ResidualForm::kImpedance &&
+      (o.gap.residual_form == ResidualForm::kAdmittance || CurrentNoiseDominates(formed));
+  const EffectFitter fitter(cal.nominal, {formed});
   if (hidden.empty()) {
     c.oracle_separable = true;
   } else {
     const EffectFit truth_fit = fitter.Fit(hidden, {}, o.gap.max_iterations);
-    const double penalty = std::log(static_cast<double>(truth_fit.residuals));
-    double truth_score = truth_fit.chi2 + truth_fit.n_params * penalty;
-    double best_other = s.chi2_before;  // "none"
+    double truth_score = truth_fit.cost + truth_fit.occam;
+    double best_other = fitter.Cost({}, {});  // "none"
     for (const RankedEffect& r : s.ranking) {
       if (r.effects.size() != 1) continue;
       if (r.effect == c.truth)
