@@ -203,5 +203,26 @@ TEST(GapDiagnosis, BadInputIsNotUsable) {
             std::string::npos);
 }
 
+// Calibration and structure apart: a unit whose only difference from the simulation is the
+// nominal's own f0 and R (a calibration, no structure) is closed by the refit, and the shares
+// add to 1. One cheap candidate keeps the test short; the split does not depend on it.
+TEST(GapDiagnosis, SplitPutsARetunedNominalUnderCalibration) {
+  const NominalNetwork n = Nominal(false);
+  NominalNetwork retuned = n;
+  retuned.motional.f0_hz *= 1.01;
+  retuned.motional.r_ohm *= 1.03;
+  GapOptions o;
+  o.effects = {EffectKind::kSeriesResistance};
+  const GapSummary s = DiagnoseGap(n, {Measure(retuned, {}, 31)}, o);
+  ASSERT_TRUE(s.usable) << s.message;
+  ASSERT_TRUE(s.split.available) << s.split.message;
+  EXPECT_GT(s.split.g_nominal, 2.0);
+  EXPECT_LT(s.split.g_refit, 1.1);
+  EXPECT_GT(s.split.share_calibration, 0.97);
+  EXPECT_NEAR(s.split.share_calibration + s.split.share_structure + s.split.share_left, 1.0, 1e-9);
+  EXPECT_NEAR(s.split.refit.motional.f0_hz, retuned.motional.f0_hz, 0.002 * retuned.motional.f0_hz);
+  EXPECT_LT(s.split.heldout_g_refit_effect, 1.15);
+}
+
 }  // namespace
 }  // namespace eol::analysis
