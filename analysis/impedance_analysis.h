@@ -5,17 +5,22 @@
 
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "analysis/fit/resonance_fit.h"
 #include "analysis/qc/measurement.h"
+#include "analysis/signal/frf_method.h"
 #include "analysis/signal/periodic_frf.h"
 #include "analysis/signal/recording.h"
+#include "analysis/signal/transient_frf.h"
 
 namespace eol::analysis {
 
 struct ImpedanceAnalysisOptions {
-  PeriodicFrfOptions frf;
+  FrfMethod frf_method = FrfMethod::kDiscardTransient;
+  PeriodicFrfOptions frf;   // kDiscardTransient
+  TransientFrfOptions lpm;  // kTransientLpm
   ResonanceFitOptions fit;
 };
 

@@ -13,7 +13,10 @@ install(FILES ${PROJECT_SOURCE_DIR}/station/web/index.html ${PROJECT_SOURCE_DIR}
               ${PROJECT_SOURCE_DIR}/station/web/style.css
         DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/web)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/deploy/bench/ DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/bench)
-install(FILES ${PROJECT_SOURCE_DIR}/deploy/debian/station.json DESTINATION /etc/eol)
+# The config may hold API tokens: readable by root and the service's group only (postinst
+# gives it to group eol).
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/debian/station.json DESTINATION /etc/eol
+        PERMISSIONS OWNER_READ OWNER_WRITE GROUP_READ)
 install(FILES ${PROJECT_SOURCE_DIR}/deploy/eol-station.service DESTINATION /lib/systemd/system)
 
 set(CPACK_GENERATOR "DEB")

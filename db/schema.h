@@ -116,4 +116,36 @@ CREATE TABLE self_checks (
 CREATE INDEX self_checks_at ON self_checks(at);
 )sql";
 
+// Version 3 -> 4: who tested and for which order (db/test_record.h WorkContext).
+//
+// tests.operator_id, tests.shift, tests.order_number: as given with the serial; '' when not
+//   given, and for every row written before version 4. Authoritative like the other columns
+//   (the record JSON holds copies). The index serves "every unit of this order".
+inline constexpr const char kSchemaV4[] = R"sql(
+ALTER TABLE tests ADD COLUMN operator_id TEXT NOT NULL DEFAULT '';
+ALTER TABLE tests ADD COLUMN shift TEXT NOT NULL DEFAULT '';
+ALTER TABLE tests ADD COLUMN order_number TEXT NOT NULL DEFAULT '';
+CREATE INDEX tests_order_started ON tests(order_number, started_at);
+)sql";
+
+// Version 4 -> 5: the outbox of finished records for the publishers (MQTT, ...).
+//
+// outbox: one row per finished record, written in the record's own transaction (and for a
+//   test recovered as ABORTED, in the recovery's), so a record is never stored without its
+//   row. AUTOINCREMENT: ids only grow, even if old rows are pruned, so a cursor stays valid.
+//   Records stored before version 5 have no row and are not published.
+// outbox_cursors: per consumer ('mqtt'), the id of the newest row it has delivered (acknowledged
+//   by the broker); the consumer reads the rows after it, in id order.
+inline constexpr const char kSchemaV5[] = R"sql(
+CREATE TABLE outbox (
+  id         INTEGER PRIMARY KEY AUTOINCREMENT,
+  test_id    INTEGER NOT NULL REFERENCES tests(id) ON DELETE CASCADE,
+  created_at TEXT    NOT NULL
+);
+CREATE TABLE outbox_cursors (
+  consumer TEXT    PRIMARY KEY,
+  last_id  INTEGER NOT NULL
+);
+)sql";
+
 }  // namespace eol::db::schema

@@ -1,11 +1,18 @@
 #include "db/store.h"
 
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <sys/file.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 #include <stdexcept>
 #include <string_view>
@@ -172,8 +179,16 @@ void MigrateTo3(sqlite3* db, const std::string& path) {
   Exec(db, path, schema::kSchemaV3, "migrate the schema to version 3");
 }
 
-constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {&MigrateTo1, &MigrateTo2,
-                                                                      &MigrateTo3};
+void MigrateTo4(sqlite3* db, const std::string& path) {
+  Exec(db, path, schema::kSchemaV4, "migrate the schema to version 4");
+}
+
+void MigrateTo5(sqlite3* db, const std::string& path) {
+  Exec(db, path, schema::kSchemaV5, "migrate the schema to version 5");
+}
+
+constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {
+    &MigrateTo1, &MigrateTo2, &MigrateTo3, &MigrateTo4, &MigrateTo5};
 
 std::int64_t PragmaInt(sqlite3* db, const std::string& path, const char* sql,
                        const std::string& op) {
@@ -242,16 +257,29 @@ void Migrate(sqlite3* db, const std::string& path) {
 }
 
 int AbortUnfinished(sqlite3* db, const std::string& path) {
+  // The recovered records go to the outbox with them, in one transaction.
+  Transaction tx(db, path, "open (mark unfinished tests ABORTED)");
+  const std::string now = UtcNowIso8601();
+  {
+    Statement o(db, path,
+                "INSERT INTO outbox (test_id, created_at) "
+                "SELECT id, ?1 FROM tests WHERE outcome = 'RUNNING' ORDER BY id",
+                "open (queue the aborted tests in the outbox)");
+    o.BindText(1, now);
+    o.Run();
+  }
   Statement s(db, path,
               "UPDATE tests SET outcome = 'ABORTED', finished_at = ?1, reasons = ?2 "
               "WHERE outcome = 'RUNNING'",
               "open (mark unfinished tests ABORTED)");
-  s.BindText(1, UtcNowIso8601());
+  s.BindText(1, now);
   s.BindText(2, nlohmann::json::array(
                     {analysis::Reason{analysis::ReasonCode::kAborted, kInterruptedReason}})
                     .dump());
   s.Run();
-  return sqlite3_changes(db);
+  const int changed = sqlite3_changes(db);
+  tx.Commit();
+  return changed;
 }
 
 // ---- Writing -----------------------------------------------------------------------------
@@ -278,9 +306,10 @@ void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
   if (record.started_at.empty()) throw StoreError(Message(path, op, "record.started_at is empty"));
   Statement s(db, path, R"sql(
     INSERT INTO tests (serial, station_id, recipe_id, recipe_version, recipe_hash,
-                       software_version, started_at, outcome, retest_of, kind)
+                       software_version, started_at, outcome, retest_of, kind,
+                       operator_id, shift, order_number)
     VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, 'RUNNING',
-            (SELECT min(id) FROM tests WHERE serial = ?1), ?8)
+            (SELECT min(id) FROM tests WHERE serial = ?1), ?8, ?9, ?10, ?11)
     RETURNING id, retest_of)sql",
               op);
   s.BindText(1, record.serial);
@@ -291,6 +320,9 @@ void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
   s.BindText(6, record.software_version);
   s.BindText(7, record.started_at);
   s.BindText(8, ToString(record.kind));
+  s.BindText(9, record.work.operator_id);
+  s.BindText(10, record.work.shift);
+  s.BindText(11, record.work.order_number);
   if (!s.Step()) throw StoreError(Message(path, op, "the insert returned no id"));
   const std::int64_t id = s.Int(0);
   const std::optional<std::int64_t> retest_of = s.OptInt(1);
@@ -366,6 +398,14 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
     sc.Run();
   }
 
+  {
+    Statement o(db, path, "INSERT INTO outbox (test_id, created_at) VALUES (?1, ?2)",
+                op + " (queue in the outbox)");
+    o.BindInt(1, record.id);
+    o.BindText(2, record.finished_at);
+    o.Run();
+  }
+
   const std::string curves_op = op + " (write curves)";
   Statement c(db, path,
               "INSERT INTO curves (test_id, name, raw_size, data) VALUES (?1, ?2, ?3, ?4)",
@@ -386,7 +426,8 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
 
 constexpr std::string_view kSelectTests =
     "SELECT id, serial, station_id, recipe_id, recipe_version, recipe_hash, software_version, "
-    "started_at, finished_at, outcome, retest_of, reasons, record, kind FROM tests ";
+    "started_at, finished_at, outcome, retest_of, reasons, record, kind, operator_id, shift, "
+    "order_number FROM tests ";
 
 TestRecord RowToRecord(const Statement& s, const std::string& path) {
   const std::int64_t id = s.Int(0);
@@ -420,6 +461,9 @@ TestRecord RowToRecord(const Statement& s, const std::string& path) {
   } catch (const std::invalid_argument& e) {
     throw StoreError(Message(path, op, e.what()));
   }
+  r.work.operator_id = s.Text(14);
+  r.work.shift = s.Text(15);
+  r.work.order_number = s.Text(16);
   r.curves.clear();
   return r;
 }
@@ -472,18 +516,84 @@ std::vector<TestRecord> ReadTests(sqlite3* db, const std::string& path, Statemen
 
 }  // namespace
 
+namespace {
+
+// The URI a kReadOnly store opens. A WAL database opened read-only makes SQLite create
+// "-wal" and "-shm" beside it and leave them; while a writer has the file open they exist
+// already and "mode=ro" shares them. Without a "-wal" no connection has it open (the last one
+// to close removes it), so the file is opened "immutable": no lock and no file is created. A
+// station that starts writing during such a read may make that read fail; it cannot make it
+// write.
+std::string ReadOnlyUri(const std::string& path) {
+  std::string uri = "file:";
+  for (const char ch : path) {
+    if (ch == '%' || ch == '?' || ch == '#') {
+      char esc[4];
+      std::snprintf(esc, sizeof esc, "%%%02X", static_cast<unsigned char>(ch));
+      uri += esc;
+    } else {
+      uri += ch;
+    }
+  }
+  std::error_code ec;
+  const bool writer_open = std::filesystem::exists(path + "-wal", ec);
+  return uri + (writer_open ? "?mode=ro" : "?immutable=1");
+}
+
+}  // namespace
+
 Store::Store(std::string path) : path_(std::move(path)) {}
 
-Store::~Store() { sqlite3_close_v2(db_); }
+Store::~Store() {
+  sqlite3_close_v2(db_);
+  if (lock_fd_ >= 0) ::close(lock_fd_);
+}
 
 std::unique_ptr<Store> Store::Open(const std::string& path, Role role) {
   std::unique_ptr<Store> store(new Store(path));
-  const int rc = sqlite3_open_v2(path.c_str(), &store->db_,
-                                 SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  if (role == Role::kReadOnly) {
+    // sqlite3_open_v2 would name a missing file "unable to open database file".
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+      throw StoreError(Message(path, "open read-only", "no such file"));
+  }
+  if (role == Role::kWriter && path != ":memory:" && !path.empty()) {
+    const std::string lock_path = path + ".lock";
+    store->lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+    if (store->lock_fd_ < 0)
+      throw StoreError(
+          Message(path, "lock", "cannot open " + lock_path + ": " + std::strerror(errno)));
+    if (::flock(store->lock_fd_, LOCK_EX | LOCK_NB) != 0)
+      throw StoreError(Message(path, "lock",
+                               errno == EWOULDBLOCK
+                                   ? "another station holds " + lock_path +
+                                         " (one station per database; stop the other first)"
+                                   : "cannot lock " + lock_path + ": " + std::strerror(errno)));
+  }
+  const int rc = role == Role::kReadOnly
+                     ? sqlite3_open_v2(ReadOnlyUri(path).c_str(), &store->db_,
+                                       SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr)
+                     : sqlite3_open_v2(path.c_str(), &store->db_,
+                                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
   if (rc != SQLITE_OK) {
     const std::string detail =
         store->db_ != nullptr ? sqlite3_errmsg(store->db_) : sqlite3_errstr(rc);
     throw StoreError(Message(path, "open", detail + " (sqlite code " + std::to_string(rc) + ")"));
+  }
+  if (role == Role::kReadOnly) {
+    sqlite3_extended_result_codes(store->db_, 1);
+    sqlite3_busy_timeout(store->db_, kBusyTimeoutMs);
+    const std::string op = "open read-only (read the schema version)";
+    const std::int64_t version = PragmaInt(store->db_, path, "PRAGMA user_version", op);
+    CheckSchemaVersion(store->db_, path, version);
+    if (version != kSchemaVersion)
+      throw StoreError(Message(path, "open read-only",
+                               version == 0
+                                   ? std::string("not an EOL test store (no schema)")
+                                   : "schema version " + std::to_string(version) +
+                                         ", this software reads " + std::to_string(kSchemaVersion) +
+                                         "; let `eol station` migrate it first"));
+    return store;
   }
   // SQLite falls back to read-only when the file is write-protected; the station must write.
   if (sqlite3_db_readonly(store->db_, "main") == 1)
@@ -561,6 +671,14 @@ std::vector<TestRecord> Store::Tests(const TestQuery& query) {
   if (outcome_i) sql += " AND outcome = ?" + std::to_string(outcome_i);
   const int serial_i = query.serial ? ++n : 0;
   if (serial_i) sql += " AND serial = ?" + std::to_string(serial_i);
+  const int order_i = query.order_number ? ++n : 0;
+  if (order_i) sql += " AND order_number = ?" + std::to_string(order_i);
+  const int after_i = query.after ? ++n : 0;
+  if (after_i) {
+    ++n;  // the id's parameter
+    sql += " AND (started_at < ?" + std::to_string(after_i) + " OR (started_at = ?" +
+           std::to_string(after_i) + " AND id < ?" + std::to_string(after_i + 1) + "))";
+  }
   const int limit_i = ++n;
   sql += " ORDER BY started_at DESC, id DESC LIMIT ?" + std::to_string(limit_i);
 
@@ -569,6 +687,11 @@ std::vector<TestRecord> Store::Tests(const TestQuery& query) {
   if (to_i) s.BindText(to_i, *query.to);
   if (outcome_i) s.BindText(outcome_i, analysis::ToString(*query.outcome));
   if (serial_i) s.BindText(serial_i, *query.serial);
+  if (order_i) s.BindText(order_i, *query.order_number);
+  if (after_i) {
+    s.BindText(after_i, query.after->first);
+    s.BindInt(after_i + 1, query.after->second);
+  }
   s.BindInt(limit_i, std::clamp(query.limit, 1, kMaxQueryLimit));
   return ReadTests(db_, path_, s, query.with_curves);
 }
@@ -721,6 +844,47 @@ std::vector<RecipeAudit> Store::AuditLog(int limit) {
     out.push_back(a);
   }
   return out;
+}
+
+// ---- Outbox ------------------------------------------------------------------------------
+
+std::vector<OutboxEntry> Store::OutboxAfterCursor(const std::string& consumer, int limit) {
+  Statement s(db_, path_,
+              "SELECT id, test_id, created_at FROM outbox WHERE id > "
+              "coalesce((SELECT last_id FROM outbox_cursors WHERE consumer = ?1), 0) "
+              "ORDER BY id LIMIT ?2",
+              "read the outbox of '" + consumer + "'");
+  s.BindText(1, consumer);
+  s.BindInt(2, std::clamp(limit, 1, kMaxQueryLimit));
+  std::vector<OutboxEntry> out;
+  while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Text(2)});
+  return out;
+}
+
+void Store::AdvanceOutboxCursor(const std::string& consumer, std::int64_t id) {
+  Statement s(db_, path_,
+              "INSERT INTO outbox_cursors (consumer, last_id) VALUES (?1, ?2) "
+              "ON CONFLICT (consumer) DO UPDATE SET last_id = max(last_id, excluded.last_id)",
+              "advance the outbox cursor of '" + consumer + "' to " + std::to_string(id));
+  s.BindText(1, consumer);
+  s.BindInt(2, id);
+  s.Run();
+}
+
+std::int64_t Store::OutboxCursor(const std::string& consumer) {
+  Statement s(db_, path_, "SELECT last_id FROM outbox_cursors WHERE consumer = ?1",
+              "read the outbox cursor of '" + consumer + "'");
+  s.BindText(1, consumer);
+  return s.Step() ? s.Int(0) : 0;
+}
+
+std::int64_t Store::OutboxPending(const std::string& consumer) {
+  Statement s(db_, path_,
+              "SELECT count(*) FROM outbox WHERE id > "
+              "coalesce((SELECT last_id FROM outbox_cursors WHERE consumer = ?1), 0)",
+              "count the outbox of '" + consumer + "'");
+  s.BindText(1, consumer);
+  return s.Step() ? s.Int(0) : 0;
 }
 
 }  // namespace eol::db

@@ -9,6 +9,9 @@
 // - FinishTest() writes the whole record in one transaction and returns only once it is
 //   committed durably: the verdict may be published after it returns, never before.
 // - Retests: a test of a serial that already has tests links to the first one (retest_of).
+// - Outbox (schema v5): every finished record, and every test recovered as ABORTED, gets an
+//   outbox row in the same transaction; publishers read the rows after their own cursor, in
+//   order, and advance it only once delivered: an outage of any length loses nothing.
 // - All SQL is parameterised. Errors throw StoreError naming the file and the operation.
 // Not thread-safe: one Store per thread (SQLite connections are cheap).
 #pragma once
@@ -18,6 +21,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "db/test_record.h"
@@ -36,6 +40,10 @@ struct TestQuery {
   std::optional<std::string> to;    // ISO 8601, exclusive
   std::optional<analysis::Outcome> outcome;
   std::optional<std::string> serial;
+  std::optional<std::string> order_number;  // schema v4
+  // Keyset paging in the result's order (started_at DESC, id DESC): only tests after this
+  // (started_at, id) in that order; give the last test of the previous page.
+  std::optional<std::pair<std::string, std::int64_t>> after;
   int limit = 100;
   bool with_curves = false;
 };
@@ -89,14 +97,27 @@ struct MeasurementRow {
   std::optional<double> hi;
 };
 
+// One row of the outbox: the record of test `test_id`, to be delivered in `id` order.
+struct OutboxEntry {
+  std::int64_t id = 0;
+  std::int64_t test_id = 0;
+  std::string created_at;  // ISO 8601 UTC, when the record was stored
+};
+
 class Store {
  public:
-  static constexpr int kSchemaVersion = 3;
+  static constexpr int kSchemaVersion = 5;
 
-  // kWriter: the station's one connection; recovers unfinished tests as ABORTED.
+  // kWriter: the station's one connection; recovers unfinished tests as ABORTED. It holds an
+  // exclusive flock on "<path>.lock" (created 0600 beside the file) for as long as it is open:
+  // a second writer, e.g. a second `eol station` on the same database, gets a StoreError
+  // before it can recover (abort) the first one's running test.
   // kReader: further connections (the HTTP API, queries, exports) that must never touch a
   // test another connection is running; they migrate a new file but recover nothing.
-  enum class Role { kWriter, kReader };
+  // kReadOnly: a reader that never writes (queries, exports, stats): it opens an existing
+  // store read-only, so it works on a file it may not write (a copy, a read-only share) and
+  // never creates or migrates one; a missing file or another schema version is a StoreError.
+  enum class Role { kWriter, kReader, kReadOnly };
 
   static std::unique_ptr<Store> Open(const std::string& path, Role role = Role::kWriter);
   ~Store();
@@ -137,6 +158,15 @@ class Store {
   // (started_at, id), at most 1,000,000 rows.
   std::vector<MeasurementRow> MeasurementRows(const MeasurementQuery& query);
 
+  // The outbox rows after `consumer`'s cursor, oldest first, at most `limit` (1..10000).
+  std::vector<OutboxEntry> OutboxAfterCursor(const std::string& consumer, int limit);
+  // Moves `consumer`'s cursor to `id` (the row just delivered); a cursor never moves back.
+  void AdvanceOutboxCursor(const std::string& consumer, std::int64_t id);
+  // The id of the newest row `consumer` has delivered (0: none).
+  std::int64_t OutboxCursor(const std::string& consumer);
+  // Rows after `consumer`'s cursor.
+  std::int64_t OutboxPending(const std::string& consumer);
+
   // SQLite's own consistency check: "ok" or the first problem it finds.
   std::string IntegrityCheck();
   // Rows still RUNNING (a test in flight, or left by a crash not yet recovered).
@@ -147,6 +177,7 @@ class Store {
   std::string path_;
   sqlite3* db_ = nullptr;
   int aborted_on_open_ = 0;
+  int lock_fd_ = -1;  // kWriter: "<path>.lock", flock'ed exclusively while the store is open
 };
 
 }  // namespace eol::db

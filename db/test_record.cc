@@ -82,8 +82,12 @@ void to_json(nlohmann::json& j, const TestRecord& r) {
        {"fit", r.fit},
        {"curves", r.curves},
        {"trace", r.trace},
+       {"cycle_s", r.cycle_s},
        {"kind", r.kind},
-       {"self_check", r.self_check}};
+       {"self_check", r.self_check},
+       {"operator_id", r.work.operator_id},
+       {"shift", r.work.shift},
+       {"order_number", r.work.order_number}};
 }
 
 void from_json(const nlohmann::json& j, TestRecord& r) {
@@ -108,8 +112,12 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   r.fit = j.value("fit", nlohmann::json::object());
   r.curves = j.value("curves", std::vector<Curve>{});
   r.trace = j.value("trace", std::vector<StateEntry>{});
+  r.cycle_s = j.value("cycle_s", std::map<std::string, double>{});
   r.kind = j.value("kind", RecordKind::kProduction);
   r.self_check = j.value("self_check", nlohmann::json::object());
+  r.work.operator_id = j.value("operator_id", "");
+  r.work.shift = j.value("shift", "");
+  r.work.order_number = j.value("order_number", "");
 }
 
 }  // namespace eol::db

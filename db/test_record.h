@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -45,6 +46,17 @@ struct StateEntry {
   std::string detail;
 };
 
+// Who tested the unit and for which order (schema v4), as given with the serial over HTTP,
+// by the line PLC or the scanner (station/test_request.h says what is accepted). Each is
+// empty when not given. In the record's JSON they are the top-level keys "operator_id",
+// "shift" and "order_number".
+struct WorkContext {
+  std::string operator_id;   // the operator's badge or login
+  std::string shift;         // the plant's shift name ("A", "night", ...)
+  std::string order_number;  // production order or batch
+  bool operator==(const WorkContext&) const = default;
+};
+
 struct TestRecord {
   std::int64_t id = 0;  // assigned by the store
   std::string serial;
@@ -71,11 +83,17 @@ struct TestRecord {
   nlohmann::json fit = nlohmann::json::object();  // the fit summary
   std::vector<Curve> curves;
   std::vector<StateEntry> trace;
+  // Where the test's time went, seconds per step (station/cycle_time.h: "interlocks",
+  // "clamp", "excitation", "analysis", ..., and "total"), summed from the trace. The stored
+  // record has the steps up to the store (its own store and publish cannot be in it); the
+  // record RunTest returns has them all, "total" being serial received -> verdict published.
+  std::map<std::string, double> cycle_s;
 
   RecordKind kind = RecordKind::kProduction;
   // For a self-check: {"master": "good" | "limit", "passed": bool, "detail": "..."}; the store
   // writes it to the self_checks table in the test's own transaction. Empty otherwise.
   nlohmann::json self_check = nlohmann::json::object();
+  WorkContext work;  // schema v4
 };
 
 void to_json(nlohmann::json& j, const Curve& c);

@@ -8,12 +8,13 @@ build_pkgs=(
   g++ cmake ninja-build pkg-config git
   libeigen3-dev libfftw3-dev libmodbus-dev libsqlite3-dev libspdlog-dev nlohmann-json3-dev
   libcpp-httplib-dev libcli11-dev libgtest-dev libssl-dev zlib1g-dev libasound2-dev
-  libsndfile1-dev libsystemd-dev
+  libsndfile1-dev libsystemd-dev prometheus-cpp-dev libcairo2-dev libmosquitto-dev libpq-dev
 )
 test_pkgs=(
   python3 python3-numpy python3-scipy python3-pymodbus python3-serial-asyncio python3-can
-  can-utils socat sqlite3
-  chromium dpkg-dev pulseaudio libasound2-plugins clang-format
+  can-utils socat sqlite3 mosquitto python3-paho-mqtt postgresql-15 openssl
+  chromium dpkg-dev pulseaudio libasound2-plugins clang-format systemd
+  clang-14 libclang-rt-14-dev
 )
 
 pkgs=("${build_pkgs[@]}")

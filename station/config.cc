@@ -1,12 +1,25 @@
 #include "station/config.h"
 
+#include <arpa/inet.h>
+
 #include <filesystem>
+#include <fstream>
 
 #include "drivers/io/json_config.h"
+#include "station/plant_urls.h"
 #include "station/serial_number.h"
 
 namespace eol::station {
 namespace {
+
+// 127.0.0.0/8, ::1 and "localhost": addresses only this host can reach.
+bool IsLoopback(const std::string& host) {
+  if (host == "localhost") return true;
+  in_addr v4{};
+  if (inet_pton(AF_INET, host.c_str(), &v4) == 1) return (ntohl(v4.s_addr) >> 24) == 127;
+  in6_addr v6{};
+  return inet_pton(AF_INET6, host.c_str(), &v6) == 1 && IN6_IS_ADDR_LOOPBACK(&v6);
+}
 
 std::string Resolve(const std::string& base_dir, const std::string& p) {
   if (p.empty() || std::filesystem::path(p).is_absolute() || base_dir.empty()) return p;
@@ -29,6 +42,17 @@ std::optional<Role> ParseRole(std::string_view text) {
   for (Role r : {Role::kOperator, Role::kEngineer})
     if (text == ToString(r)) return r;
   return std::nullopt;
+}
+
+std::string SimulationReason(const StationConfig& config) {
+  std::string why;
+  for (const char* part : {"fixture", "daq"}) {
+    if (!config.drivers.contains(part) || !config.drivers.at(part).is_object()) continue;
+    const std::string driver = config.drivers.at(part).value("driver", "");
+    if (driver == "sim" || driver == "replay")
+      why += (why.empty() ? "" : ", ") + std::string(part) + " driver '" + driver + "'";
+  }
+  return why;
 }
 
 StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,
@@ -63,18 +87,26 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
         }
       }
       http->RejectUnknown();
+      // Without tokens anyone who reaches the port may start tests: only this host may.
+      if (c.tokens.empty() && !IsLoopback(c.http_listen))
+        throw io::ConfigError(http->PathOf("listen") + ": \"" + c.http_listen +
+                              "\" listens beyond this host, which needs \"tokens\" (none are "
+                              "configured); listen on 127.0.0.1 or configure tokens");
     }
     if (auto s = root.OptionalObject("safety")) {
       c.safety.watchdog_period_ms = s->Number("watchdog_period_ms", c.safety.watchdog_period_ms);
       c.safety.heartbeat_timeout_ms =
           s->Number("heartbeat_timeout_ms", c.safety.heartbeat_timeout_ms);
       c.safety.poll_period_ms = s->Number("poll_period_ms", c.safety.poll_period_ms);
+      c.safety.safe_state_retry_s = s->Number("safe_state_retry_s", c.safety.safe_state_retry_s);
       s->Require(c.safety.watchdog_period_ms >= 1 && c.safety.watchdog_period_ms <= 50,
                  "watchdog_period_ms", "must be in [1, 50] ms (the reaction target is 50 ms)");
       s->Require(c.safety.heartbeat_timeout_ms >= 600, "heartbeat_timeout_ms",
                  "must be at least 600 ms (the heartbeat increments every 500 ms)");
       s->Require(c.safety.poll_period_ms >= 1 && c.safety.poll_period_ms <= 500, "poll_period_ms",
                  "must be in [1, 500] ms");
+      s->Require(c.safety.safe_state_retry_s >= 0 && c.safety.safe_state_retry_s <= 60,
+                 "safe_state_retry_s", "must be in [0, 60] s");
       s->RejectUnknown();
     }
     c.serial_from_stdin = root.Bool("serial_from_stdin", false);
@@ -108,6 +140,87 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
           if (f.is_string()) f = Resolve(base_dir, f.get<std::string>());
     }
     if (root.Has("sim")) c.drivers["sim"] = root.Raw("sim");
+    // Plant integration (issue 15).
+    if (auto p = root.OptionalObject("plc")) {
+      plc::PlcServerSettings s;
+      s.listen = p->String("listen", s.listen);
+      s.port = p->Integer("port", s.port);
+      s.unit_id = p->Integer("unit_id", s.unit_id);
+      s.max_clients = p->Integer("max_clients", s.max_clients);
+      p->Require(s.port >= 0 && s.port <= 65535, "port", "must be in [0, 65535]");
+      p->Require(s.unit_id >= 1 && s.unit_id <= 247, "unit_id", "must be in [1, 247]");
+      p->Require(s.max_clients >= 1 && s.max_clients <= 64, "max_clients", "must be in [1, 64]");
+      if (p->Has("map")) s.map = plc::ParsePlcMap(p->Raw("map"), p->PathOf("map"));
+      p->RejectUnknown();
+      c.plc = s;
+    }
+    if (auto m = root.OptionalObject("mqtt")) {
+      MqttConfig q;
+      std::string why;
+      bool tls = false;
+      m->Require(ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &tls, &why), "url", why);
+      q.topic_prefix = m->String("topic_prefix", q.topic_prefix);
+      m->Require(!q.topic_prefix.empty() &&
+                     q.topic_prefix.find_first_of("#+") == std::string::npos &&
+                     q.topic_prefix.back() != '/',
+                 "topic_prefix", "must be a topic without wildcards or a trailing '/'");
+      q.client_id = m->String("client_id", q.client_id);
+      q.username = m->String("username", q.username);
+      q.password = m->String("password", q.password);
+      q.keepalive_s = m->Integer("keepalive_s", q.keepalive_s);
+      q.reconnect_s = m->Number("reconnect_s", q.reconnect_s);
+      m->Require(q.keepalive_s >= 5 && q.keepalive_s <= 3600, "keepalive_s",
+                 "must be in [5, 3600] s");
+      m->Require(q.reconnect_s >= 0.05 && q.reconnect_s <= 600, "reconnect_s",
+                 "must be in [0.05, 600] s");
+      if (auto t = m->OptionalObject("tls")) {
+        m->Require(tls, "tls", "needs an mqtts:// url (this one is plain mqtt://)");
+        MqttTls s;
+        // Each named file must be readable now: a typo is a config error, not an outage.
+        const auto file = [&](const std::string& key) {
+          const std::string path = Resolve(base_dir, t->String(key, ""));
+          if (path.empty()) return path;
+          std::ifstream probe(path);
+          t->Require(probe.good(), key, "cannot read the file " + path);
+          return path;
+        };
+        s.ca_file = file("ca_file");
+        s.cert_file = file("cert_file");
+        s.key_file = file("key_file");
+        s.insecure = t->Bool("insecure", s.insecure);
+        t->Require(s.cert_file.empty() == s.key_file.empty(),
+                   s.cert_file.empty() ? "cert_file" : "key_file",
+                   "cert_file and key_file go together (a client certificate and its key)");
+        t->RejectUnknown();
+        q.tls = s;
+      } else if (tls) {
+        q.tls = MqttTls{};  // the system's CAs, host name checked
+      }
+      m->RejectUnknown();
+      c.mqtt = q;
+    }
+    if (auto p = root.OptionalObject("central")) {
+      central::CentralConfig q;
+      q.postgres = p->RequiredString("postgres");
+      // Not Require: its "(got ...)" would print the password.
+      if (q.postgres.rfind("postgresql://", 0) != 0 && q.postgres.rfind("postgres://", 0) != 0)
+        throw io::ConfigError(p->PathOf("postgres") +
+                              ": must be a URI postgresql://user@host:port/db (got '" +
+                              central::RedactUrl(q.postgres) + "')");
+      q.batch = p->Integer("batch", q.batch);
+      q.retry_min_s = p->Number("retry_min_s", q.retry_min_s);
+      q.retry_max_s = p->Number("retry_max_s", q.retry_max_s);
+      q.connect_timeout_s = p->Integer("connect_timeout_s", q.connect_timeout_s);
+      p->Require(q.batch >= 1 && q.batch <= 10000, "batch", "must be in [1, 10000]");
+      p->Require(q.retry_min_s >= 0.01 && q.retry_min_s <= 3600, "retry_min_s",
+                 "must be in [0.01, 3600] s");
+      p->Require(q.retry_max_s >= q.retry_min_s && q.retry_max_s <= 3600, "retry_max_s",
+                 "must be in [retry_min_s, 3600] s");
+      p->Require(q.connect_timeout_s >= 1 && q.connect_timeout_s <= 600, "connect_timeout_s",
+                 "must be in [1, 600] s");
+      p->RejectUnknown();
+      c.central = q;
+    }
     root.RejectUnknown();
     return c;
   } catch (const io::ConfigError& e) {

@@ -8,14 +8,32 @@
 //            "tokens": [{"name": "line1-operator", "role": "operator", "token": "..."},
 //                       {"name": "qe-anna", "role": "engineer", "token": "..."}]},
 //     Reads need no token. With tokens configured, starting a test needs an operator or
-//     engineer token; changing the recipe always needs an engineer token.
+//     engineer token; changing the recipe always needs an engineer token. Listening beyond
+//     loopback (anything but 127.0.0.0/8, ::1, localhost) needs tokens: refused otherwise.
 //   "fixture": {"driver": "sim" | ...},              see drivers/factory/factory.h
 //   "daq": {"driver": "sim" | ...},
 //   "sim": {...},                                    the simulated bench, when a driver is sim
-//   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500},
+//   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500, "poll_period_ms": 10,
+//              "safe_state_retry_s": 3},
 //   "serial_from_stdin": false,                      a scanner typing serials into stdin
+//                                                    (its line format: station/test_request.h)
 //   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
 //                  "every_n_tests": 50, "every_hours": 8}       optional, station/self_check.h
+//   "plc": {"listen": "0.0.0.0", "port": 502, "unit_id": 1, "max_clients": 8,
+//           "map": {"serial": 100, ...}}         optional: the line PLC's handshake, served
+//                                                when the block is there (station/plc/)
+//   "mqtt": {"url": "mqtt://host:1883" | "mqtts://host:8883", "topic_prefix": "plant/eol",
+//            "client_id": "", "username": "", "password": "", "keepalive_s": 30,
+//            "reconnect_s": 1,
+//            "tls": {"ca_file": "ca.crt", "cert_file": "", "key_file": "", "insecure": false}}
+//                                                optional: results and status to the MES
+//                                                (station/mqtt_publisher.h); "tls" only with
+//                                                mqtts:// (without it: the system's CAs);
+//                                                each named file must be readable
+//   "central": {"postgres": "postgresql://eol@db.plant:5432/plant", "batch": 200,
+//               "retry_min_s": 0.5, "retry_max_s": 30, "connect_timeout_s": 5}
+//                                                optional: every stored record into the
+//                                                plant's PostgreSQL (station/central/)
 // }
 #pragma once
 
@@ -25,12 +43,17 @@
 #include <string_view>
 #include <vector>
 
+#include "station/central/central_replicator.h"
+#include "station/mqtt_publisher.h"
+#include "station/plc/plc_server.h"
+
 namespace eol::station {
 
 struct SafetyOptions {
   double watchdog_period_ms = 5.0;     // interlock poll period during excitation
   double heartbeat_timeout_ms = 1500;  // controller heartbeat must change within this
   double poll_period_ms = 10.0;        // clamp/release confirmation polling
+  double safe_state_retry_s = 3.0;     // on a fault, excitation off and unclamp retried this long
 };
 
 // What a token may do. Operators start tests; engineers also change and teach recipes.
@@ -69,7 +92,18 @@ struct StationConfig {
   bool serial_from_stdin = false;
   SelfCheckConfig self_check;
   nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}
+  // Plant integration (issue 15): the line PLC's handshake; nullopt without a "plc" block.
+  std::optional<plc::PlcServerSettings> plc;
+  // Plant integration: results to the MES over MQTT; nullopt without an "mqtt" block.
+  std::optional<MqttConfig> mqtt;
+  // Plant integration: the central PostgreSQL record; nullopt without a "central" block.
+  std::optional<central::CentralConfig> central;
 };
+
+// Non-empty when the station runs on simulators or recorded data rather than a real fixture
+// and DAQ ("fixture driver 'sim'", "daq driver 'replay'"): its records are no production
+// results, and the page and every record say SIMULATION.
+std::string SimulationReason(const StationConfig& config);
 
 // Throws io::ConfigError naming the file and the JSON path.
 StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& source,

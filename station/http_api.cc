@@ -1,12 +1,15 @@
 #include "station/http_api.h"
 
-#include <httplib.h>
 #include <spdlog/spdlog.h>
 
 #include "db/store.h"
 #include "station/http/context.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
+
+// After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
+#include "station/http/gate.h"
+#include "station/http/server.h"
 
 namespace eol::station {
 
@@ -19,10 +22,9 @@ HttpApi::~HttpApi() { Stop(); }
 void HttpApi::Start() {
   const HttpOptions& o = context_->options;
   context_->db = db::Store::Open(o.db_path, db::Store::Role::kReader);
-  server_ = std::make_unique<httplib::Server>();
+  server_ = std::make_unique<http::ApiServer>(o.limits);
   server_->set_payload_max_length(http::kMaxBodyBytes);
-  server_->set_read_timeout(5, 0);
-  server_->set_write_timeout(5, 0);
+  http::InstallGate(*server_, *context_);
   http::AddBoardRoutes(*server_, *context_);
   http::AddRecipeRoutes(*server_, *context_);
   http::AddTestRoutes(*server_, *context_);
@@ -39,14 +41,11 @@ void HttpApi::Start() {
         spdlog::error("http: {} {}: {}", req.method, req.path, what);
         http::Send(res, http::ApiError{http::ApiErrorKind::kInternal, "internal", what});
       });
-  if (o.port == 0) {
-    port_ = server_->bind_to_any_port(o.listen.c_str());
-  } else {
-    port_ = server_->bind_to_port(o.listen.c_str(), o.port) ? o.port : -1;
-  }
+  std::string why;
+  port_ = server_->Bind(o.listen, o.port, &why);
   if (port_ <= 0)
     throw std::runtime_error("http: cannot listen on " + o.listen + ":" + std::to_string(o.port) +
-                             " (address in use or not local)");
+                             ": " + why);
   thread_ = std::thread([this] { server_->listen_after_bind(); });
   spdlog::info("http: serving on http://{}:{}/", o.listen, port_);
 }

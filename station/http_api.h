@@ -4,13 +4,23 @@
 //   GET  /api/events            server-sent events: state changes and verdicts
 //   GET  /api/units/{serial}    every test of that serial, newest first (no curves)
 //   GET  /api/tests/{id}        one test with its curves
-//   GET  /api/tests?from=&to=&verdict=&serial=&limit=   tests in a time range
-//   POST /api/tests             {"serial": "..."} starts a test (bearer token when configured)
+//   GET  /api/tests?from=&to=&outcome=&serial=&limit=   tests in a time range ("verdict=",
+//                               the older name of outcome=, is still accepted)
+//   POST /api/tests             {"serial": "...", "operator_id", "shift", "order_number"}
+//                               starts a test (bearer token when configured; the three
+//                               optional fields as station/test_request.h accepts them)
 //   PUT  /api/recipe            a new version of the recipe (engineer token; audited)
 //   GET  /api/recipe/audit      who changed the recipe, when, old and new hash
-//   GET  /api/recipe            the recipe in use with its hash (limits and masks)
-//   GET  /api/stats?from=&to=&recipe_hash=&gauge=&reference=NAME=VALUE&sigma_span=
-//                               capability, drift alarms, gauge study (station/stats_report.h)
+//   POST /api/recipe/approve    approve a taught proposal and install it (engineer; audited)
+//   GET  /api/recipe            the recipe in use with its hash (limits and masks) and its
+//                               operator "instructions" with their defaults written out
+//   GET  /api/stats?from=&to=&recipe_hash=&population=&subgroup=&gauge=&reference=NAME=VALUE
+//        &sigma_span=           capability (Cp/Cpk within, Pp/Ppk overall), run-rule and drift
+//                               alarms, gauge study (station/stats_report.h)
+//   GET  /api/charts/<measurement>.svg?chart=imr|xbar_r|histogram&from=&to=&last=&subgroup=
+//        &population=pass|all&recipe_hash=
+//                               a control chart or histogram as image/svg+xml
+//                               (station/spc_charts.h); 404 "unknown_measurement", "no_units"
 //   GET  /api/detectability?k_fixture=&limit_sigmas=&required_sigmas=
 //                               where each defect class shows with this recipe and fixture
 //                               (station/qc_service.h; k_fixture from the gap diagnosis)
@@ -37,19 +47,18 @@
 #include <vector>
 
 #include "station/config.h"
+#include "station/http/limits.h"
 #include "station/recipe.h"
 #include "station/recipe_change.h"
 #include "station/status_board.h"
-
-namespace httplib {
-class Server;
-}
+#include "station/test_request.h"
 
 namespace eol::station {
 
 namespace http {
 struct ApiContext;
-}
+class ApiServer;
+}  // namespace http
 
 struct HttpOptions {
   std::string listen = "127.0.0.1";
@@ -58,18 +67,24 @@ struct HttpOptions {
   // Empty: starting tests needs no token. Recipe changes always need an engineer token.
   std::vector<ApiToken> tokens;
   std::string web_root;  // folder of the operator page; empty: built-in fallback page
+  // The central record's URI (station/central/): GET /api/units/{serial}?scope=plant reads
+  // it; empty: that scope answers 400.
+  std::string central_postgres;
+  http::ServerLimits limits;  // workers, streams, deadlines (station/http/server.h)
 };
 
 // What the API asks of the station.
 struct HttpHandlers {
-  // Queues a test for `serial`; false with the reason when refused (busy, stopping).
-  std::function<bool(const std::string& serial, std::string* why)> start_test;
+  // Queues a test; false with the reason when refused (busy, stopping).
+  std::function<bool(const TestRequest& request, std::string* why)> start_test;
   // The recipe in use as JSON, with its "hash".
   std::function<nlohmann::json()> recipe;
   // The recipe in use, parsed (teaching and detectability work from it).
   std::function<std::shared_ptr<const Recipe>()> current_recipe;
   // Validates, stores and activates a new recipe version (Station::ChangeRecipe).
   std::function<RecipeChange(const nlohmann::json& recipe, const ApiToken& who)> change_recipe;
+  // GET /metrics: the Prometheus exposition text (station/station_metrics.h).
+  std::function<std::string()> metrics;
 };
 
 class HttpApi {
@@ -86,7 +101,7 @@ class HttpApi {
 
  private:
   std::unique_ptr<http::ApiContext> context_;
-  std::unique_ptr<httplib::Server> server_;
+  std::unique_ptr<http::ApiServer> server_;
   std::thread thread_;
   int port_ = 0;
 };

@@ -1,5 +1,6 @@
 #include "station/qc_service.h"
 
+#include "db/clock.h"
 #include "station/serial_number.h"
 
 namespace eol::station {
@@ -30,16 +31,14 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
     note += " FORCED: " + std::to_string(s.units_used) + " golden units where " +
             std::to_string(s.units_needed) + " are needed.";
   taught.description += note;
+  // A proposal until an engineer approves it (recipe.h, RecipeApproval).
+  taught.approval = RecipeApproval{"proposed", "eol teach", db::UtcNowIso8601(), ""};
   return RecipeToJson(taught);
 }
 
 json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOptions& o) {
   json limits = json::array(), stats = json::array(), masks = json::array();
-  for (const auto& l : s.limits)
-    limits.push_back({{"name", l.name},
-                      {"lo", l.limit.lo ? json(*l.limit.lo) : json(nullptr)},
-                      {"hi", l.limit.hi ? json(*l.limit.hi) : json(nullptr)},
-                      {"marginal", l.limit.marginal}});
+  for (const auto& l : s.limits) limits.push_back(LimitJson(l));
   for (const auto& t : s.statistics)
     stats.push_back({{"name", t.name}, {"centre", t.centre}, {"scale", t.scale}});
   for (const auto& m : s.masks) masks.push_back(MaskJson(m));

@@ -4,13 +4,18 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <tuple>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/text.h"
 #include "drivers/io/json_config.h"
 
 namespace eol::station {
 namespace {
 
+using analysis::Fixed;
 using io::ConfigError;
 using io::JsonObject;
 
@@ -43,8 +48,27 @@ void ParseExcitation(const JsonObject& e, Recipe& r) {
   e.Require(r.excitation.sample_rate_hz >= 2.5 * r.excitation.f_hi_hz, "sample_rate_hz",
             "must be at least 2.5 x f_hi_hz (anti-alias margin)");
   e.Require(r.excitation.peak_v > 0 && r.excitation.peak_v <= 50, "peak_v", "must be in (0, 50] V");
+  // Resource bounds: a recipe must not be able to exhaust the station's memory or time.
+  e.Require(r.excitation.sample_rate_hz <= kMaxSampleRateHz, "sample_rate_hz",
+            "must be at most " + Fixed(kMaxSampleRateHz, 0) + " Hz (the fastest supported DAQ)");
+  e.Require(r.excitation.line_spacing_hz >= kMinLineSpacingHz, "line_spacing_hz",
+            "must be at least " + Fixed(kMinLineSpacingHz, 2) + " Hz (a period of at most " +
+                Fixed(1.0 / kMinLineSpacingHz, 0) + " s)");
+  e.Require(r.excitation.sample_rate_hz / r.excitation.line_spacing_hz <= kMaxPeriodSamples,
+            "sample_rate_hz",
+            "gives more than " + std::to_string(static_cast<long>(kMaxPeriodSamples)) +
+                " samples per period (sample_rate_hz / line_spacing_hz)");
+  e.Require(
+      r.excitation.crest_iterations >= 0 && r.excitation.crest_iterations <= kMaxCrestIterations,
+      "crest_iterations", "must be in [0, " + std::to_string(kMaxCrestIterations) + "]");
   e.Require(periods >= 2 && periods <= 1000, "periods", "must be in [2, 1000]");
   e.Require(transient >= 0 && transient <= 100, "transient_periods", "must be in [0, 100]");
+  const double excitation_s =
+      static_cast<double>(periods + transient) / r.excitation.line_spacing_hz;
+  e.Require(excitation_s <= kMaxExcitationS, "periods",
+            "(periods + transient_periods) / line_spacing_hz is " + Fixed(excitation_s, 1) +
+                " s of excitation per phase pair; at most " + Fixed(kMaxExcitationS, 0) +
+                " s are allowed");
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     e.Require(pairs[i] >= 0 && pairs[i] <= 2, e.Has("phase_pairs") ? "phase_pairs" : "phase_pair",
               "must be 0 (U-V), 1 (V-W) or 2 (W-U)");
@@ -69,6 +93,15 @@ void ParseFixture(const JsonObject& f, Recipe& r) {
   p.Require(r.clamp_pressure_lo_bar > 0, "lo", "must be positive");
   p.Require(r.clamp_pressure_hi_bar > r.clamp_pressure_lo_bar, "hi",
             "must be greater than " + p.PathOf("lo"));
+  // The window is a safety interlock: one so wide that any pressure passes checks nothing.
+  p.Require(r.clamp_pressure_lo_bar >= kMinClampPressureBar, "lo",
+            "must be at least " + Fixed(kMinClampPressureBar, 1) +
+                " bar (a clamp below it does not hold the shaft)");
+  p.Require(r.clamp_pressure_hi_bar <= kMaxClampPressureBar, "hi",
+            "must be at most " + Fixed(kMaxClampPressureBar, 0) + " bar");
+  p.Require(r.clamp_pressure_hi_bar <= kMaxClampPressureRatio * r.clamp_pressure_lo_bar, "hi",
+            "must be at most " + Fixed(kMaxClampPressureRatio, 0) + " x " + p.PathOf("lo") +
+                " (a wider window does not check the clamp)");
   p.RejectUnknown();
   r.clamp_timeout_s = f.Number("clamp_timeout_s", r.clamp_timeout_s);
   r.release_timeout_s = f.Number("release_timeout_s", r.release_timeout_s);
@@ -92,6 +125,10 @@ void ParseAnalysis(const JsonObject& a, Recipe& r) {
   a.Require(fit.q_min > 0 && fit.q_max > fit.q_min, "q_max", "must be above q_min > 0");
   std::string why;
   a.Require(fit.IsValid(&why), "f0_min_hz", why);
+  const std::string method =
+      a.String("frf_method", analysis::ToString(analysis::FrfMethod::kDiscardTransient));
+  a.Require(analysis::ParseFrfMethod(method, &r.analysis.frf_method), "frf_method",
+            "must be \"discard_transient\" or \"transient_lpm\"");
   a.RejectUnknown();
 }
 
@@ -124,6 +161,8 @@ void ParseLimits(const nlohmann::json& limits, const std::string& path, Recipe& 
 
 void ParseMasks(const nlohmann::json& masks, const std::string& path, Recipe& r) {
   if (!masks.is_array()) throw ConfigError(path + ": must be an array of masks");
+  if (masks.size() > kMaxMasks)
+    throw ConfigError(path + ": must hold at most " + std::to_string(kMaxMasks) + " masks");
   for (std::size_t i = 0; i < masks.size(); ++i) {
     const JsonObject m(masks[i], path + "/" + std::to_string(i));
     analysis::CurveMask mask;
@@ -142,6 +181,8 @@ void ParseMasks(const nlohmann::json& masks, const std::string& path, Recipe& r)
     mask.guard_sigma = m.Number("guard_sigma", 0.0);
     const nlohmann::json& pts = m.Raw("points");
     if (!pts.is_array()) throw ConfigError(m.PathOf("points") + ": must be an array of points");
+    m.Require(pts.size() <= kMaxMaskPoints, "points",
+              "must hold at most " + std::to_string(kMaxMaskPoints) + " points");
     for (std::size_t k = 0; k < pts.size(); ++k) {
       const JsonObject p(pts[k], m.PathOf("points") + "/" + std::to_string(k));
       analysis::MaskPoint point;
@@ -191,6 +232,37 @@ void ParseConditions(const JsonObject& c, Recipe& r) {
             "is estimated from R itself, see station/conditions.h)");
   w.error_when_out = policy == "error";
   c.RejectUnknown();
+}
+
+void ParseApproval(const JsonObject& o, Recipe& r) {
+  RecipeApproval a;
+  a.state = o.String("state", "");
+  o.Require(a.state == "proposed" || a.state == "approved", "state",
+            "must be \"proposed\" or \"approved\"");
+  for (auto [key, field, required] : {std::tuple{"by", &a.by, true}, std::tuple{"at", &a.at, true},
+                                      std::tuple{"note", &a.note, false}}) {
+    *field = o.String(key, "");
+    if (!required && field->empty() && !o.Has(key)) continue;
+    o.Require(!field->empty() && field->size() <= kMaxInstructionBytes, key,
+              "must be 1 to " + std::to_string(kMaxInstructionBytes) + " bytes of text");
+  }
+  o.RejectUnknown();
+  r.approval = a;
+}
+
+void ParseInstructions(const JsonObject& o, Recipe& r) {
+  for (auto [key, text] :
+       {std::pair{"fail", &r.instructions.fail}, std::pair{"error", &r.instructions.error},
+        std::pair{"aborted", &r.instructions.aborted}}) {
+    *text = o.String(key, *text);
+    const bool control = std::any_of(text->begin(), text->end(), [](char ch) {
+      return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7F;
+    });
+    o.Require(!text->empty() && text->size() <= kMaxInstructionBytes && !control, key,
+              "must be 1 to " + std::to_string(kMaxInstructionBytes) +
+                  " bytes of text without control characters");
+  }
+  o.RejectUnknown();
 }
 
 }  // namespace
@@ -249,6 +321,8 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
     ParseLimits(root.Raw("limits"), "/limits", r);
     if (root.Has("masks")) ParseMasks(root.Raw("masks"), "/masks", r);
     if (auto c = root.OptionalObject("conditions")) ParseConditions(*c, r);
+    if (auto i = root.OptionalObject("instructions")) ParseInstructions(*i, r);
+    if (auto a = root.OptionalObject("approval")) ParseApproval(*a, r);
     root.RejectUnknown();
     r.source = j;
     r.hash = CanonicalHash(j);
@@ -260,19 +334,31 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
 
 Recipe LoadRecipe(const std::string& path) { return ParseRecipe(io::ReadJsonFile(path), path); }
 
+void WriteRecipeFile(const std::string& path, const nlohmann::json& j) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error(tmp + ": cannot be written");
+    out << j.dump(2) << "\n";
+    out.flush();
+    if (!out) throw std::runtime_error(tmp + ": writing failed");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+std::string Recipe::WhyNotApproved() const {
+  if (Approved()) return "";
+  return "recipe " + id + " v" + std::to_string(version) + " is a proposal (" + approval->by +
+         ", " + approval->at +
+         "): an engineer approves it first (POST /api/recipe/approve or eol recipe-approve)";
+}
+
 // The emitting half of the field list above: every key ParseRecipe reads, in its schema.
 namespace {
 
 void PutWindow(nlohmann::json& j, const analysis::Limit& l) {
   if (l.lo) j["lo"] = *l.lo;
   if (l.hi) j["hi"] = *l.hi;
-}
-
-nlohmann::json LimitJson(const analysis::MeasurementSpec& s) {
-  nlohmann::json j = {{"name", s.name}, {"unit", s.unit}, {"doc", s.doc}};
-  PutWindow(j, s.limit);
-  j["marginal"] = s.limit.marginal;
-  return j;
 }
 
 nlohmann::json ConditionsJson(const ConditionWindows& w) {
@@ -294,6 +380,17 @@ nlohmann::json ConditionsJson(const ConditionWindows& w) {
 }
 
 }  // namespace
+
+nlohmann::json InstructionsJson(const OperatorInstructions& i) {
+  return {{"fail", i.fail}, {"error", i.error}, {"aborted", i.aborted}};
+}
+
+nlohmann::json LimitJson(const analysis::MeasurementSpec& s) {
+  nlohmann::json j = {{"name", s.name}, {"unit", s.unit}, {"doc", s.doc}};
+  PutWindow(j, s.limit);
+  j["marginal"] = s.limit.marginal;
+  return j;
+}
 
 nlohmann::json MaskJson(const analysis::CurveMask& m) {
   nlohmann::json points = nlohmann::json::array();
@@ -340,11 +437,17 @@ nlohmann::json RecipeToJson(const Recipe& r) {
        {{"f0_min_hz", r.analysis.fit.f0_min_hz},
         {"f0_max_hz", r.analysis.fit.f0_max_hz},
         {"q_min", r.analysis.fit.q_min},
-        {"q_max", r.analysis.fit.q_max}}},
+        {"q_max", r.analysis.fit.q_max},
+        {"frf_method", analysis::ToString(r.analysis.frf_method)}}},
       {"retest", {{"max_tests_per_serial", r.max_tests_per_serial}}},
       {"limits", limits},
-      {"masks", masks}};
+      {"masks", masks},
+      {"instructions", InstructionsJson(r.instructions)}};
   if (r.conditions.enabled) j["conditions"] = ConditionsJson(r.conditions);
+  if (r.approval) {
+    j["approval"] = {{"state", r.approval->state}, {"by", r.approval->by}, {"at", r.approval->at}};
+    if (!r.approval->note.empty()) j["approval"]["note"] = r.approval->note;
+  }
   return j;
 }
 

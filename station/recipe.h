@@ -8,7 +8,10 @@
 //                  "phase_pairs": [0, 1, 2]},
 //   "fixture":    {"clamp_pressure_bar": {"lo": 4.5, "hi": 6.5}, "clamp_timeout_s": 2.0,
 //                  "release_timeout_s": 2.0},
-//   "analysis":   {"f0_min_hz": 250, "f0_max_hz": 700, "q_min": 5, "q_max": 500},
+//   "analysis":   {"f0_min_hz": 250, "f0_max_hz": 700, "q_min": 5, "q_max": 500,
+//                  "frf_method": "discard_transient" (default: drop transient_periods, average
+//                  the rest) | "transient_lpm" (keep every period, remove the start transient;
+//                  analysis/signal/transient_frf.h)},
 //   "retest":     {"max_tests_per_serial": 3},                                    optional
 //   "limits": [ {"name": "resonance_f_hz", "unit": "Hz", "lo": 370, "hi": 420,
 //                "marginal": 3, "doc": "..."}, ... ],
@@ -18,6 +21,7 @@
 //   "conditions": {"winding_temperature_c": {"r_ref_ohm": 0.5, "t_ref_c": 20, "lo": 0, "hi": 45},
 //                  "excitation_v_rms": {"lo": 1.2, "hi": 1.45}, "excitation_a_rms": {...},
 //                  "out_of_window": "error" | "record"}       optional, station/conditions.h
+//   "instructions": {"fail": "...", "error": "...", "aborted": "..."}  optional, each optional
 // }
 // Validated on load: every message names the JSON path and the rule broken, and a recipe
 // that fails validation is never used. The hash is the SHA-256 of the canonical JSON (keys
@@ -26,6 +30,7 @@
 
 #include <cstddef>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +42,45 @@
 #include "station/conditions.h"
 
 namespace eol::station {
+
+// Bounds every recipe must respect, physical and of resources: ParseRecipe refuses a recipe
+// outside them, naming the field, so a recipe can neither exhaust the station's memory or
+// time nor switch off a safety interlock by a window that passes everything.
+inline constexpr double kMaxSampleRateHz = 1.0e6;      // the fastest supported DAQ
+inline constexpr double kMinLineSpacingHz = 0.05;      // a period of at most 20 s
+inline constexpr double kMaxPeriodSamples = 1 << 21;   // samples per period (16 MiB a channel)
+inline constexpr int kMaxCrestIterations = 2000;       // crest-factor optimisation (~0.3 s)
+inline constexpr double kMaxExcitationS = 60.0;        // excitation per phase pair
+inline constexpr double kMinClampPressureBar = 0.5;    // below it the clamp does not hold
+inline constexpr double kMaxClampPressureBar = 300.0;  // hydraulic clamps included
+inline constexpr double kMaxClampPressureRatio = 2.0;  // hi / lo of the interlock window
+inline constexpr std::size_t kMaxMasks = 64;
+inline constexpr std::size_t kMaxMaskPoints = 512;
+inline constexpr std::size_t kMaxInstructionBytes = 200;
+
+// What the operator does with the unit after a verdict other than PASS: the operator page
+// shows it above the technical reason. Each is 1 to kMaxInstructionBytes bytes of UTF-8 text
+// without control characters; a key the recipe leaves out keeps its default.
+struct OperatorInstructions {
+  std::string fail = "Put the rotor in the red reject bin";
+  std::string error = "Test the rotor again; if ERROR repeats, call maintenance";
+  std::string aborted = "Test the rotor again";
+  bool operator==(const OperatorInstructions&) const = default;
+};
+
+// Who stands behind the limits (issue 12). A recipe `eol teach` writes is a proposal; the
+// station refuses to test with it (at start and on PUT /api/recipe) until an engineer
+// approves it: POST /api/recipe/approve (engineer token) or `eol recipe-approve` (both
+// audited). A recipe without "approval" was written by hand and counts as approved.
+//   "approval": {"state": "proposed" | "approved", "by": text, "at": ISO 8601, "note": text}
+// "by" and "at" are required; each text is 1 to kMaxInstructionBytes bytes.
+struct RecipeApproval {
+  std::string state;  // "proposed" or "approved"
+  std::string by;     // the teaching tool, or the approving engineer (token or --by name)
+  std::string at;
+  std::string note;  // optional
+  bool operator==(const RecipeApproval&) const = default;
+};
 
 struct Recipe {
   std::string id;
@@ -70,6 +114,12 @@ struct Recipe {
   std::vector<analysis::MeasurementSpec> limits;
   std::vector<analysis::CurveMask> masks;
   ConditionWindows conditions;
+  OperatorInstructions instructions;
+  std::optional<RecipeApproval> approval;
+
+  bool Approved() const { return !approval || approval->state == "approved"; }
+  // Empty when Approved(); else why the station refuses it, naming how to approve it.
+  std::string WhyNotApproved() const;
 
   // Every declared measurement: the scalar limits, then one per mask.
   std::vector<analysis::MeasurementSpec> Specs() const;
@@ -80,6 +130,10 @@ struct Recipe {
 // Throws io::ConfigError with "<source>: <json path>: <rule>".
 Recipe ParseRecipe(const nlohmann::json& j, const std::string& source);
 Recipe LoadRecipe(const std::string& path);
+// Writes a recipe's JSON (2-space indent) to `path` through `path`.tmp and a rename, so a
+// reader never sees half a file (atomic on one file system). Throws std::runtime_error naming
+// the file when it cannot be written.
+void WriteRecipeFile(const std::string& path, const nlohmann::json& j);
 
 // The recipe as JSON in the schema ParseRecipe reads (every key, defaults written out), so
 // that ParseRecipe(RecipeToJson(r)) gives r back (tests/station/recipe_test.cc). Used for
@@ -88,6 +142,12 @@ Recipe LoadRecipe(const std::string& path);
 nlohmann::json RecipeToJson(const Recipe& r);
 // One curve mask in the recipe's "masks" schema.
 nlohmann::json MaskJson(const analysis::CurveMask& mask);
+// The recipe's "instructions" schema, every key written out (the page reads it from
+// GET /api/recipe).
+nlohmann::json InstructionsJson(const OperatorInstructions& instructions);
+// One limit in the recipe's "limits" schema ({"name", "unit", "doc", "lo"?, "hi"?, "marginal"};
+// an open side is left out). Also how a taught or benched limit is reported.
+nlohmann::json LimitJson(const analysis::MeasurementSpec& spec);
 
 std::string Sha256Hex(const std::string& data);
 std::string CanonicalHash(const nlohmann::json& j);

@@ -12,6 +12,7 @@ struct RecipeChange {
   enum class Kind {
     kChanged,              // stored, audited and in use for the next test
     kInvalid,              // the recipe does not parse or validate; message names the field
+    kNotApproved,          // a proposal (Recipe::approval): an engineer approves it first
     kBusy,                 // a test is running or waiting; nothing changed
     kWrongRecipe,          // another recipe id than the one in use; nothing changed
     kVersionNotIncreased,  // version <= the version in use; nothing changed

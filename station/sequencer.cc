@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <sstream>
 #include <thread>
 
@@ -12,6 +13,7 @@
 #include "analysis/text.h"
 #include "db/clock.h"
 #include "drivers/daq/calibration_file.h"
+#include "station/cycle_time.h"
 #include "station/judge.h"
 #include "station/self_check.h"
 #include "station/version.h"
@@ -37,6 +39,11 @@ db::Curve ToCurve(const analysis::Frf& z, const std::string& name) {
   }
   c.sigma = z.sigma;
   return c;
+}
+
+// "fixture heartbeat frozen for N ms": the start of every frozen-heartbeat reason.
+std::string FrozenHeartbeat(const HeartbeatMonitor& heartbeat, Clock::time_point now) {
+  return "fixture heartbeat frozen for " + Fixed(heartbeat.stale_ms(now), 0) + " ms";
 }
 
 }  // namespace
@@ -116,9 +123,16 @@ struct Sequencer::MeasuredPair {
 class Sequencer::Watchdog {
  public:
   Watchdog(Sequencer& seq) : seq_(seq), thread_([this] { Run(); }) {}
-  ~Watchdog() {
-    stop_ = true;
-    thread_.join();
+  ~Watchdog() { Stop(); }
+  // Stops the thread now, not after the rest of its period; idempotent. fault() and
+  // pressure_range() are final once it returns.
+  void Stop() {
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    if (thread_.joinable()) thread_.join();
   }
   std::optional<std::string> fault() {
     std::lock_guard<std::mutex> lock(mu_);
@@ -150,24 +164,31 @@ class Sequencer::Watchdog {
         }
         why = InterlockFault(in.value(), *seq_.recipe_, true);
         if (why.empty() && !seq_.heartbeat_.Update(in.value().heartbeat, now))
-          why = "fixture heartbeat frozen for " + Fixed(seq_.heartbeat_.stale_ms(now), 0) + " ms";
+          why = FrozenHeartbeat(seq_.heartbeat_, now);
       }
       if (!why.empty()) {
         const drivers::Status off = seq_.fixture_.Write(FixtureOutput::kExcitationEnable, false);
+        {
+          // The cause is stored before the abort wakes the sequencer, which reads it.
+          std::lock_guard<std::mutex> lock(mu_);
+          fault_ = "interlock lost during excitation: " + why;
+        }
         seq_.abort_.store(true);
+        seq_.watchdog_trips_.fetch_add(1);
         spdlog::error("watchdog: {}; excitation off{}", why,
                       off.ok() ? "" : " command failed (" + off.message() + ")");
-        std::lock_guard<std::mutex> lock(mu_);
-        fault_ = "interlock lost during excitation: " + why;
         return;
       }
-      std::this_thread::sleep_until(now + std::chrono::duration_cast<Clock::duration>(period));
+      std::unique_lock<std::mutex> lock(mu_);
+      wake_.wait_until(lock, now + std::chrono::duration_cast<Clock::duration>(period),
+                       [this] { return stop_.load(); });
     }
   }
 
   Sequencer& seq_;
   std::atomic<bool> stop_{false};
   std::mutex mu_;
+  std::condition_variable wake_;
   std::optional<std::string> fault_;
   std::optional<std::pair<double, double>> pressure_;
   std::thread thread_;  // last: starts after the members it uses exist
@@ -186,8 +207,8 @@ Sequencer::Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& st
       heartbeat_(
           std::chrono::milliseconds(static_cast<long>(options_.safety.heartbeat_timeout_ms))) {}
 
-void Sequencer::SetRecipe(std::shared_ptr<const Recipe> recipe) {
-  excitation_ = analysis::DesignMultisine(recipe->excitation);
+void Sequencer::SetRecipe(std::shared_ptr<const Recipe> recipe, analysis::Excitation designed) {
+  excitation_ = std::move(designed);
   recipe_ = std::move(recipe);
 }
 
@@ -229,19 +250,23 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
   // A fixture that failed earlier gets a fresh connection: the station recovers by itself.
   if (fixture_.lifecycle() != drivers::Lifecycle::kInactive &&
       fixture_.lifecycle() != drivers::Lifecycle::kActive) {
-    if (const drivers::Status s = fixture_.Connect(); !s.ok())
+    if (const drivers::Status s = fixture_.Connect(); !s.ok()) {
+      board_.SetReadiness(false, "fixture unavailable: " + s.message());
       throw Fault{Outcome::kError, {ReasonCode::kFixture, "fixture unavailable: " + s.message()}};
+    }
   }
   if (daq_.lifecycle() != drivers::Lifecycle::kInactive) {
-    if (const drivers::Status s = daq_.Connect(); !s.ok())
+    if (const drivers::Status s = daq_.Connect(); !s.ok()) {
+      board_.SetReadiness(false, "acquisition unavailable: " + s.message());
       throw Fault{Outcome::kError,
                   {ReasonCode::kAcquisition, "acquisition unavailable: " + s.message()}};
+    }
   }
   const drivers::FixtureInputs in = ReadInputs("check interlocks");
+  board_.SetReadiness(true, "");
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
     throw Fault{Outcome::kError,
-                {ReasonCode::kInterlock, "fixture heartbeat frozen for " +
-                                             Fixed(heartbeat_.stale_ms(Clock::now()), 0) + " ms"}};
+                {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, Clock::now())}};
   if (const std::string why = InterlockFault(in, *recipe_, false); !why.empty())
     throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock: " + why}};
 }
@@ -278,14 +303,16 @@ void Sequencer::ClampAndConfirm(db::TestRecord& record) {
 }
 
 analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
-  Enter(record, SeqState::kExcite,
-        std::to_string(recipe_->transient_periods + recipe_->periods) + " periods of " +
-            Fixed(1.0 / excitation_.line_spacing_hz, 3) + " s");
   // Re-check right before closing the relay: nothing may have changed since confirmation.
+  // (Still in the clamp's state: the excite state, and the cycle's excitation step, begin
+  // when the stator is about to be excited.)
   const drivers::FixtureInputs in = ReadInputs("interlocks before excitation");
   if (const std::string why = InterlockFault(in, *recipe_, true); !why.empty())
     throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock before excitation: " + why}};
   ThrowIfAborted();
+  Enter(record, SeqState::kExcite,
+        std::to_string(recipe_->transient_periods + recipe_->periods) + " periods of " +
+            Fixed(1.0 / excitation_.line_spacing_hz, 3) + " s");
 
   drivers::AcquisitionRequest req;
   req.sample_rate_hz = excitation_.sample_rate_hz;
@@ -306,6 +333,7 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
     }
     result.emplace(daq_.Acquire(req, abort_));
     (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
+    watchdog.Stop();  // a trip in flight has stored its cause before this returns
     watchdog_fault = watchdog.fault();
     // From the check right before the relay closed through the watchdog's reads (a very
     // short acquisition may end before the watchdog's first read).
@@ -321,6 +349,18 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
   record.calibration["daq"] = daq_.name();
   if (watchdog_fault) throw Fault{Outcome::kError, {ReasonCode::kInterlock, *watchdog_fault}};
   ThrowIfAborted();
+  // The interlocks must still hold now that the relay is open: one that broke between the
+  // watchdog's last read and the end of the record makes the recording worthless. The
+  // heartbeat is confirmed alive by a fresh beat before the verdict (Unclamp).
+  Enter(record, SeqState::kCheckInterlocks, "after excitation");
+  const drivers::FixtureInputs after = ReadInputs("interlocks after excitation");
+  if (const std::string why = InterlockFault(after, *recipe_, true); !why.empty())
+    throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock after excitation: " + why}};
+  if (!heartbeat_.Update(after.heartbeat, Clock::now()))
+    throw Fault{Outcome::kError,
+                {ReasonCode::kInterlock,
+                 FrozenHeartbeat(heartbeat_, Clock::now()) + " at the end of excitation"}};
+  beat_after_excitation_ = after.heartbeat;
   if (!result->ok())
     throw Fault{Outcome::kError,
                 {ReasonCode::kAcquisition, "acquisition failed: " + result->status().message()}};
@@ -372,8 +412,23 @@ void Sequencer::Unclamp(db::TestRecord& record) {
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(recipe_->release_timeout_s));
-  while (!ReadInputs("confirm release").released) {
-    if (Clock::now() > deadline)
+  // Before the verdict is published the controller must prove it was alive at the end of
+  // excitation: a heartbeat newer than the one read when the relay opened (a freeze near the
+  // end of excitation is shorter than the watchdog's timeout and would pass unseen).
+  bool released = false;
+  bool fresh_beat = !beat_after_excitation_;
+  for (;;) {
+    const drivers::FixtureInputs in = ReadInputs("confirm release");
+    const auto now = Clock::now();
+    released = released || in.released;
+    fresh_beat = fresh_beat || in.heartbeat != *beat_after_excitation_;
+    if (!fresh_beat && !heartbeat_.Update(in.heartbeat, now))
+      throw Fault{Outcome::kError,
+                  {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, now) +
+                                               " after excitation: its inputs during the "
+                                               "test cannot be trusted"}};
+    if (released && fresh_beat) break;
+    if (!released && now > deadline)
       throw Fault{Outcome::kError,
                   {ReasonCode::kFixture,
                    "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s"}};
@@ -383,38 +438,71 @@ void Sequencer::Unclamp(db::TestRecord& record) {
   (void)fixture_.Deactivate();
 }
 
+// Excitation off, then the clamp released when that is safe. On a communication loss both
+// are retried (reconnecting; a fresh connection drives excitation off first) until they are
+// confirmed or safety.safe_state_retry_s has passed; what could not be confirmed is named.
 void Sequencer::SafeState(db::TestRecord& record) {
   Enter(record, SeqState::kSafeState, record.reasons.empty() ? "" : record.reasons.front().text);
+  const auto give_up =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(options_.safety.safe_state_retry_s));
+  const auto pause =
+      std::chrono::duration<double, std::milli>(std::max(options_.safety.poll_period_ms, 50.0));
   // 1. Excitation off, always first, whatever state the fixture is in.
-  if (const drivers::Status s = fixture_.Write(FixtureOutput::kExcitationEnable, false); !s.ok())
+  int attempts = 0;
+  drivers::Status off = drivers::Status::Ok();
+  for (;;) {
+    ++attempts;
+    off = fixture_.lifecycle() == drivers::Lifecycle::kError
+              ? fixture_.Connect()  // a fresh connection drives excitation off first
+              : fixture_.Write(FixtureOutput::kExcitationEnable, false);
+    if (off.ok() || Clock::now() >= give_up) break;
+    std::this_thread::sleep_for(pause);
+  }
+  if (!off.ok())
     record.reasons.push_back(
-        {ReasonCode::kFixture, "excitation-off command failed: " + s.message() +
+        {ReasonCode::kFixture, "excitation off not confirmed after " + std::to_string(attempts) +
+                                   " attempts: " + off.message() +
                                    " (the relay is wired to drop on controller loss)"});
   // 2. Unclamp only when it is safe: the controller answers, nobody is at the door, the
   //    emergency-stop chain is healthy. Otherwise leave the part clamped and say so.
-  auto in = fixture_.ReadInputs();
   std::string unsafe;
   ReasonCode code = ReasonCode::kInterlock;
-  if (!in.ok()) {
-    unsafe = "fixture not answering";
-    code = ReasonCode::kFixture;
-  } else if (!in.value().estop_ok) {
-    unsafe = "emergency stop open";
-  } else if (!in.value().door_closed) {
-    unsafe = "door open";
+  for (;;) {
+    if (fixture_.lifecycle() == drivers::Lifecycle::kError) (void)fixture_.Connect();
+    auto in = fixture_.ReadInputs();
+    if (!in.ok()) {
+      unsafe = "fixture not answering (" + in.status().message() + ")";
+      code = ReasonCode::kFixture;
+      if (Clock::now() < give_up) {
+        std::this_thread::sleep_for(pause);
+        continue;
+      }
+    } else if (!in.value().estop_ok) {
+      unsafe = "emergency stop open";
+    } else if (!in.value().door_closed) {
+      unsafe = "door open";
+    } else {
+      unsafe.clear();
+      (void)fixture_.Activate();
+      const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false);
+      if (!s.ok() && Clock::now() < give_up) {
+        std::this_thread::sleep_for(pause);
+        continue;
+      }
+      if (!s.ok())
+        record.reasons.push_back({ReasonCode::kFixture, "unclamp not confirmed: " + s.message()});
+    }
+    break;
   }
-  if (!unsafe.empty()) {
-    record.reasons.push_back({code, "clamp left as it is: " + unsafe});
-  } else {
-    (void)fixture_.Activate();
-    const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false);
-    if (!s.ok()) record.reasons.push_back({ReasonCode::kFixture, "unclamp failed: " + s.message()});
-  }
+  if (!unsafe.empty()) record.reasons.push_back({code, "clamp left as it is: " + unsafe});
   (void)fixture_.Deactivate();
 }
 
 void Sequencer::StoreAndPublish(db::TestRecord& record) {
   Enter(record, SeqState::kStore, analysis::ToString(record.outcome));
+  record.cycle_s =
+      CycleBreakdown({record.trace.begin(), record.trace.end() - 1}, record.trace.back().t_ms);
   record.finished_at = db::UtcNowIso8601();
   try {
     store_.FinishTest(record);
@@ -427,16 +515,25 @@ void Sequencer::StoreAndPublish(db::TestRecord& record) {
   }
   Enter(record, SeqState::kPublish, analysis::ToString(record.outcome));
   board_.OnVerdict(record);
+  // The fixture's two lamps: green alone PASS, red alone FAIL (reject the rotor), both ERROR
+  // or ABORTED (the station could not judge: test again) - distinct without a third output.
   const bool pass = record.outcome == analysis::Outcome::kPass;
-  (void)fixture_.Write(FixtureOutput::kLampPass, pass);
+  const bool fail = record.outcome == analysis::Outcome::kFail;
+  (void)fixture_.Write(FixtureOutput::kLampPass, !fail);
   (void)fixture_.Write(FixtureOutput::kLampFail, !pass);
 }
 
 db::TestRecord Sequencer::RunTest(const std::string& serial) {
+  return RunTest(serial, db::WorkContext{});
+}
+
+db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkContext& work) {
   test_start_ = Clock::now();
   abort_.store(stop_requested_.load());
+  beat_after_excitation_.reset();
   db::TestRecord record;
   record.serial = serial;
+  record.work = work;
   record.station_id = options_.station_id;
   record.recipe_id = recipe_->id;
   record.recipe_version = recipe_->version;
@@ -444,6 +541,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
   record.software_version = SoftwareVersion();
   record.started_at = db::UtcNowIso8601();
   record.outcome = analysis::Outcome::kError;
+  if (!options_.simulation.empty()) record.conditions["simulation"] = options_.simulation;
   Enter(record, SeqState::kWaitSerial, "serial " + serial + " received");
   const std::optional<std::string> master = MasterRole(options_.self_check, serial);
   if (master) record.kind = db::RecordKind::kSelfCheck;
@@ -522,6 +620,8 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
   StoreAndPublish(record);
   if (options_.self_check.enabled()) PublishLockout();
   Enter(record, SeqState::kWaitSerial);
+  record.cycle_s =
+      CycleBreakdown({record.trace.begin(), record.trace.end() - 1}, record.trace.back().t_ms);
   return record;
 }
 

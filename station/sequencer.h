@@ -1,7 +1,8 @@
 // The one path every test takes (ARCHITECTURE.md), as explicit, logged states:
 //
-//   wait_serial -> check_interlocks -> clamp -> confirm_clamp -> excite -> analyse -> judge
-//     -> unclamp -> store -> publish -> wait_serial
+//   wait_serial -> check_interlocks -> clamp -> confirm_clamp -> excite -> check_interlocks
+//     -> analyse -> judge -> unclamp -> store -> publish -> wait_serial
+//   (further phase pairs: after analyse, clamp (pair switch) -> excite -> ... again)
 //   any fault:  -> safe_state (excitation off first; unclamp only when that is safe)
 //               -> store (ERROR or ABORTED with the cause) -> publish
 //
@@ -68,6 +69,9 @@ std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& recip
 
 struct SequencerOptions {
   std::string station_id = "eol-1";
+  // Non-empty on simulators (station/config.h SimulationReason): every record carries
+  // conditions.simulation with this text.
+  std::string simulation;
   SafetyOptions safety;
   // Called with the serial before the interlock check (the simulated operator loads a part).
   std::function<void(const std::string& serial)> on_serial;
@@ -85,15 +89,21 @@ class Sequencer {
   // Runs one test to its end and returns the stored record. Never throws for station,
   // fixture, acquisition or data faults: they end as ERROR with the cause in reasons.
   db::TestRecord RunTest(const std::string& serial);
+  // The same, with who tests it for which order (stored with the record; issue 15).
+  db::TestRecord RunTest(const std::string& serial, const db::WorkContext& work);
   // Thread-safe: aborts the test in flight (excitation off, safe state, outcome ABORTED).
   void RequestAbort(const std::string& why);
   SeqState state() const { return state_.load(); }
-  // Between tests only (the caller guarantees no RunTest is in progress).
-  void SetRecipe(std::shared_ptr<const Recipe> recipe);
+  // Between tests only (the caller guarantees no RunTest is in progress). `designed` is
+  // analysis::DesignMultisine(recipe->excitation), which the caller has already built to
+  // validate the recipe before anything was swapped.
+  void SetRecipe(std::shared_ptr<const Recipe> recipe, analysis::Excitation designed);
   const Recipe& recipe() const { return *recipe_; }
   // Re-reads the self-check state from the store and shows it on the board (GET /api/status).
   // Between tests only; a no-op when self-checks are off.
   void PublishLockout();
+  // Times the interlock watchdog cut the excitation since construction. Thread-safe.
+  std::uint64_t watchdog_trips() const { return watchdog_trips_.load(); }
 
  private:
   struct Fault;
@@ -125,10 +135,13 @@ class Sequencer {
   SequencerOptions options_;
   analysis::Excitation excitation_;  // designed from the recipe
   HeartbeatMonitor heartbeat_;
+  // The heartbeat read right after the last excitation ended; Unclamp waits for a newer one.
+  std::optional<std::uint32_t> beat_after_excitation_;
 
   std::atomic<SeqState> state_{SeqState::kWaitSerial};
   std::atomic<bool> stop_requested_{false};  // sticky: RequestAbort() was called
-  std::atomic<bool> abort_{false};           // read by the DAQ: stop playing now (reset per test)
+  std::atomic<std::uint64_t> watchdog_trips_{0};
+  std::atomic<bool> abort_{false};  // read by the DAQ: stop playing now (reset per test)
   std::mutex abort_mu_;
   std::string abort_reason_;
   std::chrono::steady_clock::time_point test_start_{};

@@ -1,5 +1,8 @@
-// What the station accepts as a serial number: 1 to 64 printable ASCII characters, no
-// spaces at either end, no control characters. Everything else is refused before a test.
+// What the station accepts as a serial number: 1 to 64 characters from A-Z a-z 0-9 and
+// "-_.:#+", starting with a letter or digit. Everything else is refused before a test, so
+// every stored serial can be read back as one URL path segment (GET /api/units/{serial};
+// '/' was stored but unreachable) and written into CSV and file names unquoted. '#' and '+'
+// must be percent-encoded in URLs (%23, %2B).
 #pragma once
 
 #include <string>

@@ -3,16 +3,56 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
-#include <fstream>
+#include <thread>
 
+#include "analysis/text.h"
 #include "db/clock.h"
 #include "station/systemd_notify.h"
+#include "station/version.h"
 
 namespace eol::station {
 
+namespace {
+
+// The configured recipe; when it does not load, the newest kept version beside it that does
+// (<stem>.v<N>.json, kept by ChangeRecipe), with `problem` saying so. Throws the configured
+// file's ConfigError when no kept version loads either.
+Recipe LoadRecipeOrLastGood(const std::string& path, std::string* problem) {
+  namespace fs = std::filesystem;
+  try {
+    return LoadRecipe(path);
+  } catch (const io::ConfigError& e) {
+    const fs::path p(path);
+    const std::string prefix = p.stem().string() + ".v";
+    std::optional<std::pair<int, fs::path>> newest;
+    std::error_code ec;
+    for (const auto& entry :
+         fs::directory_iterator(p.parent_path().empty() ? "." : p.parent_path(), ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind(prefix, 0) != 0 || entry.path().extension() != ".json") continue;
+      const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - 5);
+      if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      const int v = std::stoi(digits);
+      if (!newest || v > newest->first) newest = {v, entry.path()};
+    }
+    if (!newest) throw;
+    Recipe last = LoadRecipe(newest->second.string());
+    *problem = std::string(e.what()) + "; tests are refused until a valid recipe is installed " +
+               "(PUT /api/recipe or a fixed file and a restart); the last good version v" +
+               std::to_string(last.version) + " (" + newest->second.string() + ") is shown";
+    return last;
+  }
+}
+
+}  // namespace
+
 Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
     : config_(std::move(config)) {
-  recipe_ = std::make_shared<const Recipe>(LoadRecipe(config_.recipe_path));
+  recipe_ =
+      std::make_shared<const Recipe>(LoadRecipeOrLastGood(config_.recipe_path, &recipe_problem_));
+  if (recipe_problem_.empty() && !recipe_->Approved())
+    recipe_problem_ = recipe_->WhyNotApproved() + "; tests are refused until then";
+  if (!recipe_problem_.empty()) spdlog::error("{}", recipe_problem_);
   spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_->id, recipe_->version, config_.recipe_path,
                recipe_->hash.substr(0, 12));
   store_ = db::Store::Open(config_.db_path);
@@ -21,16 +61,30 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
                  config_.db_path, store_->aborted_on_open());
   drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench));
   board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_->id, recipe_->hash);
+  std::string not_ready;
   if (const drivers::Status s = drivers_.fixture->Connect(); !s.ok()) {
     spdlog::error("{} (will retry at the next test)", s.message());
     board_->SetMessage(s.message());
+    not_ready = s.message();
   }
   if (const drivers::Status s = drivers_.daq->Connect(); !s.ok()) {
     spdlog::error("{} (will retry at the next test)", s.message());
     board_->SetMessage(s.message());
+    not_ready += (not_ready.empty() ? "" : "; ") + s.message();
+  }
+  if (!recipe_problem_.empty()) {
+    board_->SetMessage(recipe_problem_);
+    not_ready += (not_ready.empty() ? "" : "; ") + std::string("recipe does not load");
+  }
+  board_->SetReadiness(not_ready.empty(), not_ready);
+  const std::string simulation = SimulationReason(config_);
+  if (!simulation.empty()) {
+    spdlog::warn("SIMULATION ({}): records are marked and are no production results", simulation);
+    board_->SetSimulation(simulation);
   }
   SequencerOptions opts;
   opts.station_id = config_.station_id;
+  opts.simulation = simulation;
   opts.safety = config_.safety;
   opts.self_check = config_.self_check;
   if (drivers_.bench && drivers_.bench->settings().load_part_on_serial) {
@@ -43,6 +97,9 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
 }
 
 Station::~Station() {
+  if (plc_) plc_->Stop();
+  if (mqtt_) mqtt_->Stop();
+  if (central_) central_->Stop();
   if (http_) http_->Stop();
   if (drivers_.fixture) drivers_.fixture->Disconnect();
   if (drivers_.daq) drivers_.daq->Disconnect();
@@ -55,18 +112,21 @@ void Station::StartHttp(const std::string& web_root) {
   o.db_path = config_.db_path;
   o.tokens = config_.tokens;
   o.web_root = web_root;
+  if (config_.central) o.central_postgres = config_.central->postgres;
   HttpHandlers h;
-  h.start_test = [this](const std::string& s, std::string* why) { return Enqueue(s, why); };
+  h.start_test = [this](const TestRequest& r, std::string* why) { return Enqueue(r, why); };
   h.recipe = [this] {
     const auto r = recipe();
     nlohmann::json j = r->source;
     j["hash"] = r->hash;
+    j["instructions"] = InstructionsJson(r->instructions);  // defaults written out
     return j;
   };
   h.current_recipe = [this] { return recipe(); };
   h.change_recipe = [this](const nlohmann::json& j, const ApiToken& who) {
     return ChangeRecipe(j, who);
   };
+  h.metrics = [this] { return metrics_.Render(LiveValues()); };
   http_ = std::make_unique<HttpApi>(*board_, o, h);
   http_->Start();
 }
@@ -89,6 +149,17 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   } catch (const io::ConfigError& e) {
     return refused(RecipeChange::Kind::kInvalid, e.what());
   }
+  if (!next->Approved())
+    return refused(RecipeChange::Kind::kNotApproved, "PUT /api/recipe: " + next->WhyNotApproved());
+  // Everything the new recipe needs is built before anything is renamed, audited or swapped:
+  // a recipe whose excitation cannot be designed leaves the station as it was.
+  analysis::Excitation designed;
+  try {
+    designed = analysis::DesignMultisine(next->excitation);
+  } catch (const std::exception& e) {
+    return refused(RecipeChange::Kind::kInvalid,
+                   std::string("PUT /api/recipe: /excitation: cannot be designed: ") + e.what());
+  }
   // Holding the queue lock keeps the sequencer idle until the new recipe is in place.
   std::lock_guard<std::mutex> queue_lock(queue_mu_);
   if (running_test_ || !queue_.empty())
@@ -109,14 +180,7 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
                         (path.stem().string() + ".v" + std::to_string(current->version) + ".json");
   try {
     if (!fs::exists(kept)) fs::copy_file(path, kept);
-    const fs::path tmp = path.string() + ".tmp";
-    {
-      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      out << j.dump(2) << "\n";
-      out.flush();
-      if (!out) throw std::runtime_error(tmp.string() + ": cannot be written");
-    }
-    fs::rename(tmp, path);  // atomic on one file system
+    WriteRecipeFile(path.string(), j);
   } catch (const std::exception& e) {
     return refused(RecipeChange::Kind::kIoError, e.what());
   }
@@ -135,7 +199,24 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
     std::lock_guard<std::mutex> lock(recipe_mu_);
     recipe_ = next;
   }
-  sequencer_->SetRecipe(next);
+  if (!recipe_problem_.empty()) {  // under queue_mu_, as Enqueue reads it
+    recipe_problem_.clear();
+    board_->SetMessage("");
+    // The recipe was the only thing wrong only if both drivers answered; otherwise the board
+    // keeps saying so until the next test reconnects them.
+    const auto connected = [](drivers::Lifecycle l) {
+      return l == drivers::Lifecycle::kInactive || l == drivers::Lifecycle::kActive;
+    };
+    const bool fixture_up = connected(drivers_.fixture->lifecycle());
+    const bool daq_up = connected(drivers_.daq->lifecycle());
+    std::string not_ready;
+    if (!fixture_up) not_ready = "fixture not connected (retried at the next test)";
+    if (!daq_up)
+      not_ready += (not_ready.empty() ? "" : "; ") +
+                   std::string("acquisition not connected (retried at the next test)");
+    board_->SetReadiness(not_ready.empty(), not_ready);
+  }
+  sequencer_->SetRecipe(next, std::move(designed));
   board_->SetRecipe(next->id, next->hash);
   spdlog::warn("recipe {} changed by {} ({}): v{} {} -> v{} {}", next->id, who.name,
                ToString(who.role), current->version, current->hash.substr(0, 12), next->version,
@@ -152,48 +233,151 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   return changed;
 }
 
+bool Station::ready() const { return board_->Snapshot().value("ready", false); }
+
 int Station::http_port() const { return http_ ? http_->port() : 0; }
 
-db::TestRecord Station::RunTest(const std::string& serial) { return sequencer_->RunTest(serial); }
+db::TestRecord Station::RunTest(const std::string& serial) {
+  db::TestRecord r = sequencer_->RunTest(serial);
+  metrics_.OnTest(r);
+  return r;
+}
+
+LiveMetrics Station::LiveValues() {
+  LiveMetrics m;
+  const nlohmann::json board = board_->Snapshot();
+  const std::string state = board.value("state", "");
+  m.testing = state != "wait_serial" && state != "idle";
+  m.ready = board.value("ready", false);
+  m.locked_out = board["lockout"].is_object() && board["lockout"].value("locked", false);
+  m.simulation = !board.value("simulation", std::string()).empty();
+  {
+    std::lock_guard<std::mutex> lock(queue_mu_);
+    m.queue_length = queue_.size();
+  }
+  m.fixture_errors = drivers_.fixture->failures();
+  m.watchdog_trips = sequencer_->watchdog_trips();
+  m.db_path = config_.db_path;
+  m.station_id = config_.station_id;
+  const auto r = recipe();
+  m.recipe_id = r->id;
+  m.recipe_hash = r->hash;
+  m.software_version = SoftwareVersion();
+  if (central_) {
+    const central::CentralStatus c = central_->status();
+    m.central_connected = c.connected;
+    if (c.backlog >= 0) m.central_backlog = c.backlog;
+  }
+  return m;
+}
 
 bool Station::Enqueue(const std::string& serial, std::string* why) {
+  return Enqueue(TestRequest{serial, {}}, why);
+}
+
+bool Station::Enqueue(const TestRequest& request, std::string* why,
+                      std::uint64_t* verdicts_before) {
   std::lock_guard<std::mutex> lock(queue_mu_);
   if (stop_) {
     *why = "station is stopping";
+    return false;
+  }
+  if (!recipe_problem_.empty()) {
+    *why = recipe_problem_;
     return false;
   }
   if (running_test_ || !queue_.empty()) {
     *why = "busy: a test is running or waiting";
     return false;
   }
-  queue_.push_back(serial);
+  queue_.push_back(request);
+  if (verdicts_before != nullptr) *verdicts_before = verdicts_;
   queue_cv_.notify_all();
   return true;
 }
 
+// A deadline no healthy test reaches: the excitation of every phase pair, the clamp and
+// release timeouts, the safe state's retries, and a generous allowance for analysis and I/O.
+double TestDeadlineS(const Recipe& r, const SafetyOptions& safety) {
+  const double excite_s =
+      static_cast<double>(r.transient_periods + r.periods) / r.excitation.line_spacing_hz;
+  const double per_pair_s = excite_s + 10.0;
+  return static_cast<double>(r.phase_pairs.size()) * per_pair_s + r.clamp_timeout_s +
+         r.release_timeout_s + safety.safe_state_retry_s + 30.0;
+}
+
 void Station::Serve() {
+  std::atomic<bool> serving{true};
+  std::thread health([&] { HealthLoop(serving); });
+  ServeQueue();
+  serving = false;
+  health.join();
+}
+
+// systemd's watchdog is fed from the daemon's health, not from the serial loop: the station
+// is healthy while it waits for a serial, and while the test in flight is within its own
+// deadline (TestDeadlineS). A test past its deadline is stuck: excitation off, the operator
+// told, and the pings stop so systemd restarts the daemon (the store records the test as
+// ABORTED when it reopens).
+void Station::HealthLoop(const std::atomic<bool>& serving) {
+  bool reported = false;
+  while (serving) {
+    std::string stuck;
+    {
+      std::lock_guard<std::mutex> lock(queue_mu_);
+      if (running_test_) {
+        const double running_s =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - test_started_).count();
+        if (running_s > test_deadline_s_)
+          stuck = "test of " + running_serial_ + " running for " + analysis::Fixed(running_s, 0) +
+                  " s, beyond its deadline of " + analysis::Fixed(test_deadline_s_, 0) + " s";
+      }
+    }
+    if (stuck.empty()) {
+      NotifyWatchdog();
+      reported = false;
+    } else if (!reported) {
+      (void)drivers_.fixture->Write(drivers::FixtureOutput::kExcitationEnable, false);
+      spdlog::error("{}: excitation off, watchdog pings stopped (systemd restarts the daemon)",
+                    stuck);
+      board_->SetMessage(stuck + "; call maintenance");
+      metrics_.OnStuckTest();
+      reported = true;
+    }
+    for (int i = 0; i < 10 && serving; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+}
+
+void Station::ServeQueue() {
   while (true) {
-    std::string serial;
+    TestRequest request;
     {
       std::unique_lock<std::mutex> lock(queue_mu_);
-      // Wakes at least every second to tell systemd's watchdog the loop is alive; a test that
-      // hangs stops the pings and gets the daemon restarted.
       int idle_s = 0;
       while (!queue_cv_.wait_for(lock, std::chrono::seconds(1),
                                  [&] { return stop_ || !queue_.empty(); })) {
-        NotifyWatchdog();
         if (++idle_s % 60 == 0) sequencer_->PublishLockout();  // a check falls due with time
       }
-      NotifyWatchdog();
       if (stop_) return;
-      serial = queue_.front();
+      request = queue_.front();
       queue_.pop_front();
       running_test_ = true;
+      running_serial_ = request.serial;
+      test_started_ = std::chrono::steady_clock::now();
+      test_deadline_s_ = TestDeadlineS(*recipe(), config_.safety);
     }
-    const db::TestRecord r = sequencer_->RunTest(serial);
+    const db::TestRecord r = sequencer_->RunTest(request.serial, request.work);
+    metrics_.OnTest(r);
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),
                  r.reasons.empty() ? "" : r.reasons.front().text);
     std::lock_guard<std::mutex> lock(queue_mu_);
+    // Plant integration: what the line PLC reads, changed together with running_test_.
+    ++verdicts_;
+    if (r.id != 0) ++stored_;  // refusals by the sequencer (lockout, ...) store nothing
+    last_outcome_ = r.outcome;
+    last_reason_.reset();
+    if (!r.reasons.empty()) last_reason_ = r.reasons.front().code;
     running_test_ = false;
   }
 }
@@ -206,6 +390,54 @@ void Station::RequestStop(const std::string& why) {
     queue_cv_.notify_all();
   }
   sequencer_->RequestAbort(why);
+}
+
+// ---- Plant integration (issue 15) ----
+
+void Station::StartPlc() {
+  if (!config_.plc || plc_) return;
+  plc::PlcBackend backend;
+  backend.start = [this](const TestRequest& request) {
+    plc::PlcStartReply reply;
+    if (Enqueue(request, &reply.message, &reply.verdicts_before)) return reply;
+    std::lock_guard<std::mutex> lock(queue_mu_);
+    reply.refusal = stop_ ? plc::PlcRefusal::kStopping : plc::PlcRefusal::kBusy;
+    return reply;
+  };
+  backend.view = [this] {
+    plc::PlcStationView v;
+    {
+      std::lock_guard<std::mutex> lock(queue_mu_);
+      v.busy = running_test_ || !queue_.empty();
+      v.stopping = stop_;
+      v.verdicts = verdicts_;
+      v.stored = stored_;
+      v.last_outcome = last_outcome_;
+      v.last_reason = last_reason_;
+    }
+    const nlohmann::json lockout = board_->Snapshot()["lockout"];
+    v.lockout = lockout.is_object() && lockout.value("locked", false);
+    return v;
+  };
+  plc_ = std::make_unique<plc::PlcServer>(*config_.plc, std::move(backend));
+  plc_->Start();
+}
+
+int Station::plc_port() const { return plc_ ? plc_->port() : 0; }
+
+void Station::StartMqtt() {
+  if (!config_.mqtt || mqtt_) return;
+  mqtt_ = std::make_unique<MqttPublisher>(
+      *config_.mqtt, config_.station_id, config_.db_path,
+      [this] { return board_->Snapshot()["state"].get<std::string>(); });
+  mqtt_->Start();
+}
+
+void Station::StartCentral() {
+  if (!config_.central || central_) return;
+  central_ = std::make_unique<central::CentralReplicator>(*config_.central, config_.db_path,
+                                                          config_.station_id);
+  central_->Start();
 }
 
 }  // namespace eol::station

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -14,16 +15,21 @@
 #include "drivers/factory/factory.h"
 #include "station/config.h"
 #include "station/http_api.h"
+#include "station/plc/plc_server.h"
 #include "station/recipe.h"
 #include "station/recipe_change.h"
 #include "station/sequencer.h"
+#include "station/station_metrics.h"
 #include "station/status_board.h"
+#include "station/test_request.h"
 
 namespace eol::station {
 
 class Station {
  public:
-  // Loads and validates the recipe, opens the store (recovering interrupted tests as
+  // Loads and validates the recipe (when the configured file does not load, the newest kept
+  // version beside it is loaded and tests are refused until a valid recipe is installed;
+  // with none, it throws), opens the store (recovering interrupted tests as
   // ABORTED), makes the drivers and connects them. A fixture or DAQ that does not answer
   // yet is not fatal: the station says so and retries at the next test. A bad recipe,
   // config or database is fatal (throws with the cause).
@@ -36,13 +42,21 @@ class Station {
   // Serves the API; the port actually bound is http_port().
   void StartHttp(const std::string& web_root = "");
   int http_port() const;
+  // The fixture and the DAQ answered (at start, or at the latest test); otherwise the board's
+  // not_ready_reason says what did not.
+  bool ready() const;
 
   // Runs one test now, on the calling thread.
   db::TestRecord RunTest(const std::string& serial);
 
   // For the daemon: queue a serial (one test at a time; refused while one runs or waits).
   bool Enqueue(const std::string& serial, std::string* why);
-  // Runs queued tests until RequestStop(); returns when the test in flight has ended.
+  // The same for a whole request; `verdicts_before` (optional) gets the number of tests
+  // ended before this one was accepted (the PLC's done bit waits for the next).
+  bool Enqueue(const TestRequest& request, std::string* why,
+               std::uint64_t* verdicts_before = nullptr);
+  // Runs queued tests until RequestStop(); returns when the test in flight has ended. Feeds
+  // systemd's watchdog from a health thread while it runs (see HealthLoop).
   void Serve();
   // Thread-safe: aborts the test in flight and ends Serve().
   void RequestStop(const std::string& why);
@@ -59,21 +73,58 @@ class Station {
   drivers::SimBench* bench() { return drivers_.bench.get(); }
   db::Store& store() { return *store_; }
 
+  // ---- Plant integration (issue 15) ----
+  // Serves the line PLC's handshake (station/plc/plc_server.h) when the config has a "plc"
+  // block; the port actually bound is plc_port() (0 when not serving). Throws naming the
+  // address when it cannot listen.
+  void StartPlc();
+  int plc_port() const;
+  // Publishes every stored record and the station's status over MQTT
+  // (station/mqtt_publisher.h) when the config has an "mqtt" block.
+  void StartMqtt();
+  // Replicates every stored record into the plant's central PostgreSQL record
+  // (station/central/central_replicator.h) when the config has a "central" block.
+  void StartCentral();
+
  private:
   StationConfig config_;
   mutable std::mutex recipe_mu_;
   std::shared_ptr<const Recipe> recipe_;
+  // Non-empty when the configured recipe did not load at start: tests are refused (Enqueue)
+  // until ChangeRecipe installs a valid one. Guarded by queue_mu_.
+  std::string recipe_problem_;
   std::unique_ptr<db::Store> store_;
   drivers::DriverSet drivers_;
   std::unique_ptr<StatusBoard> board_;
   std::unique_ptr<Sequencer> sequencer_;
   std::unique_ptr<HttpApi> http_;
+  std::unique_ptr<plc::PlcServer> plc_;
+  std::unique_ptr<MqttPublisher> mqtt_;
+  std::unique_ptr<central::CentralReplicator> central_;
+  StationMetrics metrics_;
 
   std::mutex queue_mu_;
   std::condition_variable queue_cv_;
-  std::deque<std::string> queue_;
+  std::deque<TestRequest> queue_;
   bool running_test_ = false;
+  std::string running_serial_;
+  std::chrono::steady_clock::time_point test_started_{};
+  double test_deadline_s_ = 0;
   bool stop_ = false;
+
+  void ServeQueue();
+  // What /metrics reads at scrape time (board, queue, driver and sequencer counters).
+  LiveMetrics LiveValues();
+  void HealthLoop(const std::atomic<bool>& serving);
+  // What the line PLC reads (under queue_mu_): tests ended and records stored since start,
+  // and the newest verdict.
+  std::uint64_t verdicts_ = 0;
+  std::uint64_t stored_ = 0;
+  std::optional<analysis::Outcome> last_outcome_;
+  std::optional<analysis::ReasonCode> last_reason_;
 };
+
+// Seconds after which a test of `recipe` is stuck (Station::HealthLoop).
+double TestDeadlineS(const Recipe& recipe, const SafetyOptions& safety);
 
 }  // namespace eol::station

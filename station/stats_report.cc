@@ -19,6 +19,7 @@ struct Series {
   analysis::Limit limit;
   std::vector<double> measured;  // PASS and FAIL tests
   std::vector<double> passing;   // PASS tests
+  std::vector<std::string> measured_serials, passing_serials;
 };
 
 struct Group {
@@ -111,6 +112,9 @@ std::string ValidateStatsRequest(const StatsRequest& r) {
   std::string why;
   if (!r.drift.IsValid(&why)) return "drift: " + why;
   if (!r.gauge.IsValid(&why)) return "gauge: " + why;
+  if (r.subgroup != 1 && !analysis::SpcConstantsFor(r.subgroup))
+    return "subgroup must be 1 (I-MR) or 2..10 (X-bar/R)";
+  if (!r.rules.IsValid(&why)) return "rules: " + why;
   if (r.gauge_serial && !ValidSerial(*r.gauge_serial, &why)) return "gauge: " + why;
   if (r.from && r.to && !(*r.from < *r.to)) return "from must be before to";
   return "";
@@ -163,27 +167,71 @@ nlohmann::json StatsReport(db::Store& store, const StatsRequest& req) {
     s.limit.hi = r.hi;
     if (!r.value || r.outcome == analysis::Outcome::kError) continue;
     s.measured.push_back(*r.value);
-    if (r.outcome == analysis::Outcome::kPass) s.passing.push_back(*r.value);
+    s.measured_serials.push_back(r.serial);
+    if (r.outcome == analysis::Outcome::kPass) {
+      s.passing.push_back(*r.value);
+      s.passing_serials.push_back(r.serial);
+    }
   }
 
   nlohmann::json recipes = nlohmann::json::array();
   nlohmann::json alarms = nlohmann::json::array();
+  nlohmann::json spc_alarms = nlohmann::json::array();
   for (const std::string& hash : hashes) {
     Group& g = groups[hash];
     nlohmann::json measurements = nlohmann::json::array();
     for (const std::string& name : g.order) {
       const Series& s = g.series[name];
-      const analysis::Capability c = analysis::ComputeCapability(s.measured, s.limit);
+      const bool pass_only = req.population == Population::kPass;
+      SpcSeries pop;
+      pop.measurement = name;
+      pop.unit = s.unit;
+      pop.limit = s.limit;
+      pop.population = req.population;
+      pop.values = pass_only ? s.passing : s.measured;
+      pop.serials = pass_only ? s.passing_serials : s.measured_serials;
+      const analysis::CapabilityIndices c =
+          analysis::ComputeCapabilityIndices(pop.values, s.limit, req.subgroup);
       const analysis::DriftSummary d =
           analysis::DetectDrift(s.passing, s.limit, name, s.unit, req.drift);
-      if (d.alarm)
-        alarms.push_back(g.recipe_id + " v" + std::to_string(g.recipe_version) + ": " + d.message);
+      const std::string who = g.recipe_id + " v" + std::to_string(g.recipe_version) + ": ";
+      if (d.alarm) alarms.push_back(who + d.message);
+      nlohmann::json control = {{"chart", req.subgroup > 1 ? "xbar_r" : "imr"},
+                                {"centre", nullptr},
+                                {"lcl", nullptr},
+                                {"ucl", nullptr},
+                                {"alarms", nlohmann::json::array()}};
+      std::optional<analysis::ControlLimits> limits;
+      std::vector<double> points;
+      if (req.subgroup > 1) {
+        const analysis::XbarRChart xr = analysis::ComputeXbarR(pop.values, req.subgroup);
+        if (xr.usable) {
+          limits = xr.xbar;
+          points = xr.means;
+        }
+      } else {
+        const analysis::IMrChart imr = analysis::ComputeIMr(pop.values);
+        if (imr.usable) {
+          limits = imr.individuals;
+          points = pop.values;
+        }
+      }
+      if (limits) {
+        const std::vector<NamedAlarm> named =
+            NameAlarms(analysis::ApplyRunRules(points, *limits, req.rules), pop, req.subgroup);
+        for (const NamedAlarm& a : named) spc_alarms.push_back(who + a.text);
+        control["centre"] = limits->centre;
+        control["lcl"] = limits->lcl;
+        control["ucl"] = limits->ucl;
+        control["alarms"] = AlarmsJson(named);
+      }
       const bool have = c.sample.n > 0;
       measurements.push_back(
           {{"name", name},
            {"unit", s.unit},
            {"lo", Opt(s.limit.lo)},
            {"hi", Opt(s.limit.hi)},
+           {"population", PopulationText(req.population)},
            {"n", c.sample.n},
            {"mean", have ? nlohmann::json(c.sample.mean) : nlohmann::json()},
            {"sd", c.sample.n > 1 ? nlohmann::json(c.sample.sd) : nlohmann::json()},
@@ -191,7 +239,12 @@ nlohmann::json StatsReport(db::Store& store, const StatsRequest& req) {
            {"max", have ? nlohmann::json(c.sample.max) : nlohmann::json()},
            {"cp", Opt(c.cp)},
            {"cpk", Opt(c.cpk)},
+           {"pp", Opt(c.pp)},
+           {"ppk", Opt(c.ppk)},
+           {"sigma_within", c.sigma_within > 0 ? nlohmann::json(c.sigma_within) : nlohmann::json()},
+           {"sigma_within_method", c.within_method},
            {"message", c.message},
+           {"control", control},
            {"drift", DriftJson(d)}});
     }
     recipes.push_back({{"recipe_id", g.recipe_id},
@@ -204,10 +257,13 @@ nlohmann::json StatsReport(db::Store& store, const StatsRequest& req) {
   nlohmann::json window = {
       {"from", req.from ? nlohmann::json(*req.from) : nlohmann::json()},
       {"to", req.to ? nlohmann::json(*req.to) : nlohmann::json()},
-      {"recipe_hash", req.recipe_hash ? nlohmann::json(*req.recipe_hash) : nlohmann::json()}};
+      {"recipe_hash", req.recipe_hash ? nlohmann::json(*req.recipe_hash) : nlohmann::json()},
+      {"population", PopulationText(req.population)},
+      {"subgroup", req.subgroup}};
   return {{"window", window},
           {"recipes", recipes},
           {"alarms", alarms},
+          {"spc_alarms", spc_alarms},
           {"gauge", req.gauge_serial ? GaugeReport(store, req) : nlohmann::json()}};
 }
 

@@ -13,6 +13,7 @@ nlohmann::json RecordSummary(const db::TestRecord& r) {
       {"measurements", r.measurements},
       {"started_at", r.started_at},
       {"finished_at", r.finished_at},
+      {"kind", r.kind},  // a master part's self-check is no production unit
       {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}}};
 }
 
@@ -72,6 +73,20 @@ void StatusBoard::SetMessage(const std::string& message) {
   PushEventLocked({{"type", "message"}, {"message", message}});
 }
 
+void StatusBoard::SetSimulation(const std::string& why) {
+  std::lock_guard<std::mutex> lock(mu_);
+  simulation_ = why;
+}
+
+void StatusBoard::SetReadiness(bool ready, const std::string& why) {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (ready == ready_ && why == not_ready_reason_) return;
+  ready_ = ready;
+  not_ready_reason_ = ready ? "" : why;
+  PushEventLocked(
+      {{"type", "readiness"}, {"ready", ready_}, {"not_ready_reason", not_ready_reason_}});
+}
+
 void StatusBoard::SetLockout(const nlohmann::json& lockout) {
   std::lock_guard<std::mutex> lock(mu_);
   if (lockout == lockout_) return;
@@ -86,6 +101,9 @@ nlohmann::json StatusBoard::Snapshot() const {
           {"serial", serial_},
           {"detail", detail_},
           {"message", message_},
+          {"ready", ready_},
+          {"not_ready_reason", not_ready_reason_},
+          {"simulation", simulation_},
           {"recipe", {{"id", recipe_id_}, {"hash", recipe_hash_}}},
           {"counts", {{"pass", pass_}, {"fail", fail_}, {"error", error_}, {"aborted", aborted_}}},
           {"last", last_},

@@ -34,12 +34,20 @@ class StatusBoard {
   void SetRecipe(const std::string& recipe_id, const std::string& recipe_hash);
   // Free text for the operator ("locked out: ...", "fixture not answering").
   void SetMessage(const std::string& message);
+  // Simulators or recorded data instead of the fixture and the DAQ: the page shows
+  // SIMULATION and every record says so (conditions.simulation). Set once at start.
+  void SetSimulation(const std::string& why);
+  // Ready: the fixture and the DAQ answered (at start or at the latest test). `why` names
+  // what did not answer.
+  void SetReadiness(bool ready, const std::string& why);
   // The self-check lockout (station/self_check.h LockoutState::ToJson): {"locked", "reason",
   // "good", "limit", "tests_since_check"}; null while self-checks are off.
   void SetLockout(const nlohmann::json& lockout);
 
-  // {"station_id", "state", "serial", "detail", "message", "recipe": {...}, "counts": {...},
-  //  "last": {serial, outcome, reasons [{code, text}], measurements, finished_at, id} | null,
+  // {"station_id", "state", "serial", "detail", "message", "ready", "not_ready_reason",
+  //  "simulation": "" | "<why>", "recipe": {...}, "counts": {...},
+  //  "last": {serial, outcome, reasons [{code, text}], measurements, finished_at, id,
+  //           kind: "production" | "self_check"} | null,
   //  "recent": [...], "lockout": {...} | null}
   nlohmann::json Snapshot() const;
 
@@ -61,6 +69,9 @@ class StatusBoard {
   std::string serial_;
   std::string detail_;
   std::string message_;
+  std::string simulation_;  // empty: real fixture and DAQ
+  bool ready_ = false;
+  std::string not_ready_reason_ = "drivers not connected yet";
   nlohmann::json last_;     // null until the first verdict
   nlohmann::json lockout_;  // null while self-checks are off
   std::deque<nlohmann::json> recent_;

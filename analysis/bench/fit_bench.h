@@ -27,6 +27,7 @@
 
 #include "analysis/impedance_analysis.h"
 #include "analysis/model/motor_model.h"
+#include "analysis/progress.h"
 #include "analysis/signal/multisine.h"
 #include "analysis/signal/recording.h"
 
@@ -40,7 +41,32 @@ Recording SimulatePeriodicRecording(const MotionalImpedance& motor, const Excita
                                     std::size_t periods, double voltage_noise_v,
                                     double current_noise_a, std::uint64_t seed);
 
+// The same measurement simulated FROM REST in the time domain (analysis/sim/time_domain.h):
+// the amplifier plays `periods` periods into a one-inertia clamped motor with this
+// impedance (J_r = 1e-4 kg m^2; Z does not depend on it) through series_ohm (amplifier
+// output + shunt), so both recorded channels (motor voltage and current) carry the start
+// transient. Noise as above. Deterministic in seed.
+Recording SimulateRecordingFromRest(const MotionalImpedance& motor, const Excitation& excitation,
+                                    std::size_t periods, double series_ohm, double voltage_noise_v,
+                                    double current_noise_a, std::uint64_t seed);
+
+// Per-line complex std of Z from the channels' true sample noise alone, for a record of
+// `periods` periods analysed as one (no price for a transient): NOTES.md 3 with the line
+// amplitudes of the motor voltage and current through series_ohm,
+//   sigma_k^2 = |Z_k|^2 (4 s_u^2 / (P n |U_k|^2) + 4 s_i^2 / (P n |I_k|^2)).
+std::vector<double> TrueNoiseLineSigma(const MotionalImpedance& motor, const Excitation& excitation,
+                                       std::size_t periods, double series_ohm,
+                                       double voltage_noise_v, double current_noise_a);
+
+// How fit-bench simulates the recordings.
+enum class BenchSimulation {
+  kSteadyState,  // SimulatePeriodicRecording: no transient (the first periods are steady too)
+  kTimeDomain,   // SimulateRecordingFromRest: the start transient is in the record
+};
+
 struct FitBenchOptions {
+  BenchSimulation simulation = BenchSimulation::kSteadyState;
+  double series_ohm = 0.0;  // kTimeDomain: amplifier output + shunt resistance
   MotionalImpedance truth{0.5, 2.0e-3, 0.51, 390.0, 50.0};
   MultisineOptions excitation;        // the recipe's
   std::size_t periods = 4;            // averaged
@@ -54,6 +80,8 @@ struct FitBenchOptions {
   int check_runs = 200;  // runs of the measurement-time check (0: skip it)
   // The first keep_recordings recordings are returned (for an external peer).
   std::size_t keep_recordings = 0;
+  // Sees each finished run: phase "runs", then "check runs" (analysis/progress.h).
+  ProgressCallback progress;
 
   bool IsValid(std::string* why) const;
 };
@@ -69,6 +97,12 @@ struct FitBenchResult {
   double crb_f0_hz = 0.0;              // at the truth, rms of the reported line sigmas
   double crb_f0_closed_form_hz = 0.0;  // NOTES.md 4 closed form, the line sigma at f0
   double std_over_crb = 0.0;
+  // The bound with the channels' true noise over every recorded period (TrueNoiseLineSigma:
+  // what an estimator that wasted nothing would have) and the ratio to it.
+  double crb_true_noise_f0_hz = 0.0;
+  double std_over_crb_true_noise = 0.0;
+  double bias_over_std = 0.0;  // ml_bias_hz / f0_std_hz
+  double noise_dof = 0.0;      // FrfSummary::noise_dof of the first usable run
   // (2)
   double mean_reported_f_sigma_hz = 0.0;
   double coverage_2sigma = 0.0;

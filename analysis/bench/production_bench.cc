@@ -2,8 +2,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <mutex>
+#include <random>
 #include <thread>
 
 #include "analysis/impedance_analysis.h"
@@ -13,6 +15,7 @@ namespace eol::analysis {
 namespace {
 
 constexpr std::uint64_t kGoldenIndexBase = 1000000000ULL;
+constexpr std::uint64_t kPodIndexBase = 2000000000ULL;  // + sweep x 1e8 + unit
 
 std::size_t ClassIndex(DefectClass c) {
   for (std::size_t i = 0; i < kAllDefectClasses.size(); ++i)
@@ -51,6 +54,53 @@ Outcome JudgeWith(const std::vector<MeasurementSpec>& limits, const std::vector<
           Estimate{static_cast<double>(CheckMask(m.frf, mask).lines_outside), 0.0};
   }
   return Judge(specs, values).outcome;
+}
+
+double ResonanceHz(const Measured& m) {
+  const auto it = m.analysis.values.find("resonance_f_hz");
+  return m.analysis.usable && it != m.analysis.values.end() ? it->second.value : std::nan("");
+}
+
+// Runs body(i) for i in [0, n) on `threads` threads, reporting each finished i to
+// o.progress under `phase`.
+template <typename Body>
+void ParallelFor(const ProductionBenchOptions& o, std::string_view phase, int n, int threads,
+                 Body body) {
+  std::atomic<int> next{0};
+  std::atomic<std::int64_t> done{0};
+  if (o.progress) o.progress(phase, 0, n);
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t)
+    pool.emplace_back([&] {
+      for (int i = next++; i < n; i = next++) {
+        body(i);
+        const std::int64_t d = ++done;
+        if (o.progress) o.progress(phase, d, n);
+      }
+    });
+  for (auto& t : pool) t.join();
+}
+
+void RunPodSweep(const ProductionBenchOptions& o, const LineMeasurementSetup& setup,
+                 const TeachSummary& teach, std::uint64_t sweep, PodSweep& w) {
+  const auto n = static_cast<std::size_t>(o.pod_units);
+  w.data.assign(n, HitMiss{});
+  w.f0_hz.assign(n, std::nan(""));
+  ParallelFor(o, "POD " + w.name, o.pod_units, o.threads, [&](int i) {
+    const std::uint64_t index =
+        kPodIndexBase + sweep * 100000000ULL + static_cast<std::uint64_t>(i);
+    std::mt19937_64 gen(NoiseSeed(o.seed, index) ^ 0x5DEECE66DULL);
+    const double loss = std::uniform_real_distribution<double>(o.pod_loss_lo, o.pod_loss_hi)(gen);
+    RotorChainParams nominal = o.rotor;
+    nominal.bond_poor = {o.rotor.bond.stiffness_nm_per_rad * (1.0 - loss),
+                         o.rotor.bond.damping_nms_per_rad * (1.0 - loss)};
+    const LineUnit unit = DrawLineUnit(nominal, o.spread, w.defect, o.seed, index);
+    const Measured m = MeasureUnit(o, setup, unit, index);
+    const auto k = static_cast<std::size_t>(i);
+    w.data[k] = {loss, JudgeWith(teach.limits, teach.masks, m) != Outcome::kPass};
+    w.f0_hz[k] = ResonanceHz(m);
+  });
+  w.fit = FitPod(w.data, o.pod);
 }
 
 void Count(ClassCounts& c, Outcome o) {
@@ -98,6 +148,10 @@ bool ProductionBenchOptions::IsValid(std::string* why) const {
   if (!rates.IsValid(&w)) return fail("rates: " + w);
   if (!naive.IsValid(&w)) return fail(w);
   if (declared.empty()) return fail("the recipe declares no scalar limit");
+  if (pod_units < 0 || pod_units > 1000000) return fail("pod_units must be in [0, 1000000]");
+  if (!(pod_loss_lo > 0.0 && pod_loss_lo <= pod_loss_hi && pod_loss_hi < 1.0))
+    return fail("pod losses must satisfy 0 < lo <= hi < 1");
+  if (!pod.IsValid(&w)) return fail("pod: " + w);
   return true;
 }
 
@@ -130,24 +184,17 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
   // 1. Golden units and teaching.
   std::vector<GoldenUnit> golden(static_cast<std::size_t>(o.golden_units));
   std::vector<int> golden_ok(golden.size(), 0);
-  {
-    std::atomic<std::size_t> next{0};
-    auto work = [&] {
-      for (std::size_t i = next++; i < golden.size(); i = next++) {
-        const std::uint64_t index = kGoldenIndexBase + i;
-        const LineUnit unit = DrawLineUnit(o.rotor, o.spread, DefectClass::kGood, o.seed, index);
-        Measured m = MeasureUnit(o, setup, unit, index);
-        golden[i].label = "golden-" + std::to_string(i);
-        if (!m.analysis.usable) continue;
-        for (const auto& [name, e] : m.analysis.values) golden[i].values[name] = e.value;
-        golden[i].curve = std::move(m.frf);
-        golden_ok[i] = 1;
-      }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(work);
-    for (auto& t : pool) t.join();
-  }
+  ParallelFor(o, "golden units", o.golden_units, threads, [&](int k) {
+    const auto i = static_cast<std::size_t>(k);
+    const std::uint64_t index = kGoldenIndexBase + i;
+    const LineUnit unit = DrawLineUnit(o.rotor, o.spread, DefectClass::kGood, o.seed, index);
+    Measured m = MeasureUnit(o, setup, unit, index);
+    golden[i].label = "golden-" + std::to_string(i);
+    if (!m.analysis.usable) return;
+    for (const auto& [name, e] : m.analysis.values) golden[i].values[name] = e.value;
+    golden[i].curve = std::move(m.frf);
+    golden_ok[i] = 1;
+  });
   std::vector<GoldenUnit> usable_golden;
   for (std::size_t i = 0; i < golden.size(); ++i)
     if (golden_ok[i]) usable_golden.push_back(std::move(golden[i]));
@@ -161,6 +208,8 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
   // 2. Production units, judged three ways.
   std::mutex merge;
   std::atomic<int> next{0};
+  std::atomic<std::int64_t> done{0};
+  if (o.progress) o.progress("production units", 0, o.units);
   auto work = [&] {
     ProductionBenchSummary local;
     for (int i = next++; i < o.units; i = next++) {
@@ -171,6 +220,10 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
       Count(local.counts[0][c], JudgeWith(s.teach.limits, s.teach.masks, m));
       Count(local.counts[1][c], JudgeWith(o.declared, o.recipe_masks, m));
       Count(local.counts[2][c], NaivePass(m.frf, o.naive) ? Outcome::kPass : Outcome::kFail);
+      const double f0 = ResonanceHz(m);
+      if (std::isfinite(f0)) local.f0_hz[c].push_back(f0);
+      const std::int64_t d = ++done;
+      if (o.progress) o.progress("production units", d, o.units);
     }
     const std::lock_guard<std::mutex> lock(merge);
     for (std::size_t r = 0; r < kBenchRules.size(); ++r)
@@ -180,10 +233,22 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
         s.counts[r][c].fail += local.counts[r][c].fail;
         s.counts[r][c].error += local.counts[r][c].error;
       }
+    for (std::size_t c = 0; c < kAllDefectClasses.size(); ++c)
+      s.f0_hz[c].insert(s.f0_hz[c].end(), local.f0_hz[c].begin(), local.f0_hz[c].end());
   };
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) pool.emplace_back(work);
   for (auto& t : pool) t.join();
+
+  // 3. POD sweeps.
+  if (o.pod_units > 0) {
+    s.pod.resize(2);
+    s.pod[0].name = "one_magnet";
+    s.pod[0].defect = DefectClass::kOneSoftMagnet;
+    s.pod[1].name = "all_magnets";
+    s.pod[1].defect = DefectClass::kAllSoft;
+    for (std::size_t k = 0; k < s.pod.size(); ++k) RunPodSweep(o, setup, s.teach, k, s.pod[k]);
+  }
 
   s.units = o.units;
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

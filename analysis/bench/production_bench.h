@@ -11,8 +11,14 @@
 //      naive   |Z| peak in a fixed window (naive_rule.h).
 //    A unit counts as rejected when the verdict is FAIL or ERROR (ERROR is a retest, not a
 //    ship). An escape is a defective unit that PASSes; a false reject a good unit that does not.
+// 3. Probability of detection (pod.h, MIL-HDBK-1823A hit/miss): for "one magnet" (one soft
+//    magnet) and "all magnets" (every magnet soft) pod_units units each, the soft bonds'
+//    stiffness loss a drawn uniform on [pod_loss_lo, pod_loss_hi] per unit (stiffness and
+//    damping of the good bond times 1 - a, then the line's per-magnet spread), judged by the
+//    taught limits (hit: FAIL or ERROR); POD(a) and a90/95 are fitted from those hits.
 // Each unit is drawn from (seed, index) alone, so the figures do not depend on the number of
-// threads. Golden units use indices from 1e9 up, disjoint from the production units.
+// threads. Golden units use indices from 1e9 up, POD units from 2e9 up, disjoint from the
+// production units.
 #pragma once
 
 #include <array>
@@ -22,7 +28,9 @@
 
 #include "analysis/bench/naive_rule.h"
 #include "analysis/fit/resonance_fit.h"
+#include "analysis/progress.h"
 #include "analysis/qc/line_population.h"
+#include "analysis/qc/pod.h"
 #include "analysis/qc/teach.h"
 #include "analysis/signal/multisine.h"
 
@@ -45,6 +53,15 @@ struct ProductionBenchOptions {
   LineSpread spread;
   DefectRates rates;
   NaivePeakRule naive;
+  int pod_units = 400;  // per POD sweep (0: none)
+  // The sweep is a designed experiment: sizes where POD rises (MIL-HDBK-1823A asks for sizes
+  // spanning the transition). Below a loss of 0.8 no limit responds (eol detectability's model
+  // POD stays at the false-call level), so units there would only pile up misses.
+  double pod_loss_lo = 0.80, pod_loss_hi = 0.99;
+  PodOptions pod;
+  // Sees the phases "golden units", "production units", "POD one_magnet" and
+  // "POD all_magnets" (analysis/progress.h); called from the worker threads.
+  ProgressCallback progress;
 
   bool IsValid(std::string* why) const;
 };
@@ -61,12 +78,25 @@ inline constexpr std::array<BenchRule, 3> kBenchRules = {BenchRule::kTaught, Ben
                                                          BenchRule::kNaive};
 const char* ToString(BenchRule r);
 
+// One POD sweep: the units' defect sizes and hits, their fitted f0 (NaN when the fit was not
+// usable), and POD(a).
+struct PodSweep {
+  std::string name;  // "one_magnet" or "all_magnets"
+  DefectClass defect = DefectClass::kOneSoftMagnet;
+  std::vector<HitMiss> data;
+  std::vector<double> f0_hz;
+  PodSummary fit;
+};
+
 struct ProductionBenchSummary {
   bool usable = false;
   std::string message;
   TeachSummary teach;
   // counts[rule][class], class in kAllDefectClasses order.
   std::array<std::array<ClassCounts, kAllDefectClasses.size()>, kBenchRules.size()> counts{};
+  std::vector<PodSweep> pod;
+  // Fitted f0 of every production unit per class (kAllDefectClasses order; usable fits only).
+  std::array<std::vector<double>, kAllDefectClasses.size()> f0_hz{};
   int units = 0;
   double seconds = 0.0;  // wall time of the whole benchmark
   double golden_seconds = 0.0;

@@ -22,6 +22,10 @@ Frf MotionalImpedance::Evaluate(const std::vector<double>& freq_hz) const {
   return z;
 }
 
+double MotionalImpedance::ResidueOhmPerS() const {
+  return rp_ohm * 2.0 * std::numbers::pi * f0_hz / q;
+}
+
 double ClampedRotor::EffectiveStiffnessNmPerRad() const {
   if (std::isinf(k_fixture_nm_per_rad)) return k_rotor_nm_per_rad;
   return k_rotor_nm_per_rad * k_fixture_nm_per_rad / (k_rotor_nm_per_rad + k_fixture_nm_per_rad);

@@ -24,6 +24,13 @@ struct MotionalImpedance {
 
   std::complex<double> At(double f_hz) const;
   Frf Evaluate(const std::vector<double>& freq_hz) const;  // method "model", no sigma
+  // The mode's residue T^2 / J = Rp w0 / Q (ohm/s): the inverse of the inertia that follows
+  // the magnets, where the torque acts, scaled by T^2. Loosening a magnet's bond lets less
+  // inertia follow it, so the residue rises: about twelve times faster, in relative terms, than
+  // the resonance falls (tests/peers/independent_population.py's chain, all ten bonds at a
+  // stiffness loss of 0.8: f0 -0.9 %, residue +10 %), while the fixture moves f0 but hardly
+  // the residue (the whole rotor follows a soft clamp alike).
+  double ResidueOhmPerS() const;
 };
 
 // The fixed-shaft torsional system reduced to its first mode: the rotor (magnets and poles,

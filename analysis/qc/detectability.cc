@@ -57,7 +57,7 @@ RotorChainParams WithFixtureScale(const RotorChainParams& p, double scale) {
 // (noise variance / p_scale, chi2_0 x p_scale); spread_scale_f0 rescales the f0 spread.
 std::vector<MeasurementSeparation> Separate(const DetectabilityOptions& o, const Expected& good,
                                             const Expected& defect, double p_scale,
-                                            double spread_scale_f0) {
+                                            double spread_scale_f0, double spread_scale = 1.0) {
   std::vector<MeasurementSeparation> out;
   const int dof = good.analysis.fit.dof;
   for (const auto& [name, g] : good.analysis.values) {
@@ -70,14 +70,14 @@ std::vector<MeasurementSeparation> Separate(const DetectabilityOptions& o, const
       m.good = 1.0 + good.analysis.fit.chi2 * p_scale / dof;
       m.defect = 1.0 + defect.analysis.fit.chi2 * p_scale / dof;
       m.sigma = std::sqrt(2.0 / dof);
-      m.spread = given != o.unit_spread.end() ? given->second : 0.0;
+      m.spread = given != o.unit_spread.end() ? given->second * spread_scale : 0.0;
     } else {
       if (given == o.unit_spread.end()) continue;
       m.good = g.value;
       m.defect = d->second.value;
       m.sigma = g.sigma / std::sqrt(p_scale);
-      m.spread =
-          given->second * (name == std::string(names::kResonanceFHz) ? spread_scale_f0 : 1.0);
+      m.spread = given->second * spread_scale *
+                 (name == std::string(names::kResonanceFHz) ? spread_scale_f0 : 1.0);
     }
     const double total = std::hypot(m.spread, m.sigma);
     m.separation = total > 0.0 ? std::abs(m.defect - m.good) / total : 0.0;
@@ -120,7 +120,12 @@ bool DetectabilityOptions::IsValid(std::string* why) const {
     if (!(s >= 0.0 && std::isfinite(s))) return fail("unit spread of " + name + " must be >= 0");
   for (double f : bond_fractions)
     if (!(f > 0.0 && f <= 1.0)) return fail("bond fractions must be in (0, 1]");
+  for (double a : pod_losses)
+    if (!(a > 0.0 && a < 1.0)) return fail("pod losses must be in (0, 1)");
   if (!(required_sigmas > 0.0)) return fail("required_sigmas must be positive");
+  if (spread_units < 0) return fail("spread_units must not be negative");
+  if (!(pod_confidence > 0.5 && pod_confidence < 1.0))
+    return fail("pod_confidence must be in (0.5, 1)");
   return true;
 }
 
@@ -251,6 +256,70 @@ DetectabilitySummary PredictDetectability(const DetectabilityOptions& o) {
     }
     s.classes.push_back(p);
   }
+  // detectability.h: the spread's upper confidence bound, s sqrt(nu / chi2_nu(1 - gamma)).
+  double upper_spread = std::nan("");
+  if (o.spread_units >= 2) {
+    const double nu = o.spread_units - 1;
+    double lo = 0.0, hi = nu;  // chi2 quantile at 1 - gamma: upper tail gamma
+    while (ChiSquareUpperTail(hi, nu) > 1.0 - o.pod_confidence) hi *= 2.0;
+    for (int it = 0; it < 100; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (ChiSquareUpperTail(mid, nu) > o.pod_confidence ? lo : hi) = mid;
+    }
+    upper_spread = std::sqrt(nu / (0.5 * (lo + hi)));
+  }
+  // a90 on a grid of (loss, POD): POD stays >= 0.9 from there on; NaN when it ends below.
+  auto stays_above = [](const std::vector<ModelPodPoint>& pts, double ModelPodPoint::*pod) {
+    for (std::size_t k = pts.size(); k-- > 0;) {
+      if (pts[k].*pod < 0.9) {
+        if (k + 1 == pts.size()) return std::nan("");
+        const ModelPodPoint &lo = pts[k], &up = pts[k + 1];
+        return lo.loss + (0.9 - lo.*pod) / (up.*pod - lo.*pod) * (up.loss - lo.loss);
+      }
+    }
+    return pts.empty() ? std::nan("") : pts.front().loss;
+  };
+  for (const char* which : {"one_magnet", "all_magnets"}) {
+    ModelPod pod;
+    pod.name = which;
+    for (double a : o.pod_losses) {
+      RotorChainParams p = o.rotor;
+      p.bond_poor = {o.rotor.bond.stiffness_nm_per_rad * (1.0 - a),
+                     o.rotor.bond.damping_nms_per_rad * (1.0 - a)};
+      p.soft_magnets.clear();
+      const int soft = std::string(which) == "one_magnet" ? 1 : p.magnets;
+      for (int i = 0; i < soft; ++i) p.soft_magnets.push_back(i);
+      const Expected d = ctx.Evaluate(p);
+      ModelPodPoint pt;
+      pt.loss = a;
+      pt.pod_lower = std::nan("");
+      if (!d.analysis.usable) {
+        pt.pod = 1.0;
+        pt.pod_lower = std::isnan(upper_spread) ? pt.pod_lower : 1.0;
+        pt.best = "fit (ERROR)";
+      } else {
+        pt.f0_hz = d.analysis.fit.Find("f0_hz")->value;
+        for (const auto& m : Separate(o, good, d, 1.0, 1.0))
+          if (1.0 - m.miss_probability > pt.pod) {
+            pt.pod = 1.0 - m.miss_probability;
+            pt.best = m.name;
+          }
+        if (!std::isnan(upper_spread)) {
+          pt.pod_lower = 0.0;
+          for (const auto& m : Separate(o, good, d, 1.0, 1.0, upper_spread))
+            pt.pod_lower = std::max(pt.pod_lower, 1.0 - m.miss_probability);
+        }
+      }
+      pod.points.push_back(pt);
+    }
+    // MIL-HDBK-1823A's reading: a POD that dips again (one soft magnet whose local mode meets
+    // the rotor's) moves a90 past the dip.
+    pod.a90 = stays_above(pod.points, &ModelPodPoint::pod);
+    pod.a90_95 = std::isnan(upper_spread) ? std::nan("")
+                                          : stays_above(pod.points, &ModelPodPoint::pod_lower);
+    s.pod.push_back(pod);
+  }
+
   s.usable = true;
   int separable = 0;
   for (const auto& c : s.classes) separable += c.separable ? 1 : 0;

@@ -21,6 +21,23 @@
 // periods that would (noise-limited measurements only: sigma^2 ~ 1/P, chi2_0 ~ P), and the
 // equivalent phase-pair coupling gain (Rp ~ T^2: a pair with r x the coupling acts as r^2 x
 // the periods).
+// Model POD against the defect size (MIL-HDBK-1823A's POD(a), here from the model rather than
+// from hit/miss units): for "one_magnet" (one soft bond) and "all_magnets" (every bond soft)
+// at each stiffness loss a of pod_losses (stiffness and damping of the good bond times 1 - a),
+// POD(a) = 1 - miss of the best measurement at its recommended limit (the largest of the
+// measurements' detection probabilities: a lower bound for the OR of all limits); a fit that
+// finds no resonance is an ERROR, never a PASS: POD 1. a90 is the loss from which POD stays
+// at or above 0.9 on the grid (interpolated): where POD dips again (one soft magnet whose own
+// mode meets the rotor's near a loss of 0.98) a90 lies past the dip.
+// a90/95 of the model: its one uncertain input is the good units' spread when it was estimated
+// from spread_units golden units (0: given, e.g. from the recipe's limits: no a90/95). Every
+// spread s is replaced by its one-sided upper confidence bound s sqrt(nu / chi2_nu(1 - gamma)),
+// nu = spread_units - 1, gamma = pod_confidence; a wider spread puts the recommended limit
+// further out and scatters the defect more, so POD falls: that curve is a lower confidence
+// bound on POD(a) (pointwise, the model taken as right) and a90/95 is where it reaches 0.9 and
+// stays, as a90 above. It says nothing about the model's own error: hit/miss units do
+// (`eol production-bench`, `eol pod`). The model has no sampling
+// error, so no a90/95: that needs units (hit/miss data from `eol production-bench` or `eol pod`).
 #pragma once
 
 #include <map>
@@ -50,6 +67,10 @@ struct DetectabilityOptions {
   std::map<std::string, double> unit_spread;
   std::vector<double> bond_fractions = {0.1, 0.3, 0.5, 0.7, 0.9};
   double required_sigmas = 3.0;
+  std::vector<double> pod_losses = {0.2,  0.4,  0.6,  0.7,  0.8,  0.85, 0.9,
+                                    0.92, 0.94, 0.95, 0.96, 0.97, 0.98, 0.99};
+  int spread_units = 0;  // golden units unit_spread was estimated from (0: not a sample)
+  double pod_confidence = 0.95;
 
   bool IsValid(std::string* why) const;
 };
@@ -79,6 +100,21 @@ struct DefectPrediction {
   std::vector<std::string> remedies;
 };
 
+struct ModelPodPoint {
+  double loss = 0.0;  // a
+  double pod = 0.0;
+  double pod_lower = 0.0;  // with the spread at its upper bound (NaN without spread_units)
+  double f0_hz = 0.0;      // predicted fitted f0 (0 when the fit finds none)
+  std::string best;        // measurement that gives the POD
+};
+
+struct ModelPod {
+  std::string name;  // "one_magnet", "all_magnets"
+  std::vector<ModelPodPoint> points;
+  double a90 = 0.0;     // NaN when POD ends below 0.9 on the grid
+  double a90_95 = 0.0;  // the same on pod_lower; NaN without spread_units or when not reached
+};
+
 struct DetectabilitySummary {
   bool usable = false;
   std::string message;
@@ -86,6 +122,7 @@ struct DetectabilitySummary {
   double f0_good_hz = 0.0, q_good = 0.0, chi2_good = 0.0;
   int dof = 0;
   std::vector<DefectPrediction> classes;
+  std::vector<ModelPod> pod;
 };
 
 DetectabilitySummary PredictDetectability(const DetectabilityOptions& options);

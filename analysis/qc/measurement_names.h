@@ -12,9 +12,13 @@ inline constexpr std::string_view kResonanceQ = "resonance_q";         // 1: its
 inline constexpr std::string_view kWindingROhm = "winding_r_ohm";      // ohm: phase-pair resistance
 inline constexpr std::string_view kWindingLH = "winding_l_h";          // H: phase-pair inductance
 inline constexpr std::string_view kMotionalRpOhm = "motional_rp_ohm";  // ohm: peak height T^2/R_m
+// ohm/s: T^2 / J = Rp w0 / Q, the resonance's residue (motor_model.h): rises as bonds soften
+inline constexpr std::string_view kMotionalResidueOhmPerS = "motional_residue_ohm_per_s";
 inline constexpr std::string_view kFitChi2PerDof = "fit_chi2_per_dof";  // 1: goodness of fit
 
-inline constexpr std::array<std::string_view, 6> kAll = {
-    kResonanceFHz, kResonanceQ, kWindingROhm, kWindingLH, kMotionalRpOhm, kFitChi2PerDof};
+// In the export schema's column order (db/export_schema.h): append only.
+inline constexpr std::array<std::string_view, 7> kAll = {
+    kResonanceFHz,  kResonanceQ,    kWindingROhm,           kWindingLH,
+    kMotionalRpOhm, kFitChi2PerDof, kMotionalResidueOhmPerS};
 
 }  // namespace eol::analysis::names

@@ -5,6 +5,13 @@
 #include <cstdio>
 
 namespace eol::analysis {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
 namespace {
 
 std::string Num(double v, int digits = 4) {
@@ -29,33 +36,6 @@ SampleSummary Summarize(const std::vector<double>& x) {
   s.min = *lo;
   s.max = *hi;
   return s;
-}
-
-Capability ComputeCapability(const std::vector<double>& values, const Limit& limits) {
-  Capability c;
-  c.sample = Summarize(values);
-  if (c.sample.n < 2) {
-    c.message = "fewer than 2 values";
-    return c;
-  }
-  if (!(c.sample.sd > 0.0)) {
-    c.message = "no spread (every value equal)";
-    return c;
-  }
-  const double m = c.sample.mean, s = c.sample.sd;
-  if (limits.lo && limits.hi) c.cp = (*limits.hi - *limits.lo) / (6.0 * s);
-  std::optional<double> upper, lower;
-  if (limits.hi) upper = (*limits.hi - m) / (3.0 * s);
-  if (limits.lo) lower = (m - *limits.lo) / (3.0 * s);
-  if (upper && lower)
-    c.cpk = std::min(*upper, *lower);
-  else if (upper)
-    c.cpk = upper;
-  else if (lower)
-    c.cpk = lower;
-  c.usable = true;
-  c.message = c.cpk ? "" : "no limits";
-  return c;
 }
 
 bool DriftOptions::IsValid(std::string* why) const {

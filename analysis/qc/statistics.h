@@ -1,15 +1,11 @@
-// Statistics of a measurement over many tests, for quality engineering: process capability,
-// drift alarms and the type-1 gauge study. Pure computation: values in, summaries out; the
+// Statistics of a measurement over many tests, for quality engineering: the sample summary,
+// the drift trend and the type-1 gauge study. Pure computation: values in, summaries out; the
 // station reads the values from the store (station/stats_report.h).
 //
 // Conventions (every figure uses the sample standard deviation s, divisor n - 1):
 //
-// Capability against the limits [LSL, USL] the units were judged against:
-//   Cp  = (USL - LSL) / (6 s)
-//   Cpk = min(USL - mean, mean - LSL) / (3 s)
-//   s is the overall spread of the individual values (the station sees one unit at a time:
-//   there are no rational subgroups, so strictly these are Pp/Ppk). A one-sided limit gives
-//   no Cp and a Cpk from its one side.
+// Capability (Cp/Cpk from the within-subgroup sigma, Pp/Ppk from s) and the control charts
+// are in analysis/qc/spc.h.
 //
 // Drift: least-squares line through the values in test order (x = 0, 1, ..., n - 1):
 //   slope b = Sxy / Sxx, residual variance s_r^2 = SSE / (n - 2), sigma_b = s_r / sqrt(Sxx),
@@ -38,6 +34,9 @@
 
 namespace eol::analysis {
 
+// The median of v (the mean of the two middle values for an even count); NaN when empty.
+double Median(std::vector<double> v);
+
 struct SampleSummary {
   std::size_t n = 0;
   double mean = 0.0;
@@ -46,15 +45,6 @@ struct SampleSummary {
   double max = 0.0;
 };
 SampleSummary Summarize(const std::vector<double>& values);
-
-struct Capability {
-  SampleSummary sample;
-  std::optional<double> cp;   // both limits and s > 0
-  std::optional<double> cpk;  // at least one limit and s > 0
-  bool usable = false;        // n >= 2 and s > 0
-  std::string message;
-};
-Capability ComputeCapability(const std::vector<double>& values, const Limit& limits);
 
 struct DriftOptions {
   double alarm_t = 4.0;

@@ -10,6 +10,7 @@
 
 #include "analysis/enum_names.h"
 #include "analysis/qc/measurement_names.h"
+#include "analysis/qc/statistics.h"
 #include "analysis/qc/tolerance.h"
 
 namespace eol::analysis {
@@ -23,6 +24,7 @@ constexpr double kPlausibilityWeight = 0.002;
 constexpr double kOtherWeight = 0.02;
 constexpr double kMaskMaxWeight = 0.20;   // all segments together
 constexpr double kMaskMinWeight = 0.005;  // all segments together
+constexpr double kResidueWeight = 0.30;
 
 struct SideWeights {
   double lo = 0.0, hi = 0.0;
@@ -32,9 +34,10 @@ struct SideWeights {
 SideWeights DesignWeights(const std::string& name) {
   namespace n = names;
   const double p = kPlausibilityWeight;
-  if (name == n::kResonanceFHz) return {0.40, p, true, false};
-  if (name == n::kFitChi2PerDof) return {p, 0.25, false, true};
+  if (name == n::kResonanceFHz) return {0.30, p, true, false};
+  if (name == n::kFitChi2PerDof) return {p, 0.35, false, true};
   if (name == n::kResonanceQ) return {0.05, p, true, false};
+  if (name == n::kMotionalResidueOhmPerS) return {p, kResidueWeight, false, true};
   return {kOtherWeight, kOtherWeight, true, true};
 }
 
@@ -42,12 +45,6 @@ SideWeights DesignWeights(const std::string& name) {
 // confidence 1 - coverage^n.
 int OneSidedWilksUnitsNeeded(double coverage, double confidence) {
   return static_cast<int>(std::ceil(std::log(1.0 - confidence) / std::log(coverage)));
-}
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 double RobustScale(const std::vector<double>& v, double median) {
@@ -205,11 +202,14 @@ bool TeachOptions::IsValid(std::string* why) const {
   if (mask_segments < 0 || mask_segments > 200) return fail("mask_segments must be in [0, 200]");
   if (!(mask_guard_sigma >= 0.0)) return fail("mask_guard_sigma must not be negative");
   if (!(marginal_scales >= 0.0)) return fail("marginal_scales must not be negative");
+  if (!(known_bad_max_donation >= 0.0 && known_bad_max_donation <= 1.0))
+    return fail("known_bad_max_donation must be in [0, 1]");
   return true;
 }
 
 TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
-                         const std::vector<GoldenUnit>& golden, const TeachOptions& o) {
+                         const std::vector<GoldenUnit>& golden, const TeachOptions& o,
+                         const std::vector<GoldenUnit>& known_bad) {
   TeachSummary s;
   s.units_given = static_cast<int>(golden.size());
   std::string why;
@@ -217,13 +217,19 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
   if (declared.empty()) return Fail(s, "the recipe declares no scalar limit to teach");
   const bool robust = o.method == TeachMethod::kMad;
 
-  // Every golden unit must carry every declared measurement, finite.
-  for (const GoldenUnit& u : golden)
-    for (const MeasurementSpec& d : declared) {
-      const auto it = u.values.find(d.name);
-      if (it == u.values.end() || !std::isfinite(it->second))
-        return Fail(s, "golden unit " + u.label + " has no finite value of " + d.name);
-    }
+  // Every golden (and known-bad) unit must carry every declared measurement, finite.
+  for (const auto* set : {&golden, &known_bad})
+    for (const GoldenUnit& u : *set)
+      for (const MeasurementSpec& d : declared) {
+        const auto it = u.values.find(d.name);
+        if (it == u.values.end() || !std::isfinite(it->second))
+          return Fail(s, std::string(set == &golden ? "golden" : "known-bad") + " unit " + u.label +
+                             " has no finite value of " + d.name);
+      }
+  if (!known_bad.empty() && o.allocation != "physics")
+    return Fail(s,
+                "known-bad units need allocation physics (the even split has no share to "
+                "move)");
 
   // Outliers: robust z over all given units, any measurement.
   std::set<std::size_t> out;
@@ -405,6 +411,84 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
     if (it != factor_cache.end()) return it->second;
     return factor_cache[share] = ToleranceFactorOneSided(n_eff, 1.0 - share, o.confidence);
   };
+  if (!known_bad.empty()) {
+    // teach.h "Known-bad units": scalar bounds at the current weights; which units pass them.
+    auto escapes = [&](std::vector<bool>* caught_by_lo, std::vector<bool>* caught_by_hi) {
+      std::vector<std::string> out;
+      for (const GoldenUnit& u : known_bad) {
+        bool caught = false;
+        for (std::size_t i = 0; i < scalar_count; ++i) {
+          const Stat& st = stats[i];
+          const double v = u.values.at(st.t.name);
+          const bool lo =
+              st.want_lo && v < st.t.centre - factor(alpha * st.w_lo / weight_sum) * st.t.scale;
+          const bool hi =
+              st.want_hi && v > st.t.centre + factor(alpha * st.w_hi / weight_sum) * st.t.scale;
+          if (caught_by_lo && lo) (*caught_by_lo)[i] = true;
+          if (caught_by_hi && hi) (*caught_by_hi)[i] = true;
+          caught = caught || lo || hi;
+        }
+        if (!caught) out.push_back(u.label);
+      }
+      return out;
+    };
+    std::size_t f0 = scalar_count;
+    for (std::size_t i = 0; i < scalar_count; ++i)
+      if (stats[i].t.name == names::kResonanceFHz && stats[i].want_lo) f0 = i;
+    std::vector<bool> by_lo(scalar_count, false), by_hi(scalar_count, false);
+    s.known_bad_units = static_cast<int>(known_bad.size());
+    s.known_bad_escapes_budget = escapes(&by_lo, &by_hi);
+    if (f0 < scalar_count) {
+      Stat& f = stats[f0];
+      auto f0_lo = [&](double w) {
+        return f.t.centre - factor(alpha * w / weight_sum) * f.t.scale;
+      };
+      s.f0_lo_budget_hz = f0_lo(f.w_lo);
+      // Donors: defect-side scalar bounds that catch no known-bad unit, down to plausibility.
+      double movable = 0.0;
+      for (std::size_t i = 0; i < scalar_count; ++i) {
+        const Stat& st = stats[i];
+        if (i != f0 && st.want_lo && st.defect_lo && !by_lo[i])
+          movable += o.known_bad_max_donation * std::max(0.0, st.w_lo - kPlausibilityWeight);
+        if (st.want_hi && st.defect_hi && !by_hi[i])
+          movable += o.known_bad_max_donation * std::max(0.0, st.w_hi - kPlausibilityWeight);
+      }
+      // The highest f0 among the escapes the whole movable share can still catch.
+      double target = -INFINITY;
+      const double reach = f0_lo(f.w_lo + movable);
+      for (const GoldenUnit& u : known_bad)
+        if (std::find(s.known_bad_escapes_budget.begin(), s.known_bad_escapes_budget.end(),
+                      u.label) != s.known_bad_escapes_budget.end()) {
+          // A margin of 1e-5 (relative) keeps the unit caught after Round6 writes the limit.
+          const double v = u.values.at(f.t.name) * (1.0 + 1e-5);
+          if (v < reach) target = std::max(target, v);
+        }
+      if (std::isfinite(target) && movable > 0.0) {
+        double lo = 0.0, hi = movable;  // weight moved: f0_lo(w + hi) > target
+        for (int it = 0; it < 50; ++it) {
+          const double mid = 0.5 * (lo + hi);
+          (f0_lo(f.w_lo + mid) > target ? hi : lo) = mid;
+        }
+        // Each donor gives the same fraction of what it may give.
+        const double moved = hi, scale_down = 1.0 - o.known_bad_max_donation * moved / movable;
+        for (std::size_t i = 0; i < scalar_count; ++i) {
+          Stat& st = stats[i];
+          if (i != f0 && st.want_lo && st.defect_lo && !by_lo[i] && st.w_lo > kPlausibilityWeight) {
+            st.w_lo = kPlausibilityWeight + (st.w_lo - kPlausibilityWeight) * scale_down;
+            s.known_bad_donors.push_back(st.t.name + " lo");
+          }
+          if (st.want_hi && st.defect_hi && !by_hi[i] && st.w_hi > kPlausibilityWeight) {
+            st.w_hi = kPlausibilityWeight + (st.w_hi - kPlausibilityWeight) * scale_down;
+            s.known_bad_donors.push_back(st.t.name + " hi");
+          }
+        }
+        f.w_lo += moved;
+        s.known_bad_moved_share = alpha * moved / weight_sum;
+      }
+      s.f0_lo_hz = f0_lo(f.w_lo);
+    }
+    s.known_bad_escapes = escapes(nullptr, nullptr);
+  }
   for (Stat& st : stats) {
     const double share_lo = even ? 0.0 : alpha * st.w_lo / weight_sum;
     const double share_hi = even ? 0.0 : alpha * st.w_hi / weight_sum;
@@ -469,6 +553,20 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
               " %); " + std::to_string(s.units_needed) + " units needed for limits within " +
               Num(100 * o.width_margin) + " % of a known spread (" +
               std::to_string(s.units_needed_distribution_free) + " distribution-free)" + mask_note;
+  if (s.known_bad_units > 0) {
+    s.message += "; known-bad units: " + std::to_string(s.known_bad_units) + ", " +
+                 std::to_string(s.known_bad_escapes_budget.size()) +
+                 " pass the limits the budget alone sets";
+    if (s.known_bad_moved_share > 0.0)
+      s.message += ", f0 lower bound raised from " + Num(s.f0_lo_budget_hz) + " to " +
+                   Num(s.f0_lo_hz) + " Hz by moving share " + Num(s.known_bad_moved_share) +
+                   " of the budget from bounds that catch none of them (" +
+                   std::to_string(s.known_bad_donors.size()) + ")";
+    s.message += ", " + std::to_string(s.known_bad_escapes.size()) + " pass the taught limits";
+    if (!s.known_bad_escapes.empty())
+      s.message += " (no bound within the budget catches them: " + s.known_bad_escapes.front() +
+                   (s.known_bad_escapes.size() > 1 ? ", ..." : "") + ")";
+  }
   if (s.few_units_forced)
     s.message +=
         "; WARNING: taught from fewer golden units than needed (forced), the limits "

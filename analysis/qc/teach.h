@@ -15,8 +15,15 @@
 // defect moves keeps a plausibility bound (weight 0.002: wrong motor, station fault) so that
 // the recipe keeps its shape without spending the budget there.
 //   measurement        defect side  weight  why
-//   resonance_f_hz     lo           0.40    a softer bond (or looser clamp) only lowers the mode
-//   fit_chi2_per_dof   hi           0.25    a soft magnet's local mode is a peak the one-mode
+//   resonance_f_hz     lo           0.30    a softer bond (or looser clamp) only lowers the mode
+//   motional_residue   hi           0.30    T^2/J: a softer bond lets less inertia follow the
+//     _ohm_per_s                            magnets (where the torque acts); it rises about
+//                                           twelve times faster than f0 falls and hardly moves
+//                                           with the clamp (motor_model.h). Evidence: on the
+//                                           independent generator, all ten bonds at losses of
+//                                           0.85-0.94, 29 of 80 rejected with it, 19 without
+//                                           (independent_population_test part 4)
+//   fit_chi2_per_dof   hi           0.35    a soft magnet's local mode is a peak the one-mode
 //                                           model cannot follow; it only raises chi2
 //   Re Z mask max      hi           0.20    (all segments together) an extra motional peak
 //                                           outside the resonance band only adds Re Z
@@ -51,6 +58,18 @@
 // group), not about lines.
 // Outliers among the golden units: a unit whose robust z = |x - median| / (1.4826 MAD) exceeds
 // outlier_z in any declared measurement is left out (named in the summary) before teaching.
+//
+// Known-bad units (TeachLimits' `known_bad`: limit masters and torn-down rejects an engineer
+// confirmed defective; allocation "physics" only). The budget alone sets every bound as above;
+// a known-bad unit that passes all the scalar bounds so set is an escape. The f0 lower bound
+// then takes share from the defect-side scalar bounds that catch none of the known-bad units
+// (each keeps its plausibility weight and 1 - known_bad_max_donation of the rest), just as much
+// as makes it catch every escape it can: the
+// smallest share s with centre - k(s) scale above the escapes' f0 (k the one-sided factor as
+// above). The total budget, and so the false-reject statement, is unchanged; the bound that
+// catches the known defects gets more of it. Escapes whose f0 lies within what the whole
+// movable share reaches stay escapes and are named: no limit within the budget catches them.
+// Masks are not judged for known-bad units (one they would catch counts as an escape here).
 //
 // Units needed: the smallest n whose factor for the bound with the largest share is at most
 // (1 + width_margin) times that of a perfectly known spread (divided by 0.37 for "mad"); also
@@ -99,6 +118,10 @@ struct TeachOptions {
   int mask_segments = 12;        // in all masks; 0: no mask taught
   double mask_guard_sigma = 3.0;
   double marginal_scales = 1.0;
+  // Known-bad units: the share of each donor bound's weight (above plausibility) that may move
+  // to the f0 lower bound. Below 1 because a bound none of the known-bad units trips may still
+  // catch a defect they do not represent (chi2 and one soft magnet).
+  double known_bad_max_donation = 0.5;
 
   bool IsValid(std::string* why) const;
 };
@@ -139,10 +162,19 @@ struct TeachSummary {
   // Expected share of good units the taught recipe rejects, and its interval at confidence.
   double expected_false_reject = 0.0;
   double false_reject_lo = 0.0, false_reject_hi = 0.0;
+  // Known-bad units (see above); empty when none were given.
+  int known_bad_units = 0;
+  std::vector<std::string> known_bad_escapes_budget;  // passing the limits of the budget alone
+  std::vector<std::string> known_bad_escapes;         // passing the taught limits
+  double f0_lo_budget_hz = 0.0;                       // the f0 lower bound the budget alone sets
+  double f0_lo_hz = 0.0;                              // the taught one
+  double known_bad_moved_share = 0.0;         // share of the budget moved to the f0 lower bound
+  std::vector<std::string> known_bad_donors;  // bounds it was taken from ("name lo|hi")
 };
 
 // Never throws for bad data: usable == false with the reason (names the unit or measurement).
 TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
-                         const std::vector<GoldenUnit>& golden, const TeachOptions& options);
+                         const std::vector<GoldenUnit>& golden, const TeachOptions& options,
+                         const std::vector<GoldenUnit>& known_bad = {});
 
 }  // namespace eol::analysis

@@ -42,4 +42,24 @@ std::string CheckChannels(const ChannelPair& p) {
   return "";
 }
 
+std::string CheckPeriodicPair(const ChannelPair& pair, const std::vector<std::size_t>& lines) {
+  const std::size_t n = pair.period_samples;
+  if (n < 2 || lines.empty()) return "recording is not periodic or no lines are excited";
+  if (!(pair.sample_rate_hz > 0.0)) return "sample rate must be positive";
+  if (lines.front() == 0 || lines.back() >= n / 2)
+    return "excited line " + std::to_string(lines.front() == 0 ? 0 : lines.back()) +
+           " is DC or above Nyquist";
+  return CheckChannels(pair);
+}
+
+std::string NoSignalMessage(const ChannelPair& pair, std::size_t weak_lines, std::size_t lines,
+                            double worst_snr) {
+  if (weak_lines * 10 <= lines) return "";
+  std::ostringstream m;
+  m << "no signal: " << weak_lines << " of " << lines << " excited lines have no " << pair.x_name
+    << " above the noise (worst line SNR " << worst_snr
+    << "); check the excitation relay, amplifier and wiring";
+  return m.str();
+}
+
 }  // namespace eol::analysis

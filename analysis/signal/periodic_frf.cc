@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <utility>
 
 #include "analysis/signal/channel_checks.h"
 #include "analysis/signal/fft.h"
@@ -79,24 +80,11 @@ FrfSummary EstimatePeriodicTransfer(const ChannelPair& pair, const std::vector<s
     out.message = "invalid options: " + why;
     return out;
   }
-  const std::size_t n = pair.period_samples;
-  if (n < 2 || lines.empty()) {
-    out.message = "recording is not periodic or no lines are excited";
-    return out;
-  }
-  if (!(pair.sample_rate_hz > 0.0)) {
-    out.message = "sample rate must be positive";
-    return out;
-  }
-  if (lines.front() == 0 || lines.back() >= n / 2) {
-    out.message = "excited line " + std::to_string(lines.front() == 0 ? 0 : lines.back()) +
-                  " is DC or above Nyquist";
-    return out;
-  }
-  if (const std::string bad = CheckChannels(pair); !bad.empty()) {
+  if (const std::string bad = CheckPeriodicPair(pair, lines); !bad.empty()) {
     out.message = bad;
     return out;
   }
+  const std::size_t n = pair.period_samples;
   const std::size_t periods = pair.x.size() / n;
   if (periods < o.transient_periods + o.min_periods) {
     out.message = "only " + std::to_string(periods) + " whole periods recorded; need " +
@@ -173,14 +161,12 @@ FrfSummary EstimatePeriodicTransfer(const ChannelPair& pair, const std::vector<s
   }
   out.periods_used = p_used;
   out.periods_dropped = first;
+  out.noise_dof = (pd - 1.0) * static_cast<double>(2 * hw + 1);
   // More than a tenth of the lines without input is no measurement (open circuit, relay
   // off, amplifier dead); a few weak lines are dropped and said.
-  if (weak_lines * 10 > lines.size()) {
-    std::ostringstream m;
-    m << "no signal: " << weak_lines << " of " << lines.size() << " excited lines have no "
-      << pair.x_name << " above the noise (worst line SNR " << worst_snr
-      << "); check the excitation relay, amplifier and wiring";
-    out.message = m.str();
+  if (std::string none = NoSignalMessage(pair, weak_lines, lines.size(), worst_snr);
+      !none.empty()) {
+    out.message = std::move(none);
     return out;
   }
   std::ostringstream m;

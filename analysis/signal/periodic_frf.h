@@ -53,6 +53,10 @@ struct FrfSummary {
   Frf frf;              // the pair's quantity, method "periodic-eiv"
   std::size_t periods_used = 0;
   std::size_t periods_dropped = 0;
+  // Complex degrees of freedom of the noise (co)variances behind sigma (after pooling over
+  // neighbouring lines; an edge line has fewer): (P - 1)(2 h + 1) for the periodic
+  // estimator, the effective value of transient_frf.h for the transient-aware one.
+  double noise_dof = 0.0;
 };
 
 // `lines` are the excited bins of one period (Excitation::lines). Never throws for bad data:

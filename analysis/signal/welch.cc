@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "analysis/qc/statistics.h"
 #include "analysis/signal/channel_checks.h"
 #include "analysis/signal/fft.h"
 
@@ -38,12 +39,6 @@ double EquivalentAverages(const std::vector<double>& w, std::size_t step, std::s
 
 bool Constant(std::span<const double> x) {
   return std::all_of(x.begin(), x.end(), [&](double v) { return v == x.front(); });
-}
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 }  // namespace

@@ -68,24 +68,6 @@ std::optional<std::vector<TableWrite>> DecodeWrites(const std::uint8_t* pdu, int
   }
 }
 
-// The function codes a simple fixture PLC answers; the others get "illegal function" (so a
-// mask write or a read/write-multiple can never change the table behind the bench's back).
-bool Supported(int function) {
-  switch (function) {
-    case MODBUS_FC_READ_COILS:
-    case MODBUS_FC_READ_DISCRETE_INPUTS:
-    case MODBUS_FC_READ_HOLDING_REGISTERS:
-    case MODBUS_FC_READ_INPUT_REGISTERS:
-    case MODBUS_FC_WRITE_SINGLE_COIL:
-    case MODBUS_FC_WRITE_SINGLE_REGISTER:
-    case MODBUS_FC_WRITE_MULTIPLE_COILS:
-    case MODBUS_FC_WRITE_MULTIPLE_REGISTERS:
-      return true;
-    default:
-      return false;
-  }
-}
-
 struct Range {
   int start = 0;
   int count = 0;
@@ -313,7 +295,7 @@ void ModbusFixtureServer::Handle(const unsigned char* request, int length) {
     modbus_reply_exception(ctx_, request, MODBUS_EXCEPTION_GATEWAY_TARGET);
     return;
   }
-  if (!Supported(function)) {
+  if (!IsPlainModbusFunction(function)) {
     modbus_reply_exception(ctx_, request, MODBUS_EXCEPTION_ILLEGAL_FUNCTION);
     return;
   }

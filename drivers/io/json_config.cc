@@ -1,7 +1,9 @@
 #include "drivers/io/json_config.h"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace eol::io {
@@ -50,6 +52,14 @@ int JsonObject::Integer(const std::string& key, int fallback) const {
   if (!Has(key)) return fallback;
   const nlohmann::json& v = At(key);
   if (!v.is_number_integer()) Fail(key, "must be a whole number (got " + v.dump() + ")");
+  // get<int>() wraps: 4294967300 would be read as 4.
+  const bool fits =
+      v.is_number_unsigned()
+          ? v.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<int>::max())
+          : v.get<std::int64_t>() >= std::numeric_limits<int>::min() &&
+                v.get<std::int64_t>() <= std::numeric_limits<int>::max();
+  if (!fits)
+    Fail(key, "must be a whole number in [-2147483648, 2147483647] (got " + v.dump() + ")");
   return v.get<int>();
 }
 
@@ -115,7 +125,8 @@ void JsonObject::Require(bool ok, const std::string& key, const std::string& rul
 nlohmann::json ParseJsonText(const std::string& text, const std::string& source) {
   try {
     return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // Not only parse_error: a number beyond double's range ("1e999") is out_of_range.406.
     throw ConfigError(source + ": not valid JSON: " + e.what());
   }
 }

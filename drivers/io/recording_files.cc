@@ -7,6 +7,7 @@
 #include <fstream>
 #include <locale>
 #include <memory>
+#include <sstream>
 
 #include "drivers/io/text_table.h"
 
@@ -32,6 +33,12 @@ analysis::Recording ReadRecordingCsv(const std::string& path) {
     throw FileError(path, t.row_line.back(), 0, "need at least 2 samples to infer the sample rate");
   const double dt = (ts.back() - ts.front()) / static_cast<double>(n - 1);
   if (!(dt > 0.0)) throw t.ErrorAt(n - 1, ct, "time must increase");
+  // Times near the ends of double's range give an infinite span (the grid check below then
+  // passes anything, and the rate is 0) or a subnormal step (an infinite rate).
+  if (!std::isfinite(dt) || !std::isfinite(1.0 / dt))
+    throw t.ErrorAt(n - 1, ct,
+                    "the sample interval " + (std::ostringstream() << dt).str() +
+                        " s gives no finite sample rate");
   for (std::size_t k = 1; k < n; ++k) {
     const double expected = ts.front() + static_cast<double>(k) * dt;
     if (std::abs(ts[k] - expected) > 0.01 * dt)
@@ -87,6 +94,13 @@ analysis::Recording ReadWavRecording(const std::string& path, double voltage_gai
   for (std::size_t k = 0; k < rec.voltage_v.size(); ++k) {
     rec.voltage_v[k] = frames[2 * k] * voltage_gain_v;
     rec.current_a[k] = frames[2 * k + 1] * current_gain_a;
+    // Float encodings can hold NaN and infinities, and a 64-bit float near its maximum
+    // overflows once scaled by the gain; the CSV reader refuses non-finite values too.
+    for (int c = 0; c < 2; ++c)
+      if (!std::isfinite(c == 0 ? rec.voltage_v[k] : rec.current_a[k]))
+        throw FileError(path, 0, 0,
+                        "frame " + std::to_string(k) + ": the " + (c == 0 ? "voltage" : "current") +
+                            " sample is not a finite number once scaled by its gain");
   }
   rec.voltage_full_scale_v = voltage_gain_v;
   rec.current_full_scale_a = current_gain_a;

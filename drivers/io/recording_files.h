@@ -4,7 +4,8 @@
 // ignored): time in s, voltage in V, current in A. The sampling must be uniform: with
 // dt = (t_last - t_first) / (n - 1), every t_k must lie within 1 % of dt of t_first + k dt
 // (times printed with a few decimals pass), else FileError names the first line off the grid.
-// sample_rate_hz = 1 / dt, snapped to the nearest integer when within 1e-6 of it.
+// sample_rate_hz = 1 / dt, snapped to the nearest integer when within 1e-6 of it; FileError
+// when dt or 1 / dt is not finite (times near the ends of double's range).
 // period_samples and full scales are left 0 (the caller knows the excitation).
 //
 // Two-channel WAV (libsndfile; any PCM or float encoding): channel 1 is the voltage, channel 2
@@ -12,7 +13,7 @@
 // [-1, 1) by libsndfile). Gains turn them into physical units: u = voltage_gain_v * ch1,
 // i = current_gain_a * ch2; the full scales of the Recording are the gains, so samples at the
 // converter's limit count as clipped. FileError (no line numbers) when the file cannot be
-// opened, is not two-channel, or is empty.
+// opened, is not two-channel, is empty, or holds a sample that is not finite (frame named).
 #pragma once
 
 #include <string>

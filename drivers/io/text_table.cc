@@ -71,6 +71,8 @@ bool LineReader::Next(std::string* line) {
   if (!any) return false;
   if (!line->empty() && line->back() == '\n') line->pop_back();
   if (!line->empty() && line->back() == '\r') line->pop_back();
+  // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first line.
+  if (line_number_ == 0 && line->rfind("\xEF\xBB\xBF", 0) == 0) line->erase(0, 3);
   ++line_number_;
   return true;
 }
@@ -115,12 +117,27 @@ FileError CsvTable::ErrorAt(std::size_t row, std::size_t column_index,
                    names.at(column_index) + ": " + message);
 }
 
+namespace {
+
+// A header separated by ';' (a spreadsheet in a decimal-comma locale) is refused by name:
+// reading it as ',' would split "1,5" into two numbers.
+void RefuseSemicolons(const std::string& path, std::size_t line_number, const std::string& line) {
+  const std::size_t semi = line.find(';');
+  if (semi != std::string::npos && line.find(',') == std::string::npos)
+    throw FileError(path, line_number, semi + 1,
+                    "columns are separated by ';'; this reader takes ',' with '.' decimals "
+                    "(export the CSV with a comma separator)");
+}
+
+}  // namespace
+
 std::vector<std::string> ReadCsvHeader(const std::string& path) {
   LineReader in(path);
   std::string line;
   std::vector<std::uint32_t> starts;
   while (in.Next(&line)) {
     if (Skippable(line)) continue;
+    RefuseSemicolons(path, in.line_number(), line);
     std::vector<std::string> names;
     for (std::string_view f : SplitCsv(line, &starts)) names.emplace_back(f);
     return names;
@@ -140,6 +157,7 @@ CsvTable ReadCsvTable(const std::string& path) {
     const std::vector<std::string_view> fields = SplitCsv(line, &starts);
     const std::size_t ln = in.line_number();
     if (!header) {
+      RefuseSemicolons(path, ln, line);
       for (std::size_t c = 0; c < fields.size(); ++c) {
         if (fields[c].empty())
           throw FileError(path, ln, starts[c], "empty column name in the header");

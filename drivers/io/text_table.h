@@ -13,7 +13,8 @@
 
 namespace eol::io {
 
-// Reads a text file line by line, without the line end ("\n" or "\r\n"). Throws FileError
+// Reads a text file line by line, without the line end ("\n" or "\r\n") and without a UTF-8
+// byte-order mark at the start of the file. Throws FileError
 // when the file cannot be opened or read. Not copyable.
 class LineReader {
  public:
@@ -41,6 +42,8 @@ double ParseNumber(std::string_view field, const std::string& path, std::size_t 
 
 // A numeric CSV: one header line of column names, then rows of comma-separated numbers.
 // Blank lines and lines starting with '#' are skipped; fields may be padded with spaces.
+// A UTF-8 byte-order mark before the header is accepted (LineReader drops it); a header
+// separated by ';' is refused naming the separator.
 struct CsvTable {
   std::string path;
   std::vector<std::string> names;

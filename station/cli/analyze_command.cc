@@ -7,6 +7,8 @@
 // multisine: for both the excitation-level conditions are listed under
 // verdict.conditions_not_evaluated instead of being judged.
 // A mobility FRF (f_hz,re,im[,sigma]) is fitted with the two-mass model instead (no verdict).
+// --plot FILE draws |Z| and Re Z with the fitted model and the recipe's resonance window and
+// masks (station/curve_chart.h).
 // Exit codes: 0 a usable analysis (whatever the verdict), 1 the data cannot be analysed
 // (reason on stderr and in JSON "error"), 2 usage or file errors.
 #include <cmath>
@@ -19,6 +21,7 @@
 #include "analysis/fit/fit_json.h"
 #include "analysis/impedance_analysis.h"
 #include "analysis/model/two_mass.h"
+#include "analysis/qc/measurement_json.h"
 #include "analysis/signal/waveform.h"
 #include "analysis/signal/welch.h"
 #include "analysis/text.h"
@@ -27,6 +30,7 @@
 #include "drivers/io/measured_input.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/curve_chart.h"
 #include "station/judge.h"
 #include "station/recipe.h"
 
@@ -46,6 +50,7 @@ struct AnalyzeArgs {
   double current_gain = 0.0;
   std::size_t welch_segment = 0;  // > 0: a non-periodic recording, Welch H1
   std::string band;               // Welch: f_lo,f_hi of the reported lines
+  std::string plot;               // SVG (or .png) of the curve against model and limits
 };
 
 class UsageError : public std::runtime_error {
@@ -172,20 +177,12 @@ std::string Sci(double v) {
   return os.str();
 }
 
+// The verdict in the measurement field list (analysis/qc/measurement_json.h), plus the
+// conditions the judge could not evaluate for a file.
 json VerdictJson(const Judgement& v) {
-  json ms = json::array();
-  for (const analysis::Measurement& m : v.measurements)
-    ms.push_back({{"name", m.name},
-                  {"unit", m.unit},
-                  {"value", m.value},
-                  {"sigma", m.sigma},
-                  {"lo", m.limit.lo ? json(*m.limit.lo) : json(nullptr)},
-                  {"hi", m.limit.hi ? json(*m.limit.hi) : json(nullptr)},
-                  {"outcome", analysis::ToString(m.outcome)},
-                  {"marginal", m.marginal}});
-  return {{"outcome", analysis::ToString(v.outcome)},
+  return {{"outcome", v.outcome},
           {"reasons", v.reasons},
-          {"measurements", ms},
+          {"measurements", v.measurements},
           {"conditions_not_evaluated", v.conditions_not_evaluated}};
 }
 
@@ -332,6 +329,31 @@ int RunAnalyze(const AnalyzeArgs& a) {
   Judgement verdict;
   if (recipe) out["verdict"] = JudgeJson(*recipe, result, recording, out, &verdict);
   out["usable"] = true;
+  if (!a.plot.empty()) {
+    CurvePlot p;
+    p.title = "eol analyze " + a.measured;
+    p.freq_hz = z.freq_hz;
+    p.measured = z.value;
+    p.model_freq_hz = z.freq_hz;
+    p.model = fit.Model().Evaluate(z.freq_hz).value;
+    p.f0_hz = f0.value;
+    if (recipe) {
+      p.title += " - recipe " + recipe->id + " v" + std::to_string(recipe->version) + ": " +
+                 analysis::ToString(verdict.outcome);
+      for (const analysis::MeasurementSpec& spec : recipe->limits)
+        if (spec.name == "resonance_f_hz") p.resonance_window = spec.limit;
+      p.masks = recipe->masks;
+      for (const analysis::Reason& r : verdict.reasons) p.notes.push_back(r.text);
+    } else {
+      p.notes.push_back("no --recipe: no limits or masks drawn");
+    }
+    try {
+      io::WriteChart(a.plot, CurveChart(p));
+    } catch (const std::exception& e) {
+      return Fail(a, out, 2, std::string("--plot: ") + e.what());
+    }
+    out["plot"] = a.plot;
+  }
   if (a.json) {
     std::cout << out.dump() << std::endl;
     return 0;
@@ -384,6 +406,9 @@ void AddAnalyzeCommand(CLI::App& app) {
                   "Recipe JSON: fit options, limits for a verdict, and the excitation of a raw "
                   "recording");
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
+  cmd->add_option("--plot", args->plot,
+                  "Write |Z| and Re Z, measured and fitted, with the recipe's resonance window\n"
+                  "and masks (SVG, or PNG for .png)");
   cmd->add_option("--period-samples", args->period_samples,
                   "Raw recording: samples per excitation period (with --lines)");
   cmd->add_option("--lines", args->lines,

@@ -29,6 +29,7 @@ struct CalibrateArgs {
   std::string config;
   double reference_ohm = 0.0;
   std::string out;
+  bool json = false;
 };
 
 // Connects, closes the excitation relay while the interlocks hold, acquires, opens it again.
@@ -103,7 +104,14 @@ int RunCalibrate(const CalibrateArgs& a) {
   f << text;
   f.flush();
   if (!f) throw std::runtime_error("cannot write " + a.out);
-  std::cout << "calibration " << a.out << ": " << s.message << "\n";
+  if (a.json)
+    std::cout << nlohmann::json{{"calibration", a.out},
+                                {"message", s.message},
+                                {"estimate", j["estimate"]}}
+                     .dump()
+              << std::endl;
+  else
+    std::cout << "calibration " << a.out << ": " << s.message << "\n";
   return 0;
 }
 
@@ -120,6 +128,9 @@ void AddCalibrateCommand(CLI::App& app) {
                   "The reference resistor in the fixture, ohm")
       ->required();
   cmd->add_option("--out", args->out, "Calibration JSON to write (default: stdout)");
+  cmd->add_flag("--json", args->json,
+                "With --out: print one JSON object {calibration, message, estimate} instead of "
+                "the text line (without --out the calibration JSON is printed anyway)");
   cmd->callback([args] { RunGuarded("calibrate", [args] { return RunCalibrate(*args); }); });
 }
 

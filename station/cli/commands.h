@@ -23,5 +23,10 @@ void AddCalibrateCommand(CLI::App& app);
 void AddTeachCommand(CLI::App& app);
 void AddDetectabilityCommand(CLI::App& app);
 void AddProductionBenchCommand(CLI::App& app);
+void AddHttpBenchCommand(CLI::App& app);
+void AddCycleBenchCommand(CLI::App& app);
+void AddPodCommand(CLI::App& app);
+void AddRecipeApproveCommand(CLI::App& app);
+void AddPlantBenchCommand(CLI::App& app);
 
 }  // namespace eol::station::cli

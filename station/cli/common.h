@@ -10,4 +10,8 @@ namespace eol::station::cli {
 // exit code 2, a non-zero return becomes that exit code (CLI::RuntimeError).
 void RunGuarded(const std::string& name, const std::function<int()>& body);
 
+// An ISO 8601 time option (--from, --to) normalised to UTC (db/clock.h NormaliseIso8601);
+// throws std::runtime_error naming the option, so the command exits 2.
+std::string IsoOption(const std::string& option, const std::string& value);
+
 }  // namespace eol::station::cli

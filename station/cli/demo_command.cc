@@ -2,15 +2,19 @@
 // known share of poorly cemented rotors, and scoring its verdicts against the truth.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/qc/statistics.h"
+#include "analysis/text.h"
 #include "drivers/emulators/modbus_fixture_server.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/cycle_time.h"
 #include "station/data_files.h"
 #include "station/station.h"
 
@@ -29,6 +33,7 @@ struct DemoArgs {
   double time_scale = 0.0;
   bool verbose = false;
   std::string fixture = "modbus";
+  std::string sim = "time_domain";
 };
 
 double MeasurementValue(const db::TestRecord& r, std::string_view name) {
@@ -39,13 +44,14 @@ double MeasurementValue(const db::TestRecord& r, std::string_view name) {
 
 int RunDemo(const DemoArgs& a) {
   const nlohmann::json sim = {{"population", {{"defect_share", a.defect_share}, {"seed", a.seed}}}};
-  nlohmann::json cfg = {{"station_id", "demo"},
-                        {"recipe", a.recipe},
-                        {"db", a.db},
-                        {"http", {{"listen", a.listen}, {"port", a.port}}},
-                        {"fixture", {{"driver", "sim"}}},
-                        {"daq", {{"driver", "sim"}, {"time_scale", a.time_scale}}},
-                        {"sim", sim}};
+  nlohmann::json cfg = {
+      {"station_id", "demo"},
+      {"recipe", a.recipe},
+      {"db", a.db},
+      {"http", {{"listen", a.listen}, {"port", a.port}}},
+      {"fixture", {{"driver", "sim"}}},
+      {"daq", {{"driver", "sim"}, {"time_scale", a.time_scale}, {"model", a.sim}}},
+      {"sim", sim}};
   spdlog::set_level(a.verbose ? spdlog::level::info : spdlog::level::warn);
   // One simulated bench: the DAQ plays into its motor, and with --fixture modbus the station
   // reaches its clamp and interlocks over real Modbus TCP through the fixture emulator that
@@ -78,6 +84,9 @@ int RunDemo(const DemoArgs& a) {
 
   int pass = 0, fail = 0, error = 0, defective = 0, detected = 0, false_rejects = 0;
   nlohmann::json serials = nlohmann::json::array();
+  // Cycle time per unit (station/cycle_time.h): excitation of all phase pairs, serial
+  // received -> verdict published, and the station's own overhead.
+  std::vector<double> excitation_s, cycle_s, overhead_s;
   for (int i = 1; i <= a.units; ++i) {
     char serial[64];
     std::snprintf(serial, sizeof serial, "DEMO-%llu-%04d", static_cast<unsigned long long>(a.seed),
@@ -85,6 +94,9 @@ int RunDemo(const DemoArgs& a) {
     const db::TestRecord r = station.RunTest(serial);
     const bool is_defective = station.bench()->part() && station.bench()->part()->defective;
     serials.push_back(serial);
+    excitation_s.push_back(CycleStepS(r.cycle_s, "excitation"));
+    cycle_s.push_back(CycleStepS(r.cycle_s, "total"));
+    overhead_s.push_back(StationOverheadS(r.cycle_s));
     switch (r.outcome) {
       case analysis::Outcome::kPass:
         ++pass;
@@ -103,14 +115,20 @@ int RunDemo(const DemoArgs& a) {
       ++false_rejects;
     }
     char line[256];
-    std::snprintf(line, sizeof line, "[%3d/%d] %-16s f0 = %7.2f Hz  %-7s truth: %-9s ", i, a.units,
-                  serial, MeasurementValue(r, analysis::names::kResonanceFHz),
-                  analysis::ToString(r.outcome), is_defective ? "defective" : "good");
+    std::snprintf(line, sizeof line, "[%3d/%d] %-16s f0 = %7.2f Hz  %-7s truth: %-9s %5.2f s ", i,
+                  a.units, serial, MeasurementValue(r, analysis::names::kResonanceFHz),
+                  analysis::ToString(r.outcome), is_defective ? "defective" : "good",
+                  CycleStepS(r.cycle_s, "total"));
     out << line << (r.reasons.empty() ? "" : r.reasons.front().text) << "\n" << std::flush;
   }
   out << "summary: " << a.units << " units: " << pass << " PASS, " << fail << " FAIL, " << error
       << " ERROR; " << detected << " of " << defective << " defective rotors caught, "
-      << false_rejects << " good rotors rejected\n";
+      << false_rejects << " good rotors rejected\n"
+      << "cycle (medians per unit): excitation "
+      << analysis::Fixed(analysis::Median(excitation_s), 3) << " s, serial to verdict "
+      << analysis::Fixed(analysis::Median(cycle_s), 3) << " s, station overhead "
+      << analysis::Fixed(analysis::Median(overhead_s), 3) << " s (time scale " << a.time_scale
+      << ")\n";
   if (a.json) {
     const nlohmann::json summary = {{"units", a.units},
                                     {"pass", pass},
@@ -120,6 +138,10 @@ int RunDemo(const DemoArgs& a) {
                                     {"detected", detected},
                                     {"false_rejects", false_rejects},
                                     {"serials", serials},
+                                    {"excitation_s", analysis::Median(excitation_s)},
+                                    {"cycle_s", analysis::Median(cycle_s)},
+                                    {"overhead_s", analysis::Median(overhead_s)},
+                                    {"time_scale", a.time_scale},
                                     {"db", a.db},
                                     {"http_port", station.http_port()}};
     std::cout << summary.dump() << std::endl;
@@ -163,6 +185,11 @@ void AddDemoCommand(CLI::App& app) {
          "server) on 127.0.0.1; sim: the in-process simulated fixture")
       ->capture_default_str()
       ->check(CLI::IsMember({"modbus", "sim"}));
+  cmd->add_option("--sim", args->sim,
+                  "Simulated motor: time_domain (integrated from rest, start transient\n"
+                  "included, as a real motor) or steady_state (no transient, faster)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"time_domain", "steady_state"}));
   cmd->add_flag("--verbose", args->verbose, "Log every sequencer state (to stderr)");
   cmd->callback([args] { RunGuarded("demo", [&] { return RunDemo(*args); }); });
 }

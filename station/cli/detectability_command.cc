@@ -96,7 +96,9 @@ int RunDetect(const DetectArgs& a) {
   std::string spread_source = "the recipe's limits as +-" + G(a.limit_sigmas) + " sigma";
   if (!a.golden.empty()) {
     std::vector<std::string> skipped;
-    o.unit_spread = SpreadFromGolden(ReadGoldenUnits(a.golden, r, &skipped));
+    const std::vector<analysis::GoldenUnit> golden = ReadGoldenUnits(a.golden, r, &skipped);
+    o.unit_spread = SpreadFromGolden(golden);
+    o.spread_units = static_cast<int>(golden.size());
     spread_source = std::to_string(a.golden.size()) + " golden file(s)";
   }
   const analysis::DetectabilitySummary s = analysis::PredictDetectability(o);
@@ -106,7 +108,24 @@ int RunDetect(const DetectArgs& a) {
     return 1;
   }
   if (a.json) {
-    std::cout << DetectabilityJson(s, source, spread_source, a.required_sigmas).dump() << std::endl;
+    json j = DetectabilityJson(s, source, spread_source, a.required_sigmas);
+    json pod = json::array();
+    for (const auto& p : s.pod) {
+      json points = json::array();
+      for (const auto& pt : p.points)
+        points.push_back(
+            {{"loss", pt.loss},
+             {"pod", pt.pod},
+             {"pod_lower", std::isnan(pt.pod_lower) ? json(nullptr) : json(pt.pod_lower)},
+             {"f0_hz", pt.f0_hz},
+             {"best", pt.best}});
+      pod.push_back({{"name", p.name},
+                     {"a90", std::isnan(p.a90) ? json(nullptr) : json(p.a90)},
+                     {"a90_95", std::isnan(p.a90_95) ? json(nullptr) : json(p.a90_95)},
+                     {"points", points}});
+    }
+    j["pod"] = pod;
+    std::cout << j.dump() << std::endl;
     return 0;
   }
   std::cout << "detectability (" << r.id << " v" << r.version << "): " << s.message << "\n"
@@ -121,6 +140,20 @@ int RunDetect(const DetectArgs& a) {
               G(100.0 * m.miss_probability) + " % pass)";
     std::printf("%-18s %8.2f %6.1f %8.3f %9.1f  %-16s %6.1f  %s\n", c.defect.c_str(), c.f0_hz, c.q,
                 c.chi2_per_dof, c.curve_separation, c.best.c_str(), c.best_separation, rec.c_str());
+  }
+  std::cout << "model POD against the bond stiffness loss a (best measurement at its "
+               "recommended limit); a90/95 "
+            << (o.spread_units >= 2 ? "with the good-unit spread at its 95 % upper bound from " +
+                                          std::to_string(o.spread_units) + " golden units"
+                                    : std::string("needs the spread from golden units (--golden)"))
+            << "; the model's own error: eol production-bench / eol pod:\n";
+  for (const auto& p : s.pod) {
+    std::cout << "  " << p.name << ": a90 "
+              << (std::isnan(p.a90) ? std::string("not reached") : G(p.a90)) << ", a90/95 "
+              << (std::isnan(p.a90_95) ? std::string("-") : G(p.a90_95)) << ";";
+    for (const auto& pt : p.points)
+      std::cout << " " << G(pt.loss) << ":" << G(pt.pod) << (pt.best == "fit (ERROR)" ? "E" : "");
+    std::cout << "\n";
   }
   for (const auto& c : s.classes) {
     if (c.separable) continue;

@@ -16,6 +16,7 @@
 #include "station/bench/fit_bench_peer.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/cli/progress.h"
 #include "station/data_files.h"
 #include "station/recipe.h"
 
@@ -31,6 +32,15 @@ struct FitBenchArgs {
   int peer_runs = 20;
   std::string python = "/usr/bin/python3";
   std::string script = DefaultScipyPipelineScript();
+  // The record: recipe's unless given; how it is simulated and estimated.
+  std::string frf_method;  // empty: the recipe's analysis.frf_method
+  std::string sim = "steady_state";
+  double series_ohm = 0.0;
+  double line_spacing_hz = 0.0;  // 0: the recipe's
+  int periods = 0;               // 0: the recipe's
+  int transient_periods = -1;    // -1: the recipe's
+  int lpm_degree = -1;           // -1: the default of transient_frf.h
+  int lpm_half_width = -1;
 };
 
 std::string G(double v, int precision = 4) {
@@ -60,11 +70,35 @@ int RunFitBench(const FitBenchArgs& a) {
   o.voltage_noise_v = daq.voltage_noise_v;
   o.current_noise_a = daq.current_noise_a;
   o.analysis = recipe.analysis;
+  if (!a.frf_method.empty() && !analysis::ParseFrfMethod(a.frf_method, &o.analysis.frf_method)) {
+    std::cerr << "eol fit-bench: --frf-method must be discard_transient or transient_lpm\n";
+    return 2;
+  }
+  if (a.sim == "time_domain") {
+    o.simulation = analysis::BenchSimulation::kTimeDomain;
+  } else if (a.sim != "steady_state") {
+    std::cerr << "eol fit-bench: --sim must be steady_state or time_domain\n";
+    return 2;
+  }
+  o.series_ohm = a.series_ohm;
+  if (a.line_spacing_hz > 0.0) o.excitation.line_spacing_hz = a.line_spacing_hz;
+  if (a.periods > 0) o.periods = static_cast<std::size_t>(a.periods);
+  if (a.transient_periods >= 0) {
+    o.transient_periods = static_cast<std::size_t>(a.transient_periods);
+    o.analysis.frf.transient_periods = o.transient_periods;
+  }
+  if (a.lpm_degree >= 0) o.analysis.lpm.degree = static_cast<std::size_t>(a.lpm_degree);
+  if (a.lpm_half_width >= 0) o.analysis.lpm.half_width = static_cast<std::size_t>(a.lpm_half_width);
   o.runs = a.runs;
   o.seed = a.seed;
   o.check_runs = a.check_runs;
   o.keep_recordings = static_cast<std::size_t>(std::max(0, std::min(a.peer_runs, a.runs)));
-  const analysis::FitBenchResult r = analysis::RunFitBench(o);
+  analysis::FitBenchResult r;
+  {
+    Progress progress("fit-bench");
+    o.progress = progress.Callback();
+    r = analysis::RunFitBench(o);
+  }
   if (r.usable_runs < 2) {
     std::cerr << "eol fit-bench: only " << r.usable_runs << " of " << r.runs
               << " runs were usable; first failure: " << r.first_failure << std::endl;
@@ -72,7 +106,11 @@ int RunFitBench(const FitBenchArgs& a) {
   }
   ScipyPeerResult peer;
   peer.message = "skipped (--peer-runs 0)";
-  if (a.peer_runs > 0) peer = RunScipyPipelinePeer(r, o, a.python, a.script);
+  // The SciPy pipeline re-implements the discarding estimator only.
+  if (a.peer_runs > 0 && o.analysis.frf_method != analysis::FrfMethod::kDiscardTransient)
+    peer.message = "skipped: the SciPy pipeline implements discard_transient only";
+  else if (a.peer_runs > 0)
+    peer = RunScipyPipelinePeer(r, o, a.python, a.script);
   double peer_max_diff_sigma = 0.0;
   for (std::size_t k = 0; peer.ran && k < peer.f0_hz.size() && k < r.kept_f0_hat_hz.size(); ++k)
     peer_max_diff_sigma =
@@ -97,7 +135,13 @@ int RunFitBench(const FitBenchArgs& a) {
         {"std_hz", r.f0_std_hz},
         {"crb_hz", r.crb_f0_hz},
         {"crb_closed_form_hz", r.crb_f0_closed_form_hz},
-        {"std_over_crb", r.std_over_crb}}},
+        {"std_over_crb", r.std_over_crb},
+        {"crb_true_noise_hz", r.crb_true_noise_f0_hz},
+        {"std_over_crb_true_noise", r.std_over_crb_true_noise},
+        {"bias_over_std", r.bias_over_std}}},
+      {"frf_method", analysis::ToString(o.analysis.frf_method)},
+      {"simulation", a.sim},
+      {"noise_dof", r.noise_dof},
       {"coverage_2sigma", r.coverage_2sigma},
       {"mean_reported_f_sigma_hz", r.mean_reported_f_sigma_hz},
       {"bias",
@@ -125,7 +169,7 @@ int RunFitBench(const FitBenchArgs& a) {
     std::cout << j.dump() << std::endl;
     return 0;
   }
-  const auto& e = recipe.excitation;
+  const auto& e = o.excitation;
   std::cout << "eol fit-bench: recipe " << recipe.id << " v" << recipe.version << ": multisine "
             << G(e.f_lo_hz) << "-" << G(e.f_hi_hz) << " Hz at " << G(e.line_spacing_hz)
             << " Hz spacing, " << G(e.sample_rate_hz) << " Hz, " << G(e.peak_v)
@@ -139,10 +183,18 @@ int RunFitBench(const FitBenchArgs& a) {
             << "(1) std(f0) " << G(r.f0_std_hz) << " Hz; Cramer-Rao bound " << G(r.crb_f0_hz)
             << " Hz (closed form " << G(r.crb_f0_closed_form_hz) << " Hz): ratio "
             << G(r.std_over_crb, 3) << " (target <= 1.1)\n"
+            << "    estimator " << analysis::ToString(o.analysis.frf_method) << " on " << a.sim
+            << " records (noise dof " << G(r.noise_dof, 3) << "); bound with the true noise of all "
+            << (o.simulation == analysis::BenchSimulation::kTimeDomain
+                    ? o.transient_periods + o.periods
+                    : o.periods)
+            << " periods " << G(r.crb_true_noise_f0_hz) << " Hz: ratio "
+            << G(r.std_over_crb_true_noise, 3) << "\n"
             << "(2) coverage of +-2 f_sigma_hz: " << G(100.0 * r.coverage_2sigma, 3)
             << " % (mean reported f_sigma_hz " << G(r.mean_reported_f_sigma_hz) << ")\n"
-            << "(3) bias: ML fit " << G(r.ml_bias_hz) << " Hz; |Z| peak-picking "
-            << G(r.peak_pick_bias_hz) << " Hz (std " << G(r.peak_pick_std_hz) << " Hz), "
+            << "(3) bias: ML fit " << G(r.ml_bias_hz) << " Hz (" << G(r.bias_over_std, 2)
+            << " std); |Z| peak-picking " << G(r.peak_pick_bias_hz) << " Hz (std "
+            << G(r.peak_pick_std_hz) << " Hz), "
             << G(std::abs(r.peak_pick_bias_hz) / r.f0_std_hz, 3) << " ML standard deviations\n"
             << "(4) analysis time per test " << G(r.analysis_ms_mean, 3) << " ms (min "
             << G(r.analysis_ms_min, 3) << " ms)";
@@ -191,6 +243,21 @@ void AddFitBenchCommand(CLI::App& app) {
       ->check(CLI::Range(0, 10000));
   cmd->add_option("--python", args->python, "Python with SciPy")->capture_default_str();
   cmd->add_option("--script", args->script, "The SciPy pipeline")->capture_default_str();
+  cmd->add_option("--frf-method", args->frf_method,
+                  "discard_transient or transient_lpm (default: the recipe's)");
+  cmd->add_option("--sim", args->sim,
+                  "steady_state (no transient) or time_domain (from rest, transient included)")
+      ->capture_default_str();
+  cmd->add_option("--series-ohm", args->series_ohm,
+                  "time_domain: amplifier output + shunt in series with the motor")
+      ->capture_default_str();
+  cmd->add_option("--line-spacing-hz", args->line_spacing_hz, "Override the recipe's spacing");
+  cmd->add_option("--periods", args->periods, "Override the recipe's averaged periods");
+  cmd->add_option("--transient-periods", args->transient_periods,
+                  "Override the recipe's transient periods");
+  cmd->add_option("--lpm-degree", args->lpm_degree, "transient_lpm: polynomial degree");
+  cmd->add_option("--lpm-half-width", args->lpm_half_width,
+                  "transient_lpm: non-excited bins on each side");
   cmd->callback([args] { RunGuarded("fit-bench", [&] { return RunFitBench(*args); }); });
 }
 

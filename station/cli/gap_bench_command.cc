@@ -1,14 +1,18 @@
 // `eol gap-bench`: the blind benchmark of the gap diagnosis (analysis/bench/gap_bench.h). Prints
 // one line per case, the confusion matrix, top-1 accuracy (overall and on oracle-separable cases),
 // band coverage, the held-out shrink of g and how often a strong effect was called "none".
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "analysis/bench/gap_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/cli/progress.h"
 
 namespace eol::station::cli {
 namespace {
@@ -55,8 +59,14 @@ int RunGapBenchCommand(const GapBenchArgs& a) {
   o.seed = a.seed;
   std::ostream& out = a.json ? std::cerr : std::cout;
   const auto start = std::chrono::steady_clock::now();
+  // The progress line would break the per-case lines where they reach the terminal: it is
+  // drawn when they do not (--quiet, or results piped).
+  auto progress =
+      std::make_unique<Progress>("gap-bench", a.quiet || (!a.json && isatty(STDOUT_FILENO) != 1));
+  int finished = 0;
   const analysis::GapBenchSummary s =
       analysis::RunGapBench(o, [&](const analysis::GapBenchCase& c) {
+        progress->Update("cases", ++finished, o.cases);
         if (a.quiet) return;
         char line[256];
         std::snprintf(line, sizeof line,
@@ -66,6 +76,7 @@ int RunGapBenchCommand(const GapBenchArgs& a) {
                       c.heldout_before, c.heldout_after);
         out << line << std::flush;
       });
+  progress.reset();  // ends the line before the results
   if (!s.usable) {
     std::cerr << "eol gap-bench: " << s.message << "\n";
     return 2;

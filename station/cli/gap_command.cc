@@ -2,7 +2,7 @@
 // measurement leaves the simulation, which unmodelled effect explains it, how far the gap
 // shrinks (also on held-out lines or units), and optionally where a second simulated design
 // would land in the measured set-up (--predict-sim). Inputs: drivers/io/gap_inputs.h;
-// report: gap_report.h; plot: drivers/io/svg_plot.h.
+// report: gap_report.h; plot: drivers/io/chart.h.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include "analysis/gap/noise.h"
+#include "drivers/io/chart.h"
 #include "drivers/io/file_error.h"
-#include "drivers/io/svg_plot.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/gap_report.h"
@@ -25,7 +25,8 @@ namespace {
 struct GapArgs {
   std::string sim;
   std::vector<std::string> measured;
-  std::string json_out;
+  bool json = false;     // the JSON report on stdout (the text report then on stderr)
+  std::string json_out;  // and/or into this file
   std::string plot;
   std::string quantity = "impedance";
   std::string predict_sim;
@@ -80,17 +81,48 @@ analysis::CalibrationSummary Calibrate(const io::GapInput& sim, double inertia) 
   return analysis::CalibrateNominal(sim.frf, o);
 }
 
-io::SvgFigure Plot(const GapReport& r, const io::GapInput& meas) {
+io::Chart Plot(const GapReport& r, const io::GapInput& meas) {
   const bool mobility = r.quantity == analysis::Quantity::kMobility;
   const analysis::NominalNetwork& n = r.calibration.nominal;
   const auto& f = meas.frf.freq_hz;
-  io::SvgFigure fig;
+  io::Chart fig;
+  fig.panel_height_px = 260;
   fig.title = "eol gap: " + r.gap.effect + "  (g " + std::to_string(r.gap.gap_before).substr(0, 6) +
               " -> " + std::to_string(r.gap.gap_after).substr(0, 6) + ")  " + meas.source;
-  fig.x_label = "frequency (Hz)";
-  fig.log_x = f.back() / f.front() > 10.0;
-  std::vector<std::pair<double, double>> shaded;
-  for (const auto& b : r.gap.where) shaded.push_back({b.band.f_lo_hz, b.band.f_hi_hz});
+  const bool log_x = f.back() / f.front() > 10.0;
+  std::vector<io::ChartBand> shaded;
+  for (const auto& b : r.gap.where) {
+    io::ChartBand band;
+    band.label = shaded.empty() ? "where the gap is" : "";
+    band.lo = b.band.f_lo_hz;
+    band.hi = b.band.f_hi_hz;
+    band.colour = {0.957, 0.635, 0.380};
+    band.alpha = 0.25;
+    shaded.push_back(band);
+  }
+  auto series = [&](const std::string& label, io::Colour colour, const std::vector<double>& y,
+                    bool markers, double width, bool dashed) {
+    io::ChartSeries c;
+    c.label = label;
+    c.colour = colour;
+    c.x = f;
+    c.y = y;
+    c.line = !markers;
+    c.markers = markers;
+    c.marker_radius = 1.6;
+    c.width = width;
+    c.style = dashed ? io::LineStyle::kDashed : io::LineStyle::kSolid;
+    return c;
+  };
+  auto base = [&](const std::string& y_label, bool log_y) {
+    io::ChartPanel p;
+    p.x_label = "frequency (Hz)";
+    p.y_label = y_label;
+    p.log_x = log_x;
+    p.log_y = log_y;
+    p.vbands = shaded;
+    return p;
+  };
   // Curves: measured, simulated (the calibrated nominal), corrected (nominal + winner).
   std::vector<double> m1, m2, s1, s2, c1, c2, before, after;
   for (std::size_t k = 0; k < f.size(); ++k) {
@@ -119,13 +151,10 @@ io::SvgFigure Plot(const GapReport& r, const io::GapInput& meas) {
   }
   auto panel = [&](const std::string& label, const std::vector<double>& m,
                    const std::vector<double>& s, const std::vector<double>& c, bool log_y) {
-    io::SvgPanel p;
-    p.y_label = label;
-    p.log_y = log_y;
-    p.shaded = shaded;
-    p.series.push_back({"measured", "#444444", f, m, true, 1.0, false});
-    p.series.push_back({"simulated", "#1f77b4", f, s, false, 1.6, true});
-    p.series.push_back({"corrected", "#d62728", f, c, false, 1.6, false});
+    io::ChartPanel p = base(label, log_y);
+    p.series.push_back(series("measured", {0.267, 0.267, 0.267}, m, true, 1.0, false));
+    p.series.push_back(series("simulated", io::kChartBlue, s, false, 1.6, true));
+    p.series.push_back(series("corrected", io::kChartRed, c, false, 1.6, false));
     return p;
   };
   if (mobility) {
@@ -135,13 +164,15 @@ io::SvgFigure Plot(const GapReport& r, const io::GapInput& meas) {
     fig.panels.push_back(panel("Re Z (ohm)", m1, s1, c1, false));
     fig.panels.push_back(panel("Im Z - w L_nominal (ohm)", m2, s2, c2, false));
   }
-  io::SvgPanel res;
-  res.y_label = "|residual| / sigma";
-  res.log_y = true;
-  res.shaded = shaded;
-  res.hlines = {1.0};
-  res.series.push_back({"simulated", "#1f77b4", f, before, false, 1.0, false});
-  res.series.push_back({"corrected", "#d62728", f, after, false, 1.0, false});
+  io::ChartPanel res = base("|residual| / sigma", true);
+  io::ChartLine one;
+  one.label = "1 sigma";
+  one.value = 1.0;
+  one.colour = io::kChartGrey;
+  one.style = io::LineStyle::kDotted;
+  res.hlines.push_back(one);
+  res.series.push_back(series("simulated", io::kChartBlue, before, false, 1.0, false));
+  res.series.push_back(series("corrected", io::kChartRed, after, false, 1.0, false));
   fig.panels.push_back(res);
   return fig;
 }
@@ -225,19 +256,16 @@ int RunGap(const GapArgs& a) {
   }
 
   const nlohmann::json j = GapReportJson(r);
-  std::ostream& text = a.json_out == "-" ? std::cerr : std::cout;
+  std::ostream& text = a.json ? std::cerr : std::cout;
   text << GapReportText(r);
+  if (a.json) std::cout << j.dump(2) << std::endl;
   if (!a.json_out.empty()) {
-    if (a.json_out == "-") {
-      std::cout << j.dump(2) << std::endl;
-    } else {
-      std::ofstream out(a.json_out);
-      out << j.dump(2) << "\n";
-      if (!out) throw io::FileError(a.json_out, 0, 0, "cannot write the JSON report");
-    }
+    std::ofstream out(a.json_out);
+    out << j.dump(2) << "\n";
+    if (!out) throw io::FileError(a.json_out, 0, 0, "cannot write the JSON report");
   }
   if (!a.plot.empty()) {
-    io::WriteSvg(a.plot, Plot(r, r.measured.front()));
+    io::WriteChart(a.plot, Plot(r, r.measured.front()));
     text << "plot written to " << a.plot << "\n";
   }
   return 0;
@@ -262,7 +290,8 @@ void AddGapCommand(CLI::App& app) {
                   "Measured unit (repeatable): FRF CSV with sigma (else the noise is estimated), "
                   ".zma, or a raw periodic recording CSV with t_s (plain or .gz)")
       ->required();
-  cmd->add_option("--json", a->json_out, "Write the JSON report to this file ('-': stdout)");
+  cmd->add_flag("--json", a->json, "Print the JSON report on stdout (the text goes to stderr)");
+  cmd->add_option("--json-out", a->json_out, "Write the JSON report to this file");
   cmd->add_option("--plot", a->plot,
                   "Write an SVG plot: measured, simulated and corrected curves, the normalised "
                   "residual, gap bands shaded");

@@ -45,10 +45,11 @@ analysis::GoldenUnit FromMeasured(const std::string& path, const Recipe& recipe)
   return u;
 }
 
-analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string& path) {
+analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string& path,
+                                     bool known_bad) {
   if (!j.value("usable", false))
     throw std::runtime_error(path + ": the analysis is not usable (\"usable\": false)");
-  if (j.contains("verdict") && j.at("verdict").value("outcome", "") != "PASS")
+  if (!known_bad && j.contains("verdict") && j.at("verdict").value("outcome", "") != "PASS")
     throw std::runtime_error(path + ": the verdict is " + j.at("verdict").value("outcome", "?") +
                              ": only PASS units are golden units");
   static const std::map<std::string, std::string_view> kParams = {
@@ -63,6 +64,14 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
     const auto& p = j.at("params");
     if (p.contains(param)) u.values[std::string(name)] = p.at(param).at("value").get<double>();
   }
+  const auto& p = j.at("params");
+  if (p.contains("Rp_ohm") && p.contains("f0_hz") && p.contains("Q")) {
+    analysis::MotionalImpedance m;
+    m.rp_ohm = p.at("Rp_ohm").at("value").get<double>();
+    m.f0_hz = p.at("f0_hz").at("value").get<double>();
+    m.q = p.at("Q").at("value").get<double>();
+    u.values[std::string(names::kMotionalResidueOhmPerS)] = m.ResidueOhmPerS();
+  }
   if (j.contains("fit") && j.at("fit").contains("chi2_per_dof"))
     u.values[std::string(names::kFitChi2PerDof)] = j.at("fit").at("chi2_per_dof").get<double>();
   return u;
@@ -72,10 +81,15 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
 
 std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>& paths,
                                                   const Recipe& recipe,
-                                                  std::vector<std::string>* skipped) {
+                                                  std::vector<std::string>* skipped, bool known_bad,
+                                                  const analysis::ProgressCallback& progress) {
   if (skipped) skipped->clear();  // nothing is skipped any more: unusable records are refused
   std::vector<analysis::GoldenUnit> units;
+  const char* phase = known_bad ? "known-bad files" : "golden files";
+  const auto total = static_cast<std::int64_t>(paths.size());
+  std::int64_t done = 0;
   for (const std::string& path : paths) {
+    if (progress) progress(phase, done++, total);
     if (!EndsWith(path, ".json")) {
       units.push_back(FromMeasured(path, recipe));
       continue;
@@ -89,8 +103,15 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
       throw std::runtime_error(path + ": not JSON: " + e.what());
     }
     try {
-      if (j.is_object() && j.contains("params")) {
-        units.push_back(FromAnalyzeJson(j, path));
+      const auto is_export_row = [](const nlohmann::json& x) {
+        return x.is_object() && x.contains("schema_version");
+      };
+      if (is_export_row(j) || (j.is_array() && !j.empty() && is_export_row(j.front()))) {
+        throw std::runtime_error(
+            "rows of the export schema (`eol export --format json`) carry no curves; teach "
+            "reads full records: `eol export --format records`");
+      } else if (j.is_object() && j.contains("params")) {
+        units.push_back(FromAnalyzeJson(j, path, known_bad));
       } else if (j.is_array() || (j.is_object() && j.contains("measurements"))) {
         const nlohmann::json list = j.is_array() ? j : nlohmann::json::array({j});
         for (std::size_t i = 0; i < list.size(); ++i) {
@@ -98,10 +119,14 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
           const std::string label = path + "[" + std::to_string(i) + "] " + r.serial;
           // A golden unit is a good production unit tested with this very recipe: anything
           // else would teach limits from what they must reject, or from another test.
-          if (r.outcome != analysis::Outcome::kPass)
+          if (known_bad && r.outcome != analysis::Outcome::kPass &&
+              r.outcome != analysis::Outcome::kFail)
+            throw std::runtime_error("record " + label + " is " + analysis::ToString(r.outcome) +
+                                     ": a known-bad unit needs a PASS or FAIL measurement");
+          if (!known_bad && r.outcome != analysis::Outcome::kPass)
             throw std::runtime_error("record " + label + " is " + analysis::ToString(r.outcome) +
                                      ": only PASS records are golden units");
-          if (r.kind != db::RecordKind::kProduction)
+          if (!known_bad && r.kind != db::RecordKind::kProduction)
             throw std::runtime_error("record " + label + " is a " + db::ToString(r.kind) +
                                      " test (a master part), not a production unit");
           if (r.recipe_hash != recipe.hash)
@@ -113,7 +138,7 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
         }
       } else {
         throw std::runtime_error(
-            "neither `eol analyze --json` output (\"params\") nor `eol export --format json` "
+            "neither `eol analyze --json` output (\"params\") nor `eol export --format records` "
             "records (\"measurements\")");
       }
     } catch (const nlohmann::json::exception& e) {
@@ -124,7 +149,10 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
       throw std::runtime_error(path + ": " + what);
     }
   }
-  if (units.empty()) throw std::runtime_error("no golden unit could be read");
+  if (progress) progress(phase, total, total);
+  if (units.empty())
+    throw std::runtime_error(known_bad ? "no known-bad unit could be read"
+                                       : "no golden unit could be read");
   return units;
 }
 

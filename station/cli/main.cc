@@ -37,12 +37,28 @@ int main(int argc, char** argv) {
   eol::station::cli::AddTeachCommand(app);
   eol::station::cli::AddDetectabilityCommand(app);
   eol::station::cli::AddProductionBenchCommand(app);
+  eol::station::cli::AddHttpBenchCommand(app);
+  eol::station::cli::AddCycleBenchCommand(app);
+  eol::station::cli::AddPodCommand(app);
+  eol::station::cli::AddRecipeApproveCommand(app);
+  eol::station::cli::AddPlantBenchCommand(app);
   // Default files (recipe, operator page, SciPy peer) come from the working directory or the
   // installed program's prefix, never from the machine the program was built on.
   const std::string defaults =
       std::string("Default files: ") + eol::station::kDefaultsSearchHelp + ".";
   app.footer(defaults);
   for (CLI::App* sub : app.get_subcommands({})) sub->footer(defaults);
-  CLI11_PARSE(app, argc, argv);
+  // Exit codes: 0 done; 1 the command's negative answer (e.g. a serial with no tests, a
+  // drift alarm; see each command's help); 2 a usage error (unknown option, missing or
+  // malformed argument, a file that does not exist) or a failure the command names.
+  // CLI11 would exit 101-115 for usage errors; those all become 2.
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // the command ran and chose its code (RunGuarded)
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints help, the version or the usage error
+    return code == 0 ? 0 : 2;
+  }
   return 0;
 }

@@ -10,6 +10,8 @@
 #include "analysis/bench/production_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/cli/pod_svg.h"
+#include "station/cli/progress.h"
 #include "station/data_files.h"
 #include "station/recipe.h"
 
@@ -22,6 +24,7 @@ struct BenchArgs {
   std::string recipe = DefaultRecipePath();
   analysis::ProductionBenchOptions options;
   bool json = false;
+  std::string pod_svg;
 };
 
 std::string Percent(double v) {
@@ -51,11 +54,16 @@ json SummaryJson(const analysis::ProductionBenchSummary& s, const BenchArgs& a) 
                                     {"escape_rate", esc}};
   }
   json limits = json::array();
-  for (const auto& l : s.teach.limits)
-    limits.push_back({{"name", l.name},
-                      {"lo", l.limit.lo ? json(*l.limit.lo) : json(nullptr)},
-                      {"hi", l.limit.hi ? json(*l.limit.hi) : json(nullptr)}});
+  for (const auto& l : s.teach.limits) limits.push_back(LimitJson(l));
+  json pod = json::array();
+  for (const auto& w : s.pod) {
+    json f = analysis::PodToJson(w.fit);
+    f["name"] = w.name;
+    f["defect"] = analysis::ToString(w.defect);
+    pod.push_back(f);
+  }
   return {{"usable", s.usable},
+          {"pod", pod},
           {"message", s.message},
           {"units", s.units},
           {"seed", a.options.seed},
@@ -85,11 +93,33 @@ int RunBench(BenchArgs a) {
   o.recipe_masks = r.masks;
   o.naive.search_lo_hz = r.analysis.fit.f0_min_hz;
   o.naive.search_hi_hz = r.analysis.fit.f0_max_hz;
-  const analysis::ProductionBenchSummary s = analysis::RunProductionBench(o);
+  analysis::ProductionBenchSummary s;
+  {
+    Progress progress("production-bench");
+    o.progress = progress.Callback();
+    s = analysis::RunProductionBench(o);
+  }
   if (!s.usable) {
     std::cerr << "eol production-bench: " << s.message << std::endl;
     if (a.json) std::cout << json{{"usable", false}, {"error", s.message}}.dump() << std::endl;
     return 1;
+  }
+  if (!a.pod_svg.empty()) {
+    std::vector<PodCurve> curves;
+    for (const auto& w : s.pod) curves.push_back({w.name, w.fit, w.data});
+    std::vector<F0Group> groups;
+    for (std::size_t c = 0; c < analysis::kAllDefectClasses.size(); ++c)
+      if (!s.f0_hz[c].empty())
+        groups.push_back({analysis::ToString(analysis::kAllDefectClasses[c]), s.f0_hz[c]});
+    std::vector<F0Limit> limits;
+    for (const auto& l : s.teach.limits)
+      if (l.name == "resonance_f_hz") {
+        if (l.limit.lo) limits.push_back({"f0 lo", *l.limit.lo});
+        if (l.limit.hi) limits.push_back({"f0 hi", *l.limit.hi});
+      }
+    WritePodSvg(a.pod_svg,
+                "production bench, seed " + std::to_string(o.seed) + ": POD and fitted f0", curves,
+                groups, limits);
   }
   if (a.json) {
     std::cout << SummaryJson(s, a).dump() << std::endl;
@@ -121,6 +151,11 @@ int RunBench(BenchArgs a) {
         std::cout << " " << analysis::ToString(c) << " " << Percent(s.EscapeRate(rule, c));
     std::cout << "\n";
   }
+  for (const auto& w : s.pod) {
+    std::cout << "POD " << w.name << " (" << analysis::ToString(w.defect)
+              << ", bond stiffness loss a): " << w.fit.message << "\n";
+  }
+  if (!a.pod_svg.empty()) std::cout << "figure: " << a.pod_svg << "\n";
   std::printf("time: %.1f s (golden and teaching %.1f s), %.2f ms per unit on %d threads\n",
               s.seconds, s.golden_seconds,
               1000.0 * s.seconds / std::max(1, s.units + o.golden_units), o.threads);
@@ -160,6 +195,16 @@ void AddProductionBenchCommand(CLI::App& app) {
          },
          "tolerance_interval (default) or mad")
       ->check(CLI::IsMember(methods));
+  cmd->add_option("--pod-units", args->options.pod_units,
+                  "Units per POD sweep (one soft magnet, all soft), 0: none")
+      ->capture_default_str();
+  cmd->add_option("--pod-loss-lo", args->options.pod_loss_lo, "Smallest bond stiffness loss")
+      ->capture_default_str();
+  cmd->add_option("--pod-loss-hi", args->options.pod_loss_hi, "Largest bond stiffness loss")
+      ->capture_default_str();
+  cmd->add_option("--pod-svg", args->pod_svg,
+                  "Write the figure (POD with its bound and a90/95; f0 per class and the taught "
+                  "limits) to this SVG file");
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args] { RunGuarded("production-bench", [&] { return RunBench(*args); }); });
 }

@@ -10,6 +10,7 @@
 // stdout gets one line: the motor, its defect and the modes the chain shows in the band.
 #include <cstdio>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "analysis/model/rotor_chain.h"
@@ -42,6 +43,7 @@ struct SimulateArgs {
   double noise_a = 1e-3;
   double amplifier_output_ohm = 0.0;
   double shunt_ohm = 0.1;
+  bool json = false;
 };
 
 // The modes the torque excites inside [lo, hi], as "390.0 Hz (Q 54, Rp 0.571 ohm)".
@@ -112,6 +114,19 @@ int RunSimulate(const SimulateArgs& a) {
     io::WriteFrfCsv(a.out, frf.frf);
     wrote = "FRF of " + std::to_string(frf.frf.size()) + " lines";
   }
+  if (a.json) {
+    std::cout << nlohmann::json{{"motor", spec.id},
+                                {"defect", a.defect.empty() ? "from the file" : a.defect},
+                                {"soft_magnets", spec.rotor.soft_magnets.size()},
+                                {"transmission_nm_per_a", motor.transmission_nm_per_a},
+                                {"modes_in_band", VisibleModes(motor, recipe.excitation.f_lo_hz,
+                                                               recipe.excitation.f_hi_hz)},
+                                {"wrote", wrote},
+                                {"out", a.out}}
+                     .dump()
+              << std::endl;
+    return 0;
+  }
   std::cout << "motor " << spec.id << ", defect "
             << (a.defect.empty() ? std::string("from the file") : a.defect) << " ("
             << spec.rotor.soft_magnets.size()
@@ -138,6 +153,7 @@ void AddSimulateCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "Output file")->required();
+  cmd->add_flag("--json", args->json, "Print what was written as one JSON object on stdout");
   cmd->add_option("--defect", args->defect,
                   "Poorly cemented magnets: none, one_soft_magnet, all_soft or partial:<ratio> "
                   "(that share of the magnets); default: the motor file's soft_magnets");

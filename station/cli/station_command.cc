@@ -1,22 +1,28 @@
 // `eol station --config FILE`: the station as a long-running daemon. Serials arrive over
-// HTTP (POST /api/tests) or, with "serial_from_stdin", from a scanner typing into stdin.
+// HTTP (POST /api/tests), from the line PLC (a "plc" block: station/plc/plc_map.h) or, with
+// "serial_from_stdin", from a scanner typing into stdin.
 // SIGTERM/SIGINT abort the test in flight safely (excitation off, safe state, stored as
 // ABORTED) and stop the daemon.
 #include <signal.h>
 #include <spdlog/spdlog.h>
 
 #include <iostream>
+#include <memory>
 #include <thread>
 
+#include "drivers/io/json_config.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/data_files.h"
 #include "station/serial_number.h"
 #include "station/station.h"
 #include "station/systemd_notify.h"
+#include "station/test_request.h"
 
 namespace eol::station::cli {
 namespace {
+
+constexpr int kExitConfigError = 78;  // EX_CONFIG (sysexits.h)
 
 int RunStation(const std::string& config_path, std::string web_root) {
   // Block the stop signals in every thread; one thread waits for them with sigwait.
@@ -26,14 +32,37 @@ int RunStation(const std::string& config_path, std::string web_root) {
   sigaddset(&stop_signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
-  Station station(LoadStationConfig(config_path));
+  std::unique_ptr<Station> made;
+  try {
+    made = std::make_unique<Station>(LoadStationConfig(config_path));
+  } catch (const io::ConfigError& e) {
+    // Restarting cannot fix a file: the unit's RestartPreventExitStatus names this code.
+    std::cerr << "eol station: configuration error: " << e.what() << " (exit " << kExitConfigError
+              << ": fix the file, then start the station again)" << std::endl;
+    return kExitConfigError;
+  }
+  Station& station = *made;
   if (web_root.empty()) web_root = DefaultWebRoot();
   station.StartHttp(web_root);
-  std::cout << "eol station: " << station.config().station_id << " ready, recipe "
+  station.StartPlc();      // when the config has a "plc" block
+  station.StartMqtt();     // when the config has an "mqtt" block
+  station.StartCentral();  // when the config has a "central" block
+  // "ready" only when the fixture and the DAQ answered; otherwise the daemon is up (the API
+  // answers, each test retries the drivers) and says what is missing.
+  const nlohmann::json board = station.board().Snapshot();
+  const std::string readiness =
+      station.ready() ? "ready" : "up, NOT READY (" + board.value("not_ready_reason", "") + ")";
+  const std::string simulation = board.value("simulation", "");
+  std::cout << "eol station: " << station.config().station_id << " " << readiness << ", recipe "
             << station.recipe()->id << " v" << station.recipe()->version << ", http://"
-            << station.config().http_listen << ":" << station.http_port() << "/" << std::endl;
+            << station.config().http_listen << ":" << station.http_port() << "/";
+  if (station.config().plc)
+    std::cout << ", plc modbus://" << station.config().plc->listen << ":" << station.plc_port();
+  std::cout << (simulation.empty() ? "" : ", SIMULATION (" + simulation + ")") << std::endl;
 
-  NotifyReady("testing " + station.recipe()->id + " v" + std::to_string(station.recipe()->version));
+  NotifyReady((station.ready() ? "testing " : "NOT READY, testing ") + station.recipe()->id + " v" +
+              std::to_string(station.recipe()->version) +
+              (simulation.empty() ? "" : " in SIMULATION"));
   std::thread signal_thread([&] {
     int sig = 0;
     sigwait(&stop_signals, &sig);
@@ -48,9 +77,12 @@ int RunStation(const std::string& config_path, std::string web_root) {
       std::string line;
       while (std::getline(std::cin, line)) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
+        // The scanner's line: the serial, then TAB-separated key=value fields
+        // (station/test_request.h).
         std::string why;
-        if (!ValidSerial(line, &why) || !station.Enqueue(line, &why))
-          spdlog::warn("serial '{}' refused: {}", line, why);
+        const std::optional<TestRequest> request = ParseScannerLine(line, &why);
+        if (!request || !station.Enqueue(*request, &why))
+          spdlog::warn("scanner line '{}' refused: {}", line, why);
       }
     }).detach();
   }

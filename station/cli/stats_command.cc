@@ -1,12 +1,19 @@
-// `eol stats --db FILE [--recipe-hash H] [--from T] [--to T] [--gauge SERIAL]
-//  [--reference NAME=VALUE ...] [--gauge-sigma-span 6|4] [--drift-t T] [--json]`:
-// capability, drift alarms and the type-1 gauge study (station/stats_report.h).
-// Exit 0 when no drift alarm fired, 1 when one did, 2 on usage or file errors.
+// `eol stats --db FILE [--recipe-hash H] [--from T] [--to T] [--population pass|all]
+//  [--subgroup N] [--gauge SERIAL] [--reference NAME=VALUE ...] [--gauge-sigma-span 6|4]
+//  [--drift-t T] [--plot FILE.svg|.png] [--json]`:
+// capability (Cp/Cpk within, Pp/Ppk overall), control-chart run-rule alarms, drift alarms and
+// the type-1 gauge study (station/stats_report.h); --plot draws the control charts and
+// histograms of the resonance and its Q (station/spc_charts.h).
+// Exit 0 when no drift (trend) alarm fired, 1 when one did, 2 on usage or file errors; run-rule
+// alarms are printed and listed under "spc_alarms" but leave the exit code alone.
 #include <cstdio>
 #include <iostream>
 
+#include "analysis/qc/measurement_names.h"
+#include "drivers/io/chart.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
+#include "station/spc_charts.h"
 #include "station/stats_report.h"
 
 namespace eol::station::cli {
@@ -21,6 +28,9 @@ struct StatsArgs {
   std::vector<std::string> references;
   double sigma_span = 6.0;
   double drift_t = 4.0;
+  std::string population = "pass";
+  std::size_t subgroup = 1;
+  std::string plot;
   bool json = false;
 };
 
@@ -32,21 +42,29 @@ std::string Num(const nlohmann::json& v, const char* fmt = "%.4g") {
 }
 
 void PrintText(const nlohmann::json& r) {
+  std::printf(
+      "capability over %s; Cp/Cpk from the within-subgroup sigma (%s), Pp/Ppk from the "
+      "overall sd\n",
+      r["window"]["population"].get<std::string>().c_str(),
+      r["window"]["subgroup"].get<std::size_t>() > 1 ? "Rbar/d2" : "MRbar/1.128");
   for (const auto& g : r["recipes"]) {
     std::printf("recipe %s v%d (%s): %zu production tests\n",
                 g["recipe_id"].get<std::string>().c_str(), g["recipe_version"].get<int>(),
                 g["recipe_hash"].get<std::string>().substr(0, 12).c_str(),
                 g["tests"].get<std::size_t>());
-    std::printf("  %-34s %6s %12s %10s %8s %8s  %s\n", "measurement", "n", "mean", "sd", "Cp",
-                "Cpk", "drift");
+    std::printf("  %-34s %6s %12s %10s %8s %8s %8s %8s  %s\n", "measurement", "n", "mean", "sd",
+                "Cp", "Cpk", "Pp", "Ppk", "drift");
     for (const auto& m : g["measurements"])
-      std::printf("  %-34s %6zu %12s %10s %8s %8s  %s\n", m["name"].get<std::string>().c_str(),
-                  m["n"].get<std::size_t>(), Num(m["mean"], "%.6g").c_str(), Num(m["sd"]).c_str(),
-                  Num(m["cp"], "%.3f").c_str(), Num(m["cpk"], "%.3f").c_str(),
-                  m["drift"]["alarm"].get<bool>() ? "ALARM" : "-");
+      std::printf(
+          "  %-34s %6zu %12s %10s %8s %8s %8s %8s  %s\n", m["name"].get<std::string>().c_str(),
+          m["n"].get<std::size_t>(), Num(m["mean"], "%.6g").c_str(), Num(m["sd"]).c_str(),
+          Num(m["cp"], "%.3f").c_str(), Num(m["cpk"], "%.3f").c_str(), Num(m["pp"], "%.3f").c_str(),
+          Num(m["ppk"], "%.3f").c_str(), m["drift"]["alarm"].get<bool>() ? "ALARM" : "-");
   }
   if (r["recipes"].empty()) std::printf("no production tests in the window\n");
   for (const auto& a : r["alarms"]) std::printf("ALARM %s\n", a.get<std::string>().c_str());
+  for (const auto& a : r["spc_alarms"])
+    std::printf("RUN-RULE ALARM %s\n", a.get<std::string>().c_str());
   if (r["gauge"].is_object()) {
     const auto& g = r["gauge"];
     std::printf("type-1 gauge study of %s: %zu tests (K = %.0f %% of the tolerance, %g sigma)\n",
@@ -61,25 +79,60 @@ void PrintText(const nlohmann::json& r) {
   }
 }
 
+// The control charts (I-MR, or X-bar/R with --subgroup) and histograms of the resonance and
+// its Q, one under the other, for the recipe of the newest test (or --recipe-hash).
+void WritePlot(db::Store& store, const StatsRequest& req, const std::string& path) {
+  io::Chart chart;
+  for (const std::string_view name :
+       {analysis::names::kResonanceFHz, analysis::names::kResonanceQ}) {
+    ChartRequest c;
+    c.measurement = std::string(name);
+    c.from = req.from;
+    c.to = req.to;
+    c.recipe_hash = req.recipe_hash;
+    c.population = req.population;
+    const std::optional<SpcSeries> s = ReadSpcSeries(store, c);
+    if (!s) continue;
+    if (chart.title.empty())
+      chart.title = "eol stats: recipe " + s->recipe_id + " v" + std::to_string(s->recipe_version) +
+                    " (" + s->recipe_hash.substr(0, 12) + "), " + PopulationText(s->population);
+    const ChartKind kind = req.subgroup > 1 ? ChartKind::kXbarR : ChartKind::kIMr;
+    for (auto& p : ChartPanels(*s, kind, req.subgroup, req.rules))
+      chart.panels.push_back(std::move(p));
+    for (auto& p : ChartPanels(*s, ChartKind::kHistogram, 1, req.rules))
+      chart.panels.push_back(std::move(p));
+  }
+  if (chart.panels.empty())
+    throw std::runtime_error("--plot: no production test in the window measured " +
+                             std::string(analysis::names::kResonanceFHz) + " or " +
+                             std::string(analysis::names::kResonanceQ));
+  io::WriteChart(path, chart);
+}
+
 int RunStats(const StatsArgs& a) {
   StatsRequest req;
   if (!a.recipe_hash.empty()) req.recipe_hash = a.recipe_hash;
-  if (!a.from.empty()) req.from = a.from;
-  if (!a.to.empty()) req.to = a.to;
+  if (!a.from.empty()) req.from = IsoOption("--from", a.from);
+  if (!a.to.empty()) req.to = IsoOption("--to", a.to);
   if (!a.gauge.empty()) req.gauge_serial = a.gauge;
   req.gauge.sigma_span = a.sigma_span;
   req.drift.alarm_t = a.drift_t;
+  if (!ParsePopulation(a.population, &req.population))
+    throw std::runtime_error("--population must be pass or all (have '" + a.population + "')");
+  req.subgroup = a.subgroup;
   std::string why;
   for (const std::string& r : a.references)
     if (!ParseReference(r, req.reference, &why)) throw std::runtime_error("--reference: " + why);
   if (const std::string bad = ValidateStatsRequest(req); !bad.empty())
     throw std::runtime_error(bad);
-  auto store = db::Store::Open(a.db, db::Store::Role::kReader);
+  auto store = db::Store::Open(a.db, db::Store::Role::kReadOnly);
   const nlohmann::json report = StatsReport(*store, req);
+  if (!a.plot.empty()) WritePlot(*store, req, a.plot);
   if (a.json)
     std::cout << report.dump(2) << std::endl;
   else
     PrintText(report);
+  if (!a.plot.empty() && !a.json) std::printf("charts written to %s\n", a.plot.c_str());
   return report["alarms"].empty() ? 0 : 1;
 }
 
@@ -89,10 +142,13 @@ void AddStatsCommand(CLI::App& app) {
   auto args = std::make_shared<StatsArgs>();
   CLI::App* cmd = app.add_subcommand(
       "stats",
-      "Production statistics per recipe: n, mean, sd, Cp, Cpk of every measurement against\n"
-      "its limits, drift alarms (trend over the passing tests), and with --gauge a type-1\n"
-      "gauge study of one serial tested repeatedly. Self-check (master) tests are excluded.\n"
-      "Exit code 1 when a drift alarm fired.");
+      "Production statistics per recipe: n, mean, sd, Cp/Cpk (within-subgroup sigma) and\n"
+      "Pp/Ppk (overall sd) of every measurement against its limits, over the PASS units (or\n"
+      "--population all), control-chart run-rule alarms (rules 1-3, naming the serial), drift\n"
+      "alarms (trend over the passing tests), and with --gauge a type-1 gauge study of one\n"
+      "serial tested repeatedly. Self-check (master) tests are excluded. --plot draws the\n"
+      "control charts and histograms of resonance_f_hz and resonance_q.\n"
+      "Exit code 1 when a drift (trend) alarm fired.");
   cmd->add_option("--db", args->db, "SQLite file of the station")
       ->required()
       ->check(CLI::ExistingFile);
@@ -104,6 +160,13 @@ void AddStatsCommand(CLI::App& app) {
                   "Reference value of the gauge part, NAME=VALUE (repeatable): gives Cgk");
   cmd->add_option("--gauge-sigma-span", args->sigma_span, "6 (default) or 4 sigma convention");
   cmd->add_option("--drift-t", args->drift_t, "|t| of the trend slope that raises an alarm (4)");
+  cmd->add_option("--population", args->population,
+                  "Units of capability and control charts: pass (default) or all (PASS and FAIL)");
+  cmd->add_option("--subgroup", args->subgroup,
+                  "1 (default): I-MR, sigma within = MRbar/1.128; 2..10: X-bar/R subgroups of\n"
+                  "consecutive units, sigma within = Rbar/d2");
+  cmd->add_option("--plot", args->plot,
+                  "Write the control charts and histograms with the limits (SVG, or PNG for .png)");
   cmd->add_flag("--json", args->json, "One JSON object (station/stats_report.h)");
   cmd->callback([args] { RunGuarded("stats", [&] { return RunStats(*args); }); });
 }

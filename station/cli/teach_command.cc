@@ -1,17 +1,19 @@
-// `eol teach --recipe R --golden FILES... --out R2`: limits learned from good units
+// `eol teach --recipe R --golden FILES... [--bad FILES...] --out R2`: limits learned from good
+// units, and placed against confirmed-defective ones when given
 // (analysis/qc/teach.h). The new recipe is R with every declared scalar limit's bounds and
 // marginal band replaced by the learned ones, its masks replaced by the learned Re Z mask
 // (kept when no curve was given), version + 1 and a note in the description. It is validated
 // (ParseRecipe) before it is written, and an existing file is never overwritten without
 // --force. Exit: 0 written, 1 nothing could be learned (reason on stderr), 2 usage/file error.
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/golden_inputs.h"
+#include "station/cli/progress.h"
 #include "station/qc_service.h"
 #include "station/recipe.h"
 
@@ -23,6 +25,7 @@ using nlohmann::json;
 struct TeachArgs {
   std::string recipe;
   std::vector<std::string> golden;
+  std::vector<std::string> bad;
   std::string out;
   analysis::TeachOptions options;
   bool force = false;
@@ -34,15 +37,7 @@ void WriteNew(const std::string& path, const json& j, bool force) {
     throw std::runtime_error(path +
                              " exists: refusing to overwrite it (choose another --out, or "
                              "--force)");
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw std::runtime_error(tmp + ": cannot be written");
-    f << j.dump(2) << "\n";
-    f.flush();
-    if (!f) throw std::runtime_error(tmp + ": writing failed");
-  }
-  std::filesystem::rename(tmp, path);
+  WriteRecipeFile(path, j);
 }
 
 int RunTeach(const TeachArgs& a) {
@@ -54,8 +49,15 @@ int RunTeach(const TeachArgs& a) {
                              " exists: refusing to overwrite it (choose another --out, or "
                              "--force)");
   std::vector<std::string> skipped;
-  const std::vector<analysis::GoldenUnit> golden = ReadGoldenUnits(a.golden, recipe, &skipped);
-  const analysis::TeachSummary s = analysis::TeachLimits(recipe.limits, golden, a.options);
+  auto progress = std::make_unique<Progress>("teach");
+  const std::vector<analysis::GoldenUnit> golden =
+      ReadGoldenUnits(a.golden, recipe, &skipped, false, progress->Callback());
+  const std::vector<analysis::GoldenUnit> bad =
+      a.bad.empty()
+          ? std::vector<analysis::GoldenUnit>{}
+          : ReadGoldenUnits(a.bad, recipe, nullptr, /*known_bad=*/true, progress->Callback());
+  progress.reset();  // ends the line before the results
+  const analysis::TeachSummary s = analysis::TeachLimits(recipe.limits, golden, a.options, bad);
   for (const std::string& k : skipped) std::cerr << "eol teach: skipped " << k << "\n";
   if (!s.usable) {
     std::cerr << "eol teach: nothing learned: " << s.message << std::endl;
@@ -72,6 +74,12 @@ int RunTeach(const TeachArgs& a) {
         {"path", a.out}, {"id", next.id}, {"version", next.version}, {"hash", next.hash}};
     out["previous"] = {{"path", a.recipe}, {"version", recipe.version}, {"hash", recipe.hash}};
     out["skipped"] = skipped;
+    if (s.known_bad_units > 0)
+      out["known_bad"] = {
+          {"units", s.known_bad_units},     {"escapes_budget", s.known_bad_escapes_budget},
+          {"escapes", s.known_bad_escapes}, {"f0_lo_budget_hz", s.f0_lo_budget_hz},
+          {"f0_lo_hz", s.f0_lo_hz},         {"moved_share", s.known_bad_moved_share},
+          {"donors", s.known_bad_donors}};
     std::cout << out.dump() << std::endl;
     return 0;
   }
@@ -96,6 +104,15 @@ int RunTeach(const TeachArgs& a) {
     std::cout << "  mask " << m.name << ": " << m.points.size() / 2 << " segments "
               << m.points.front().f_hz << "-" << m.points.back().f_hz << " Hz on Re Z, guard "
               << m.guard_sigma << " sigma\n";
+  if (s.known_bad_units > 0) {
+    std::cout << "known-bad units: " << s.known_bad_units << "; pass the limits the budget alone "
+              << "sets: " << s.known_bad_escapes_budget.size() << "; f0 lower bound "
+              << s.f0_lo_budget_hz << " -> " << s.f0_lo_hz << " Hz (share "
+              << s.known_bad_moved_share
+              << " moved); pass the taught limits: " << s.known_bad_escapes.size() << "\n";
+    for (const std::string& e : s.known_bad_escapes)
+      std::cout << "  known-bad unit passes: " << e << "\n";
+  }
   std::cout << "units needed for the stated confidence: " << s.units_needed << " ("
             << s.units_needed_distribution_free << " distribution-free); used " << s.units_used
             << "\n";
@@ -119,12 +136,21 @@ void AddTeachCommand(CLI::App& app) {
       "--force) and\n"
       "prints its SHA-256 and how many golden units the stated confidence needs.\n"
       "Golden files: FRF CSV / .zma / recording CSV (analysed with the recipe), `eol analyze\n"
-      "--json` output, or `eol export --format json` records.\n"
+      "--json` output, or `eol export --format records` records.\n"
       "Exit: 0 written, 1 nothing could be learned, 2 usage or file error.");
   cmd->add_option("--recipe", args->recipe, "Recipe whose limits are taught")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--golden", args->golden, "Files of good units")->required()->expected(1, -1);
+  cmd->add_option("--bad", args->bad,
+                  "Files of units confirmed defective (limit masters, torn-down rejects; PASS or "
+                  "FAIL): the f0 lower bound takes budget from bounds that catch none of them "
+                  "until it catches those it can; teach reports the escapes before and after")
+      ->expected(1, -1);
+  cmd->add_option("--bad-max-donation", args->options.known_bad_max_donation,
+                  "With --bad: share of each other bound's budget (above plausibility) that may "
+                  "move to the f0 lower bound")
+      ->capture_default_str();
   cmd->add_option("--out", args->out, "The new recipe file")->required();
   cmd->add_option("--confidence", args->options.confidence, "Confidence of the tolerance intervals")
       ->capture_default_str();

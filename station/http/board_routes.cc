@@ -5,7 +5,7 @@
 #include "station/http/routes.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
-#include <httplib.h>
+#include "station/http/server.h"
 
 namespace eol::station::http {
 namespace {
@@ -15,6 +15,13 @@ void GetStatus(ApiContext& c, const httplib::Request&, httplib::Response& res) {
 }
 
 void GetEvents(ApiContext& c, const httplib::Request&, httplib::Response& res) {
+  // A stream holds its connection for as long as the page is open: its thread leaves the
+  // request workers (station/http/server.h), up to a maximum of streams.
+  if (!BecomeStream())
+    return Send(
+        res, ApiError{ApiErrorKind::kUnavailable, "too_many_streams",
+                      "the station serves at most " + std::to_string(c.options.limits.max_streams) +
+                          " event streams at once; close one (another tab?)"});
   auto last = std::make_shared<std::uint64_t>(c.board.last_event());
   res.set_header("Cache-Control", "no-cache");
   res.set_chunked_content_provider(
@@ -36,24 +43,10 @@ void GetEvents(ApiContext& c, const httplib::Request&, httplib::Response& res) {
 }
 
 void GetMetrics(ApiContext& c, const httplib::Request&, httplib::Response& res) {
-  const nlohmann::json st = c.board.Snapshot();
-  std::ostringstream m;
-  m << "# HELP eol_tests_total Finished tests since the station started, by outcome.\n"
-    << "# TYPE eol_tests_total counter\n";
-  for (const char* o : {"pass", "fail", "error", "aborted"})
-    m << "eol_tests_total{outcome=\"" << o << "\"} " << st["counts"][o].get<std::uint64_t>()
-      << "\n";
-  m << "# HELP eol_testing 1 while a test is in progress.\n# TYPE eol_testing gauge\n"
-    << "eol_testing " << (st["state"] == "wait_serial" || st["state"] == "idle" ? 0 : 1) << "\n";
-  if (st["last"].is_object()) {
-    for (const auto& meas : st["last"]["measurements"]) {
-      if (meas["name"] != "resonance_f_hz" || !meas["value"].is_number()) continue;
-      m << "# HELP eol_last_resonance_hz Resonance of the last tested unit.\n"
-        << "# TYPE eol_last_resonance_hz gauge\n"
-        << "eol_last_resonance_hz " << meas["value"].get<double>() << "\n";
-    }
-  }
-  res.set_content(m.str(), "text/plain; version=0.0.4");
+  if (!c.handlers.metrics)
+    return Send(res, ApiError{ApiErrorKind::kUnavailable, "no_metrics",
+                              "this server has no station behind it to measure"});
+  res.set_content(c.handlers.metrics(), "text/plain; version=0.0.4");
 }
 
 std::string ReadFile(const std::string& path) {
@@ -77,10 +70,10 @@ void GetOperatorPage(ApiContext& c, const httplib::Request&, httplib::Response& 
 }  // namespace
 
 void AddBoardRoutes(httplib::Server& s, ApiContext& c) {
-  s.Get("/api/status", Bind(c, GetStatus));
-  s.Get("/api/events", Bind(c, GetEvents));
-  s.Get("/metrics", Bind(c, GetMetrics));
-  s.Get("/", Bind(c, GetOperatorPage));
+  Route(s, c, "GET", "/api/status", GetStatus);
+  Route(s, c, "GET", "/api/events", GetEvents);
+  Route(s, c, "GET", "/metrics", GetMetrics);
+  Route(s, c, "GET", "/", GetOperatorPage);
   if (!c.options.web_root.empty()) s.set_mount_point("/static", c.options.web_root);
 }
 

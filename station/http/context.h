@@ -5,6 +5,9 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <regex>
+#include <string>
+#include <vector>
 
 #include "db/store.h"
 #include "station/http_api.h"
@@ -27,15 +30,22 @@ struct ApiContext {
   // One request at a time reads through `db`; it never recovers unfinished tests.
   std::mutex db_mu;
   std::unique_ptr<db::Store> db;
+  // Every route as registered (method, path pattern): the gate answers 404 and 405 from it.
+  struct RouteEntry {
+    std::string method;
+    std::regex pattern;
+  };
+  std::vector<RouteEntry> routes;
 };
 
 // A route handler: one function per route, grouped by resource in station/http/*_routes.cc.
 using RouteHandler = void (*)(ApiContext&, const httplib::Request&, httplib::Response&);
 
-// The route's handler as httplib::Server::Handler.
-inline std::function<void(const httplib::Request&, httplib::Response&)> Bind(ApiContext& c,
-                                                                             RouteHandler h) {
-  return [&c, h](const httplib::Request& req, httplib::Response& res) { h(c, req, res); };
-}
+// Registers `handler` for `method` ("GET", "POST" or "PUT") and `pattern` on the server and
+// in c.routes. POST and PUT bodies are read through httplib's content reader, so that a body
+// of any framing (Content-Length or chunked) stops at kMaxBodyBytes (413, nothing more is
+// buffered); the handler then finds it in req.body.
+void Route(httplib::Server& s, ApiContext& c, const std::string& method, const std::string& pattern,
+           RouteHandler handler);
 
 }  // namespace eol::station::http

@@ -1,10 +1,13 @@
-// Quality engineering: capability and gauge statistics, detectability of defect classes, and
-// limits taught from stored good units.
-#include <cmath>
-#include <cstdlib>
+// Quality engineering: capability and gauge statistics, control charts, detectability of
+// defect classes, and limits taught from stored good units.
+#include <algorithm>
+#include <set>
 
+#include "analysis/qc/measurement_names.h"
+#include "drivers/io/chart.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
+#include "station/spc_charts.h"
 #include "station/stats_report.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
@@ -19,14 +22,20 @@ ApiError BadRequest(std::string code, std::string message) {
 
 void GetStats(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   StatsRequest q;
-  if (req.has_param("from")) q.from = req.get_param_value("from");
-  if (req.has_param("to")) q.to = req.get_param_value("to");
+  for (const auto& e : {TimeParam(req, "from", &q.from), TimeParam(req, "to", &q.to)})
+    if (e) return Send(res, *e);
   if (req.has_param("recipe_hash")) q.recipe_hash = req.get_param_value("recipe_hash");
   if (req.has_param("gauge")) q.gauge_serial = req.get_param_value("gauge");
   std::string why;
   for (std::size_t i = 0; i < req.get_param_value_count("reference"); ++i)
     if (!ParseReference(req.get_param_value("reference", i), q.reference, &why))
       return Send(res, BadRequest("bad_reference", why));
+  if (req.has_param("population") &&
+      !ParsePopulation(req.get_param_value("population"), &q.population))
+    return Send(res, BadRequest("bad_population", "population must be pass or all"));
+  long long subgroup = 1;
+  if (const auto e = IntegerParam(req, "subgroup", 1, 10, &subgroup)) return Send(res, *e);
+  q.subgroup = static_cast<std::size_t>(subgroup);
   if (req.has_param("sigma_span")) {
     const std::string v = req.get_param_value("sigma_span");
     if (v != "4" && v != "6")
@@ -43,21 +52,62 @@ void GetStats(ApiContext& c, const httplib::Request& req, httplib::Response& res
   Send(res, HttpReply{200, report});
 }
 
-void GetDetectability(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
-  double k_fixture = 0.0, limit_sigmas = 3.0, required_sigmas = 3.0;
-  for (auto [name, target] : {std::pair<const char*, double*>{"k_fixture", &k_fixture},
-                              {"limit_sigmas", &limit_sigmas},
-                              {"required_sigmas", &required_sigmas}}) {
-    if (!req.has_param(name)) continue;
-    const std::string v = req.get_param_value(name);
-    char* end = nullptr;
-    const double x = std::strtod(v.c_str(), &end);
-    if (v.empty() || *end != '\0' || !(x > 0.0) || !std::isfinite(x))
-      return Send(res,
-                  BadRequest("bad_parameter",
-                             std::string(name) + " must be a positive number, got '" + v + "'"));
-    *target = x;
+// GET /api/charts/<measurement>.svg?chart=imr|xbar_r|histogram&from=&to=&last=&subgroup=
+//   &population=pass|all&recipe_hash=: the chart as image/svg+xml (station/spc_charts.h).
+// Unknown parameters are refused (a misspelt "subgrup" would otherwise draw the default).
+void GetChart(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
+  static const std::set<std::string> kKnown = {"chart",    "from",       "to",         "last",
+                                               "subgroup", "population", "recipe_hash"};
+  for (const auto& [name, value] : req.params)
+    if (!kKnown.count(name))
+      return Send(res, BadRequest("unknown_parameter",
+                                  "unknown parameter '" + name +
+                                      "' (chart, from, to, last, subgroup, population, "
+                                      "recipe_hash)"));
+  ChartRequest q;
+  q.measurement = req.matches[1];
+  if (std::find(analysis::names::kAll.begin(), analysis::names::kAll.end(), q.measurement) ==
+      analysis::names::kAll.end())
+    return Send(res,
+                ApiError{ApiErrorKind::kNotFound, "unknown_measurement", ValidateChartRequest(q)});
+  for (const auto& e : {TimeParam(req, "from", &q.from), TimeParam(req, "to", &q.to)})
+    if (e) return Send(res, *e);
+  long long last = 0, subgroup = 5;
+  for (const auto& e : {IntegerParam(req, "last", 1, 100000, &last),
+                        IntegerParam(req, "subgroup", 2, 10, &subgroup)})
+    if (e) return Send(res, *e);
+  q.last = static_cast<std::size_t>(last);
+  q.subgroup = static_cast<std::size_t>(subgroup);
+  if (req.has_param("chart") && !ParseChartKind(req.get_param_value("chart"), &q.kind))
+    return Send(res, BadRequest("bad_chart", "chart must be imr, xbar_r or histogram (have '" +
+                                                 req.get_param_value("chart") + "')"));
+  if (req.has_param("population") &&
+      !ParsePopulation(req.get_param_value("population"), &q.population))
+    return Send(res, BadRequest("bad_population", "population must be pass or all (have '" +
+                                                      req.get_param_value("population") + "')"));
+  if (req.has_param("recipe_hash")) q.recipe_hash = req.get_param_value("recipe_hash");
+  if (const std::string bad = ValidateChartRequest(q); !bad.empty())
+    return Send(res, BadRequest("bad_request", bad));
+  std::optional<SpcSeries> series;
+  {
+    std::lock_guard<std::mutex> lock(c.db_mu);
+    series = ReadSpcSeries(*c.db, q);
   }
+  if (!series)
+    return Send(res, ApiError{ApiErrorKind::kNotFound, "no_units",
+                              "no production test in the window measured " + q.measurement});
+  res.status = 200;
+  res.set_content(io::RenderChartSvg(MeasurementChart(*series, q)), "image/svg+xml");
+}
+
+void GetDetectability(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
+  // Fixtures measured so far are near 1e3 N m/rad; the range allows four decades each way
+  // and keeps the model's arithmetic finite (k_fixture=1e308 used to give a 500).
+  double k_fixture = 0.0, limit_sigmas = 3.0, required_sigmas = 3.0;
+  for (const auto& e : {NumberParam(req, "k_fixture", 0.1, 1e7, &k_fixture),
+                        NumberParam(req, "limit_sigmas", 0.5, 20.0, &limit_sigmas),
+                        NumberParam(req, "required_sigmas", 0.5, 20.0, &required_sigmas)})
+    if (e) return Send(res, *e);
   const auto recipe = c.handlers.current_recipe();
   const analysis::DetectabilitySummary summary = analysis::PredictDetectability(
       DetectabilityOptionsFor(*recipe, k_fixture, limit_sigmas, required_sigmas));
@@ -118,9 +168,10 @@ HttpReply TeachReply(const TeachResult& result) {
 }
 
 void AddQcRoutes(httplib::Server& s, ApiContext& c) {
-  s.Get("/api/stats", Bind(c, GetStats));
-  s.Get("/api/detectability", Bind(c, GetDetectability));
-  s.Post("/api/teach", Bind(c, PostTeach));
+  Route(s, c, "GET", "/api/stats", GetStats);
+  Route(s, c, "GET", R"(/api/charts/([^/]+)\.svg)", GetChart);
+  Route(s, c, "GET", "/api/detectability", GetDetectability);
+  Route(s, c, "POST", "/api/teach", PostTeach);
 }
 
 }  // namespace eol::station::http

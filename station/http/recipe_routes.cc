@@ -1,4 +1,5 @@
 // The recipe in use: read it, change it (engineers; audited), and read the audit log.
+#include "db/clock.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
 
@@ -19,6 +20,34 @@ void PutRecipe(ApiContext& c, const httplib::Request& req, httplib::Response& re
   if (const ApiError* e = std::get_if<ApiError>(&body)) return Send(res, *e);
   Send(res, RecipeChangeReply(
                 c.handlers.change_recipe(std::get<nlohmann::json>(body), std::get<ApiToken>(who))));
+}
+
+// POST /api/recipe/approve {"recipe": <a proposal>, "note"?: text}: the engineer whose token
+// it is approves the proposal, and it is installed as PUT /api/recipe would (validated,
+// audited under the engineer's name, in use for the next test).
+void ApproveRecipe(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
+  const auto who = RequireRole(req, c.options.tokens, Role::kEngineer, "approve recipes");
+  if (const ApiError* e = std::get_if<ApiError>(&who)) return Send(res, *e);
+  const auto body = ParseBody(req);
+  if (const ApiError* e = std::get_if<ApiError>(&body)) return Send(res, *e);
+  const nlohmann::json& b = std::get<nlohmann::json>(body);
+  auto bad = [&](const std::string& why) {
+    Send(res, ApiError{ApiErrorKind::kBadRequest, "invalid_approval", why});
+  };
+  if (!b.is_object() || !b.contains("recipe") || !b.at("recipe").is_object())
+    return bad("the body is {\"recipe\": <the proposed recipe>, \"note\": text (optional)}");
+  nlohmann::json recipe = b.at("recipe");
+  if (!recipe.contains("approval") || !recipe.at("approval").is_object() ||
+      recipe.at("approval").value("state", "") != "proposed")
+    return bad("/recipe/approval/state: is not \"proposed\": only a proposal is approved");
+  nlohmann::json approval = {
+      {"state", "approved"}, {"by", std::get<ApiToken>(who).name}, {"at", db::UtcNowIso8601()}};
+  if (b.contains("note")) {
+    if (!b.at("note").is_string()) return bad("/note: must be text");
+    approval["note"] = b.at("note");
+  }
+  recipe["approval"] = approval;
+  Send(res, RecipeChangeReply(c.handlers.change_recipe(recipe, std::get<ApiToken>(who))));
 }
 
 void GetAudit(ApiContext& c, const httplib::Request&, httplib::Response& res) {
@@ -59,6 +88,8 @@ HttpReply RecipeChangeReply(const RecipeChange& change) {
                  {"kept_as", change.kept_as}}}}};
     case Kind::kInvalid:
       return ToReply({ApiErrorKind::kBadRequest, "invalid_recipe", change.message});
+    case Kind::kNotApproved:
+      return ToReply({ApiErrorKind::kConflict, "recipe_not_approved", change.message});
     case Kind::kBusy:
       return ToReply({ApiErrorKind::kConflict, "busy", change.message});
     case Kind::kWrongRecipe:
@@ -72,9 +103,10 @@ HttpReply RecipeChangeReply(const RecipeChange& change) {
 }
 
 void AddRecipeRoutes(httplib::Server& s, ApiContext& c) {
-  s.Get("/api/recipe", Bind(c, GetRecipe));
-  s.Put("/api/recipe", Bind(c, PutRecipe));
-  s.Get("/api/recipe/audit", Bind(c, GetAudit));
+  Route(s, c, "GET", "/api/recipe", GetRecipe);
+  Route(s, c, "PUT", "/api/recipe", PutRecipe);
+  Route(s, c, "GET", "/api/recipe/audit", GetAudit);
+  Route(s, c, "POST", "/api/recipe/approve", ApproveRecipe);
 }
 
 }  // namespace eol::station::http

@@ -14,14 +14,22 @@ int HttpStatus(ApiErrorKind kind) {
       return 403;
     case ApiErrorKind::kNotFound:
       return 404;
+    case ApiErrorKind::kMethodNotAllowed:
+      return 405;
     case ApiErrorKind::kConflict:
       return 409;
+    case ApiErrorKind::kLengthRequired:
+      return 411;
     case ApiErrorKind::kTooLarge:
       return 413;
+    case ApiErrorKind::kUnsupportedMedia:
+      return 415;
     case ApiErrorKind::kUnprocessable:
       return 422;
     case ApiErrorKind::kInternal:
       return 500;
+    case ApiErrorKind::kUnavailable:
+      return 503;
   }
   return 500;
 }

@@ -13,14 +13,18 @@ namespace eol::station::http {
 
 // The classes of refusal the API gives, each with one HTTP status.
 enum class ApiErrorKind {
-  kBadRequest,     // 400: the request is malformed or fails validation
-  kUnauthorized,   // 401: no valid bearer token
-  kForbidden,      // 403: a valid token whose role may not do this
-  kNotFound,       // 404: nothing stored under that key
-  kConflict,       // 409: refused in the station's current state
-  kTooLarge,       // 413: the request body exceeds the limit
-  kUnprocessable,  // 422: well-formed, but nothing usable can be made of it
-  kInternal,       // 500: the station failed (file system, database, a bug)
+  kBadRequest,        // 400: the request is malformed or fails validation
+  kUnauthorized,      // 401: no valid bearer token
+  kForbidden,         // 403: a valid token whose role may not do this
+  kNotFound,          // 404: nothing stored under that key, or no such route
+  kMethodNotAllowed,  // 405: the route exists, not with this method
+  kConflict,          // 409: refused in the station's current state
+  kLengthRequired,    // 411: a body without Content-Length or chunked framing
+  kTooLarge,          // 413: the request body exceeds the limit, however it is framed
+  kUnsupportedMedia,  // 415: a write route's body is not application/json
+  kUnprocessable,     // 422: well-formed, but nothing usable can be made of it
+  kInternal,          // 500: the station failed (file system, database, a bug)
+  kUnavailable,       // 503: at capacity (event streams, request workers)
 };
 
 struct ApiError {

@@ -2,6 +2,10 @@
 
 #include <httplib.h>
 
+#include <charconv>
+
+#include "db/clock.h"
+
 namespace eol::station::http {
 
 std::string BearerToken(const httplib::Request& req) {
@@ -49,6 +53,54 @@ std::variant<nlohmann::json, ApiError> ParseBody(const httplib::Request& req,
     return Result(std::in_place_type<ApiError>,
                   ApiError{ApiErrorKind::kBadRequest, "bad_json", "request body is not JSON"});
   }
+}
+
+namespace {
+
+ApiError BadParam(const std::string& name, std::string message) {
+  return {ApiErrorKind::kBadRequest, "bad_" + name, std::move(message)};
+}
+
+template <typename T>
+std::string RangeText(T lo, T hi) {
+  return "[" + nlohmann::json(lo).dump() + ", " + nlohmann::json(hi).dump() + "]";
+}
+
+}  // namespace
+
+std::optional<ApiError> IntegerParam(const httplib::Request& req, const std::string& name,
+                                     long long lo, long long hi, long long* out) {
+  if (!req.has_param(name.c_str())) return std::nullopt;
+  const std::string v = req.get_param_value(name.c_str());
+  long long x = 0;
+  const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+  if (v.empty() || ec != std::errc() || end != v.data() + v.size() || x < lo || x > hi)
+    return BadParam(name,
+                    name + " must be a whole number in " + RangeText(lo, hi) + ", got '" + v + "'");
+  *out = x;
+  return std::nullopt;
+}
+
+std::optional<ApiError> NumberParam(const httplib::Request& req, const std::string& name, double lo,
+                                    double hi, double* out) {
+  if (!req.has_param(name.c_str())) return std::nullopt;
+  const std::string v = req.get_param_value(name.c_str());
+  double x = 0;
+  const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+  if (v.empty() || ec != std::errc() || end != v.data() + v.size() || !(x >= lo && x <= hi))
+    return BadParam(name, name + " must be a number in " + RangeText(lo, hi) + ", got '" + v + "'");
+  *out = x;
+  return std::nullopt;
+}
+
+std::optional<ApiError> TimeParam(const httplib::Request& req, const std::string& name,
+                                  std::optional<std::string>* out) {
+  if (!req.has_param(name.c_str())) return std::nullopt;
+  std::string why;
+  const auto t = db::NormaliseIso8601(req.get_param_value(name.c_str()), &why);
+  if (!t) return BadParam(name, name + ": " + why);
+  *out = *t;
+  return std::nullopt;
 }
 
 }  // namespace eol::station::http

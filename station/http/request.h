@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -39,5 +40,16 @@ std::variant<ApiToken, ApiError> RequireRole(const httplib::Request& req,
 // The body as JSON: 413 "too_large" above `max_bytes`, 400 "bad_json" when it does not parse.
 std::variant<nlohmann::json, ApiError> ParseBody(const httplib::Request& req,
                                                  std::size_t max_bytes = kMaxBodyBytes);
+
+// Query parameters, parsed whole (no trailing characters, no exponent for integers, the C
+// locale's '.' whatever the locale): absent leaves *out as it was; otherwise a value outside
+// [lo, hi] or not a number is 400 "bad_<name>" naming the range and the value.
+std::optional<ApiError> IntegerParam(const httplib::Request& req, const std::string& name,
+                                     long long lo, long long hi, long long* out);
+std::optional<ApiError> NumberParam(const httplib::Request& req, const std::string& name, double lo,
+                                    double hi, double* out);
+// An ISO 8601 time with its offset, normalised to UTC (db/clock.h NormaliseIso8601).
+std::optional<ApiError> TimeParam(const httplib::Request& req, const std::string& name,
+                                  std::optional<std::string>* out);
 
 }  // namespace eol::station::http

@@ -11,11 +11,13 @@ namespace eol::station::http {
 
 // GET /api/status, GET /api/events, GET /metrics, GET / and /static (station/http/board_routes.cc)
 void AddBoardRoutes(httplib::Server& s, ApiContext& c);
-// GET /api/recipe, PUT /api/recipe, GET /api/recipe/audit (station/http/recipe_routes.cc)
+// GET /api/recipe, PUT /api/recipe, GET /api/recipe/audit, POST /api/recipe/approve
+// (station/http/recipe_routes.cc)
 void AddRecipeRoutes(httplib::Server& s, ApiContext& c);
 // GET /api/units/{serial}, GET /api/tests/{id}, GET /api/tests, POST /api/tests
 void AddTestRoutes(httplib::Server& s, ApiContext& c);
-// GET /api/stats, GET /api/detectability, POST /api/teach (station/http/qc_routes.cc)
+// GET /api/stats, GET /api/charts/{measurement}.svg, GET /api/detectability, POST /api/teach
+// (station/http/qc_routes.cc)
 void AddQcRoutes(httplib::Server& s, ApiContext& c);
 
 // kChanged: 200 with {id, version, hash, path, previous: {version, hash, kept_as}};

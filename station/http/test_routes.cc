@@ -1,4 +1,8 @@
 // Tests: start one, read the stored ones by serial, by id, or by query.
+#include <charconv>
+
+#include "station/central/central_record.h"
+#include "station/central/pg.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
 #include "station/serial_number.h"
@@ -13,27 +17,42 @@ ApiError BadRequest(std::string code, std::string message) {
   return {ApiErrorKind::kBadRequest, std::move(code), std::move(message)};
 }
 
+// scope=station (the default): this station's store. scope=plant: every station's tests
+// from the central record (station/central/), each with its station_id; the same record
+// fields. 400 without a central record configured, 503 when it cannot be read now.
 void GetUnit(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   const std::string serial = req.matches[1];
   std::string why;
   if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
+  const std::string scope = req.has_param("scope") ? req.get_param_value("scope") : "station";
+  if (scope != "station" && scope != "plant")
+    return Send(res, BadRequest("bad_scope", "scope must be station or plant"));
   std::vector<db::TestRecord> tests;
-  {
+  if (scope == "plant") {
+    if (c.options.central_postgres.empty())
+      return Send(res, BadRequest("bad_scope",
+                                  "scope=plant needs a \"central\" block in the station config"));
+    try {
+      auto pg = central::PgConnection::Connect(c.options.central_postgres, 5, "api");
+      tests = central::CentralTestsOfSerial(*pg, serial, false);
+    } catch (const central::PgError& e) {
+      return Send(res, ApiError{ApiErrorKind::kUnavailable, "central_unavailable", e.what()});
+    }
+  } else {
     std::lock_guard<std::mutex> lock(c.db_mu);
     tests = c.db->TestsOfSerial(serial, false);
   }
   nlohmann::json list = nlohmann::json::array();
   for (const auto& t : tests) list.push_back(t);
-  Send(res, HttpReply{200, {{"serial", serial}, {"tests", list}}});
+  Send(res, HttpReply{200, {{"serial", serial}, {"scope", scope}, {"tests", list}}});
 }
 
 void GetTest(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   std::int64_t id = 0;
-  try {
-    id = std::stoll(req.matches[1]);
-  } catch (const std::exception&) {
-    return Send(res, BadRequest("bad_id", "test id is not a number"));
-  }
+  const std::string text = req.matches[1];
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), id);
+  if (ec != std::errc() || end != text.data() + text.size())
+    return Send(res, BadRequest("bad_id", "test id '" + text + "' is not a 64-bit whole number"));
   std::optional<db::TestRecord> t;
   {
     std::lock_guard<std::mutex> lock(c.db_mu);
@@ -47,22 +66,23 @@ void GetTest(ApiContext& c, const httplib::Request& req, httplib::Response& res)
 
 void GetTests(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   db::TestQuery q;
-  if (req.has_param("from")) q.from = req.get_param_value("from");
-  if (req.has_param("to")) q.to = req.get_param_value("to");
+  long long limit = q.limit;
+  for (const auto& e : {TimeParam(req, "from", &q.from), TimeParam(req, "to", &q.to),
+                        IntegerParam(req, "limit", 1, 10000, &limit)})
+    if (e) return Send(res, *e);
+  q.limit = static_cast<int>(limit);
+  if (q.from && q.to && !(*q.from < *q.to))
+    return Send(res, BadRequest("bad_request", "from must be before to"));
   if (req.has_param("serial")) q.serial = req.get_param_value("serial");
-  if (req.has_param("verdict")) {
-    q.outcome = analysis::ParseOutcome(req.get_param_value("verdict"));
+  // "outcome", as records name it; "verdict" is its older name, still accepted.
+  if (req.has_param("outcome") && req.has_param("verdict"))
+    return Send(res,
+                BadRequest("bad_outcome", "give outcome or verdict (its older name), not both"));
+  for (const std::string name : {"outcome", "verdict"}) {
+    if (!req.has_param(name)) continue;
+    q.outcome = analysis::ParseOutcome(req.get_param_value(name));
     if (!q.outcome)
-      return Send(res, BadRequest("bad_verdict", "verdict must be PASS, FAIL, ERROR or ABORTED"));
-  }
-  if (req.has_param("limit")) {
-    try {
-      q.limit = std::stoi(req.get_param_value("limit"));
-    } catch (const std::exception&) {
-      return Send(res, BadRequest("bad_limit", "limit must be a whole number"));
-    }
-    if (q.limit < 1 || q.limit > 10000)
-      return Send(res, BadRequest("bad_limit", "limit must be in [1, 10000]"));
+      return Send(res, BadRequest("bad_" + name, name + " must be PASS, FAIL, ERROR or ABORTED"));
   }
   std::vector<db::TestRecord> tests;
   {
@@ -85,7 +105,9 @@ void PostTest(ApiContext& c, const httplib::Request& req, httplib::Response& res
   const std::string serial = body["serial"].get<std::string>();
   std::string why;
   if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
-  if (!c.handlers.start_test(serial, &why))
+  TestRequest request{serial, {}};
+  if (!ReadWorkContext(body, &request.work, &why)) return Send(res, BadRequest("bad_field", why));
+  if (!c.handlers.start_test(request, &why))
     return Send(res, ApiError{ApiErrorKind::kConflict, "busy", why});
   Send(res, HttpReply{202, {{"serial", serial}, {"accepted", true}}});
 }
@@ -93,10 +115,10 @@ void PostTest(ApiContext& c, const httplib::Request& req, httplib::Response& res
 }  // namespace
 
 void AddTestRoutes(httplib::Server& s, ApiContext& c) {
-  s.Get(R"(/api/units/([^/]+))", Bind(c, GetUnit));
-  s.Get(R"(/api/tests/(\d+))", Bind(c, GetTest));
-  s.Get("/api/tests", Bind(c, GetTests));
-  s.Post("/api/tests", Bind(c, PostTest));
+  Route(s, c, "GET", R"(/api/units/([^/]+))", GetUnit);
+  Route(s, c, "GET", R"(/api/tests/(\d+))", GetTest);
+  Route(s, c, "GET", "/api/tests", GetTests);
+  Route(s, c, "POST", "/api/tests", PostTest);
 }
 
 }  // namespace eol::station::http

@@ -1,12 +1,36 @@
-// Operator display: live state over server-sent events, the verdict with its reasons, the
-// measured curve against the recipe's limit masks, and the last results. No libraries, no
-// network beyond this station.
+// Operator display: a serial field for a keyboard-wedge scanner that starts tests over the
+// API, live state over server-sent events, the verdict with the recipe's instruction above
+// its technical reasons, the measured curve against every limit the verdict used, and the
+// last results. No libraries, no network beyond this station.
 "use strict";
 
 const STATES = ["wait_serial", "check_interlocks", "clamp", "confirm_clamp", "excite",
                 "analyse", "judge", "unclamp", "store", "publish"];
+const FINAL = ["PASS", "FAIL", "ERROR", "ABORTED"];
 let recipe = null;
 let shownTestId = null;
+
+// The measurements in the operator's words and units (analysis/qc/measurement_names.h).
+// scale converts the recorded unit into the one shown; digits are significant digits.
+const MEASUREMENTS = {
+  resonance_f_hz: {label: "Resonance", unit: "Hz", digits: 4, fixed: true},
+  resonance_q: {label: "Quality factor Q", unit: "", digits: 3, fixed: true},
+  winding_r_ohm: {label: "Winding resistance", unit: "Ω", digits: 3, fixed: true},
+  winding_l_h: {label: "Winding inductance", unit: "mH", scale: 1e3, digits: 3, fixed: true},
+  motional_rp_ohm: {label: "Resonance peak height", unit: "Ω", digits: 3, fixed: true},
+  fit_chi2_per_dof: {label: "Curve fit χ²/dof", unit: "", digits: 2, fixed: true},
+};
+
+// How a recorded measurement is shown: {label, unit, scale, digits, fixed}. Names of further phase
+// pairs end in "@V-W"; a mask's count is "mask_<name>_lines_outside".
+function describe(m) {
+  const [base, pair] = m.name.split("@");
+  let d = MEASUREMENTS[base];
+  const mask = /^mask_(.+)_lines_outside$/.exec(base);
+  if (!d && mask) d = {label: `Curve mask ${mask[1].replaceAll("_", " ")}: lines outside`, unit: "", digits: 6};
+  if (!d) d = {label: base, unit: m.unit === "1" ? "" : m.unit, digits: 5};
+  return {scale: 1, ...d, label: d.label + (pair ? ` (phase pair ${pair})` : "")};
+}
 
 function $(id) { return document.getElementById(id); }
 
@@ -25,8 +49,25 @@ async function getJson(url) {
   return r.json();
 }
 
-function fmt(v, digits) {
-  return (v === null || v === undefined || !isFinite(v)) ? "—" : Number(v).toPrecision(digits || 5);
+// A number to at most `digits` significant digits; `fixed`: exactly that many ("2.00").
+function num(v, digits, fixed) {
+  if (v === null || v === undefined || !isFinite(v)) return "—";
+  const d = digits || 5;
+  return new Intl.NumberFormat(undefined, {maximumSignificantDigits: d, useGrouping: false,
+                                          minimumSignificantDigits: fixed ? d : 1}).format(v);
+}
+
+function withUnit(text, unit) { return unit ? text + " " + unit : text; }
+
+// Times are stored in UTC; the operator reads them in the station's local time, with its zone.
+const TIME = new Intl.DateTimeFormat(undefined, {hour: "2-digit", minute: "2-digit", second: "2-digit",
+                                                 timeZoneName: "short"});
+const DATE_TIME = new Intl.DateTimeFormat(undefined, {year: "numeric", month: "short", day: "numeric",
+                                                      hour: "2-digit", minute: "2-digit",
+                                                      second: "2-digit", timeZoneName: "short"});
+function localTime(iso, format) {
+  const t = iso ? new Date(iso) : null;
+  return t && !isNaN(t) ? (format || TIME).format(t) : "";
 }
 
 function renderStates(current) {
@@ -45,27 +86,54 @@ function reasonText(r) {
   return typeof r === "string" ? r : (r && r.text) || "";
 }
 
-function renderVerdict(outcome, serial, reasons) {
+// The recipe's instruction for FAIL, ERROR and ABORTED (GET /api/recipe writes the defaults
+// out); none for PASS.
+function instructionFor(outcome) {
+  const i = recipe && recipe.instructions;
+  return (i && FINAL.includes(outcome) && outcome !== "PASS" && i[outcome.toLowerCase()]) || "";
+}
+
+// outcome: PASS, FAIL, ERROR, ABORTED, RUNNING (shown as TESTING) or none. A master part's
+// self-check (kind "self_check") gets no production instruction: it goes back to the masters.
+function renderOutcome(outcome, serial, reasons, kind) {
   const v = $("verdict");
   v.className = "verdict " + (outcome || "none");
   v.textContent = outcome === "RUNNING" ? "TESTING" : (outcome || "—");
   $("serial").textContent = serial || "";
+  const master = kind === "self_check";
+  const instruction = master ? "Master part (self-check): keep it with the master parts" : instructionFor(outcome);
+  const box = $("instruction");
+  box.hidden = !instruction;
+  box.className = master ? "MASTER" : outcome || "";
+  box.textContent = instruction;
   const ul = $("reasons");
   ul.replaceChildren();
   for (const r of reasons || [])
     ul.appendChild(el("li", {"data-code": (r && r.code) || ""}, reasonText(r)));
+  if (outcome === "RUNNING") $("tested").textContent = "";
+}
+
+function renderTested(record) {
+  const who = [];
+  if (record.operator_id) who.push("operator " + record.operator_id);
+  if (record.shift) who.push("shift " + record.shift);
+  if (record.order_number) who.push("order " + record.order_number);
+  const when = localTime(record.finished_at, DATE_TIME);
+  $("tested").textContent = (when ? "Finished " + when : "") + (who.length ? " · " + who.join(" · ") : "");
 }
 
 function renderHistory(status) {
   const t = $("history");
   t.replaceChildren(el("tr", {}, ""));
-  t.firstChild.append(el("th", {}, "serial"), el("th", {}, "verdict"), el("th", {}, "f0 (Hz)"),
-                      el("th", {}, "finished"));
+  t.firstChild.append(el("th", {scope: "col"}, "serial"), el("th", {scope: "col"}, "outcome"),
+                      el("th", {scope: "col"}, "resonance (Hz)"), el("th", {scope: "col"}, "finished"));
   for (const r of status.recent || []) {
     const f0 = (r.measurements || []).find(m => m.name === "resonance_f_hz");
     const row = el("tr");
     row.append(el("td", {}, r.serial), el("td", {class: r.outcome}, r.outcome),
-               el("td", {}, fmt(f0 && f0.value, 5)), el("td", {}, (r.finished_at || "").slice(11, 19)));
+               el("td", {}, num(f0 && f0.value, 4, true)),
+               el("td", {"data-utc": r.finished_at || r.started_at || ""},
+                  localTime(r.finished_at || r.started_at)));
     t.appendChild(row);
   }
   const c = status.counts || {};
@@ -77,15 +145,22 @@ function renderMeasurements(measurements) {
   const t = $("measurements");
   t.replaceChildren();
   const head = el("tr");
-  head.append(el("th", {}, "measurement"), el("th", {}, "value"), el("th", {}, "limits"),
-              el("th", {}, ""));
+  head.append(el("th", {scope: "col"}, "measurement"), el("th", {scope: "col"}, "value"),
+              el("th", {scope: "col"}, "limits"), el("th", {scope: "col"}, "result"));
   t.appendChild(head);
   for (const m of measurements || []) {
-    const lim = `${m.limit.lo ?? "−∞"} … ${m.limit.hi ?? "+∞"} ${m.unit}`;
-    const row = el("tr");
-    row.append(el("td", {}, m.name), el("td", {}, fmt(m.value, 6) + " " + m.unit),
-               el("td", {}, lim), el("td", {class: m.outcome === "FAIL" ? "FAIL" : "PASS"},
-                                     m.outcome + (m.marginal ? " (marginal)" : "")));
+    const d = describe(m);
+    const scaled = v => (v === null || v === undefined) ? null : v * d.scale;
+    const lo = m.limit.lo ?? null, hi = m.limit.hi ?? null;
+    const limits = lo !== null && hi !== null ? `${num(scaled(lo), 6)} … ${num(scaled(hi), 6)}`
+        : lo !== null ? "≥ " + num(scaled(lo), 6) : hi !== null ? "≤ " + num(scaled(hi), 6) : "none";
+    const result = m.outcome === "PASS" || m.outcome === "FAIL" ? m.outcome : "not judged";
+    const row = el("tr", {"data-name": m.name});
+    row.append(el("td", {title: m.name + (m.doc ? ": " + m.doc : "")}, d.label),
+               el("td", {class: "value"}, withUnit(num(scaled(m.value), d.digits, d.fixed), d.unit)),
+               el("td", {}, withUnit(limits, d.unit)),
+               el("td", {class: m.outcome === "PASS" || m.outcome === "FAIL" ? m.outcome : "UNSET"},
+                  result + (m.marginal ? " (marginal)" : "")));
     t.appendChild(row);
   }
 }
@@ -100,27 +175,52 @@ function maskAt(points, key, f) {
   return null;
 }
 
+function renderLegend(keys) {
+  $("legend").replaceChildren(...keys.map(([cls, text]) => el("span", {class: "key " + cls}, text)));
+}
+
+function clearPlot(note) {
+  $("plot").replaceChildren();
+  $("plot").removeAttribute("data-serial");
+  $("plot").setAttribute("aria-label", "no curve" + (note ? ": " + note : ""));
+  $("curve-note").textContent = note ? "(" + note + ")" : "";
+  renderLegend([]);
+}
+
+// The measured Re Z, every limit the verdict used on it (the resonance window from the
+// record's own limit, the recipe's Re Z masks) and the fitted model on top.
 function plotCurves(record) {
   const svg = $("plot");
   svg.replaceChildren();
   const meas = (record.curves || []).find(c => c.name === "impedance");
   const model = (record.curves || []).find(c => c.name === "model");
   if (!meas) {
-    $("curve-note").textContent = "(no curve: " + reasonText((record.reasons || [""])[0]) + ")";
+    clearPlot("no curve: " + reasonText((record.reasons || [""])[0]));
     return;
   }
-  $("curve-note").textContent = "— " + record.serial;
   const W = 800, H = 420, L = 60, R = 15, T = 15, B = 40;
   const f0 = meas.freq_hz[0], f1 = meas.freq_hz[meas.freq_hz.length - 1];
-  const masks = ((recipe && recipe.masks) || []).filter(m => m.quantity === "re_ohm");
-  let ys = meas.re.slice();
-  if (model) ys = ys.concat(model.re);
+  const masks = ((recipe && recipe.masks) || []).filter(m => (m.quantity || "re_ohm") === "re_ohm");
+  const sameRecipe = recipe && record.recipe && recipe.hash === record.recipe.hash;
+  const resonance = (record.measurements || []).find(m => m.name === "resonance_f_hz");
+  const win = resonance && resonance.limit;
+  let ys = meas.re.filter(isFinite);
+  if (model) ys = ys.concat(model.re.filter(isFinite));
   for (const m of masks) for (const p of m.points) for (const k of ["lo", "hi"]) if (p[k] != null) ys.push(p[k]);
   let y0 = Math.min(...ys), y1 = Math.max(...ys);
   const pad = 0.08 * (y1 - y0 || 1);
   y0 -= pad; y1 += pad;
-  const X = f => L + (f - f0) / (f1 - f0) * (W - L - R);
+  const X = f => L + (Math.min(Math.max(f, f0), f1) - f0) / (f1 - f0) * (W - L - R);
   const Y = y => T + (y1 - y) / (y1 - y0) * (H - T - B);
+  const keys = [["measured", "measured Re Z"]];
+  if (win && (win.lo != null || win.hi != null)) {
+    const lo = win.lo ?? f0, hi = win.hi ?? f1;
+    svg.appendChild(el("rect", {class: "window", x: X(lo), width: X(hi) - X(lo), y: T, height: H - T - B,
+                                "data-lo": lo, "data-hi": hi}));
+    const range = win.lo == null ? "≤ " + num(win.hi, 6) : win.hi == null ? "≥ " + num(win.lo, 6)
+        : num(win.lo, 6) + "–" + num(win.hi, 6);
+    keys.push(["window", `resonance window ${range} Hz`]);
+  }
   for (let i = 0; i <= 6; i++) {
     const f = f0 + i * (f1 - f0) / 6, y = y0 + i * (y1 - y0) / 6;
     svg.append(el("line", {class: "grid", x1: X(f), x2: X(f), y1: T, y2: H - B}),
@@ -129,25 +229,44 @@ function plotCurves(record) {
                el("text", {x: 5, y: Y(y) + 4}, y.toFixed(2)));
   }
   svg.append(el("text", {x: W / 2 - 30, y: H - 5}, "f (Hz)"));
+  let maskCount = 0;
   for (const m of masks) {
     for (const key of ["lo", "hi"]) {
       const pts = [];
-      for (let f = Math.max(f0, m.points[0].f_hz); f <= Math.min(f1, m.points[m.points.length - 1].f_hz); f += (f1 - f0) / 200) {
+      const a = Math.max(f0, m.points[0].f_hz), b = Math.min(f1, m.points[m.points.length - 1].f_hz);
+      for (let i = 0; i <= 200 && b > a; i++) {
+        const f = a + i * (b - a) / 200;
         const v = maskAt(m.points, key, f);
         if (v != null) pts.push([X(f), Y(v)]);
       }
       if (pts.length < 2) continue;
       const edge = key === "hi" ? T : H - B;
       const poly = pts.map(p => p.join(",")).concat([`${pts[pts.length - 1][0]},${edge}`, `${pts[0][0]},${edge}`]);
-      svg.appendChild(el("polygon", {class: "mask", points: poly.join(" ")}));
+      svg.appendChild(el("polygon", {class: "mask", points: poly.join(" "), "data-mask": m.name}));
+      ++maskCount;
     }
   }
+  if (maskCount)
+    keys.push(["mask", "limit mask: Re Z must stay out of the shaded area" + (sameRecipe ? "" : " (recipe in use)")]);
+  const absMasks = ((recipe && recipe.masks) || []).filter(m => m.quantity === "abs_ohm").length;
+  if (absMasks) keys.push(["note", `${absMasks} |Z| mask${absMasks > 1 ? "s" : ""} judged, not drawn here`]);
   const line = (c, cls) => {
     const d = c.freq_hz.map((f, i) => (i ? "L" : "M") + X(f).toFixed(1) + "," + Y(c.re[i]).toFixed(1)).join("");
     svg.appendChild(el("path", {class: cls, d, "data-points": c.freq_hz.length}));
   };
-  if (model) line(model, "model");
   line(meas, "measured");
+  if (resonance && isFinite(resonance.value)) {
+    svg.appendChild(el("line", {class: "f0", x1: X(resonance.value), x2: X(resonance.value), y1: T, y2: H - B}));
+    keys.push(["f0", `measured resonance ${num(resonance.value, 4, true)} Hz`]);
+  }
+  if (model) {  // last: on top of the measured curve, never hidden under it
+    line(model, "model");
+    keys.splice(1, 0, ["model", "fitted model"]);
+  }
+  renderLegend(keys);
+  $("curve-note").textContent = "— " + record.serial;
+  svg.setAttribute("data-serial", record.serial);
+  svg.setAttribute("aria-label", `Re Z of ${record.serial} over frequency: ` + keys.map(k => k[1]).join(", "));
 }
 
 async function showTest(id) {
@@ -155,59 +274,218 @@ async function showTest(id) {
   shownTestId = id;
   try {
     const record = await getJson("/api/tests/" + id);
+    if (id !== shownTestId) return;  // a newer test is shown meanwhile
     plotCurves(record);
     renderMeasurements(record.measurements);
+    renderTested(record);
   } catch (e) {
-    $("curve-note").textContent = "(" + e.message + ")";
+    clearPlot(e.message);
   }
 }
 
-// Self-check lockout: production tests are refused until a master check passes.
-function renderLockout(lockout) {
-  const el = $("lockout");
-  el.hidden = !(lockout && lockout.locked);
-  el.textContent = el.hidden ? "" : "LOCKED OUT: " + lockout.reason;
+// A finished result: its record when it was stored (id > 0); a refusal before anything moved
+// (lockout, retest limit) is not stored and has no curve.
+function showResult(summary) {
+  renderOutcome(summary.outcome, summary.serial, summary.reasons, summary.kind);
+  if (summary.id > 0) {
+    showTest(summary.id);
+  } else {
+    shownTestId = null;
+    clearPlot("not stored: refused before testing");
+    renderMeasurements([]);
+    $("tested").textContent = "Refused " + localTime(summary.finished_at || summary.started_at, DATE_TIME);
+  }
 }
 
+function showRunning(serial) {
+  renderOutcome("RUNNING", serial, []);
+  shownTestId = null;  // the last unit's curve is not this one's
+  clearPlot("test running");
+  renderMeasurements([]);
+}
+
+// Self-check lockout: production tests are refused until the master parts pass.
+function renderLockout(lockout) {
+  const b = $("lockout");
+  b.hidden = !(lockout && lockout.locked);
+  b.textContent = b.hidden ? "" : "LOCKED OUT: production tests are refused until the master parts pass — " +
+      lockout.reason;
+  document.body.classList.toggle("locked", !b.hidden);
+}
+
+// A station on simulators or recorded data: nothing it shows is a production result.
+function renderSimulation(why) {
+  const b = $("simulation");
+  b.hidden = !why;
+  b.textContent = why ? "SIMULATION: " + why + ", not production results" : "";
+}
+
+// Ready: the fixture and the DAQ answered.
+function renderReadiness(ready, why) {
+  const b = $("not-ready");
+  b.hidden = ready !== false;
+  b.textContent = b.hidden ? "" : "NOT READY: " + why;
+}
+
+// Events of each kind received over the stream. A status fetched while an event of a kind
+// arrived may be older than that event (the lockout lifted while /api/status was answered):
+// the event wins, and of overlapping fetches only the newest answer is shown.
+const eventsSeen = {};
+let statusAsked = 0, statusShown = 0;
+
 async function refreshStatus() {
+  const asked = ++statusAsked;
+  const before = {...eventsSeen};
   const s = await getJson("/api/status");
-  renderLockout(s.lockout);
+  if (asked < statusShown) return;
+  statusShown = asked;
+  const fresh = (...kinds) => kinds.every(k => (eventsSeen[k] || 0) === (before[k] || 0));
+  if (fresh("lockout")) renderLockout(s.lockout);
+  renderSimulation(s.simulation);
+  if (fresh("readiness")) renderReadiness(s.ready, s.not_ready_reason);
   $("station").textContent = "EOL station " + s.station_id;
-  $("message").textContent = s.message || "";
+  if (fresh("message")) $("message").textContent = s.message || "";
   renderHistory(s);
+  if (!fresh("state", "verdict")) return;
   const running = s.state !== "wait_serial" && s.state !== "idle" && s.state !== "publish";
   if (running) {
-    renderVerdict("RUNNING", s.serial, []);
+    if ($("serial").textContent !== s.serial || !$("verdict").classList.contains("RUNNING")) showRunning(s.serial);
   } else if (s.last) {
-    renderVerdict(s.last.outcome, s.last.serial, s.last.reasons);
-    showTest(s.last.id);
+    showResult(s.last);
   }
   renderStates(s.state);
 }
 
-async function main() {
+async function loadRecipe() {
   try {
     recipe = await getJson("/api/recipe");
     $("recipe").textContent = `recipe ${recipe.id} v${recipe.version}`;
   } catch (e) {
     $("recipe").textContent = "recipe unavailable";
   }
+}
+
+// --- Starting tests: a keyboard-wedge scanner types the serial and Enter into #scan. ---
+
+// The serial field keeps the focus: whenever nothing else that takes text has it, the next
+// keystroke (the scanner's) lands there.
+function keepScanFocus() {
+  const scan = $("scan");
+  const takesText = e => e && ["INPUT", "TEXTAREA", "SELECT", "BUTTON"].includes(e.tagName);
+  const refocus = () => { if (!takesText(document.activeElement)) scan.focus(); };
+  scan.addEventListener("blur", () => setTimeout(refocus, 0));  // the new focus is known after blur
+  document.addEventListener("click", refocus);
+  document.addEventListener("keydown", e => {
+    if (!takesText(document.activeElement) && !e.ctrlKey && !e.altKey && !e.metaKey) scan.focus();
+  });
+  // Operator and shift: Enter there stores them and hands the focus back to the scanner.
+  for (const id of ["operator-id", "shift", "token"]) {
+    $(id).addEventListener("keydown", e => {
+      if (e.key === "Enter") { e.preventDefault(); saveWork(); scan.focus(); }
+    });
+    $(id).addEventListener("change", saveWork);
+  }
+  scan.focus();
+}
+
+// Operator and shift are kept in this browser (one browser per station) and go with every
+// test the page starts; the token only for this session.
+function saveWork() {
+  localStorage.setItem("eol.operator_id", $("operator-id").value.trim());
+  localStorage.setItem("eol.shift", $("shift").value.trim());
+  sessionStorage.setItem("eol.token", $("token").value);
+}
+
+function loadWork() {
+  $("operator-id").value = localStorage.getItem("eol.operator_id") || "";
+  $("shift").value = localStorage.getItem("eol.shift") || "";
+  $("token").value = sessionStorage.getItem("eol.token") || "";
+  $("token-row").hidden = !$("token").value;
+}
+
+function startStatus(text, problem) {
+  const s = $("start-status");
+  s.textContent = text;
+  s.className = problem ? "problem" : "";
+}
+
+// POST /api/tests as any client does: no token while the station has none configured (the
+// API then opens operator routes, station/http/request.h); with tokens, the operator's.
+async function startTest(serial) {
+  const body = {serial};
+  const operator = $("operator-id").value.trim(), shift = $("shift").value.trim();
+  if (operator) body.operator_id = operator;
+  if (shift) body.shift = shift;
+  const headers = {"Content-Type": "application/json"};
+  const token = $("token").value;
+  if (token) headers.Authorization = "Bearer " + token;
+  let res, answer = {};
+  try {
+    res = await fetch("/api/tests", {method: "POST", headers, body: JSON.stringify(body)});
+    answer = await res.json().catch(() => ({}));
+  } catch (e) {
+    startStatus("not started: station not reachable (" + e.message + ")", true);
+    return;
+  }
+  if (res.status === 202) {
+    startStatus(serial + " started");
+    return;
+  }
+  const why = (answer.error && answer.error.message) || "HTTP " + res.status;
+  if (res.status === 401 || res.status === 403) {
+    $("token-row").hidden = false;
+    startStatus(serial + " not started: this station needs an operator token (" + why + ")", true);
+  } else {
+    startStatus(serial + " not started: " + why, true);
+  }
+}
+
+function setupStart() {
+  loadWork();
+  $("start-form").addEventListener("submit", e => {
+    e.preventDefault();
+    const serial = $("scan").value.trim();
+    $("scan").value = "";
+    $("scan").focus();
+    if (!serial) return;
+    saveWork();
+    startStatus(serial + " sent…");
+    startTest(serial);
+  });
+  keepScanFocus();
+}
+
+async function main() {
+  setupStart();
+  await loadRecipe();
   await refreshStatus().catch(e => { $("message").textContent = e.message; });
-  const events = new EventSource("/api/events");
-  events.onopen = () => { $("connection").textContent = "live"; $("connection").className = "online"; };
-  events.onerror = () => { $("connection").textContent = "reconnecting…"; $("connection").className = "offline"; };
+  const source = new EventSource("/api/events");
+  const events = {
+    addEventListener(kind, handle) {
+      source.addEventListener(kind, ev => { eventsSeen[kind] = (eventsSeen[kind] || 0) + 1; handle(ev); });
+    },
+  };
+  source.onopen = () => {
+    $("connection").textContent = "live";
+    $("connection").className = "online";
+    refreshStatus().catch(() => {});  // what happened while the stream was down
+  };
+  source.onerror = () => { $("connection").textContent = "reconnecting…"; $("connection").className = "offline"; };
   events.addEventListener("state", ev => {
     const e = JSON.parse(ev.data);
     renderStates(e.state);
-    if (e.state === "check_interlocks") renderVerdict("RUNNING", e.serial, []);
+    if (e.state === "check_interlocks") showRunning(e.serial);
   });
   events.addEventListener("verdict", ev => {
-    const e = JSON.parse(ev.data);
-    renderVerdict(e.record.outcome, e.record.serial, e.record.reasons);
-    showTest(e.record.id);
+    showResult(JSON.parse(ev.data).record);
     refreshStatus().catch(() => {});
   });
+  events.addEventListener("recipe", () => { loadRecipe(); });
   events.addEventListener("lockout", ev => { renderLockout(JSON.parse(ev.data).lockout); });
+  events.addEventListener("readiness", ev => {
+    const e = JSON.parse(ev.data);
+    renderReadiness(e.ready, e.not_ready_reason);
+  });
   events.addEventListener("message", ev => { $("message").textContent = JSON.parse(ev.data).message; });
 }
 

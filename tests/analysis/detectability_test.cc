@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace eol::analysis {
 namespace {
 
@@ -75,6 +77,57 @@ TEST(Detectability, StiffClampSeparatesWhatTheSoftOneHides) {
   EXPECT_FALSE(s.separable) << s.best << " " << s.best_separation;
   EXPECT_TRUE(t.separable) << t.best << " " << t.best_separation;
   EXPECT_GT(t.best_separation, s.best_separation);
+}
+
+// Model POD against the bond stiffness loss: the bond sits in series with the bridges and the
+// fixture, so f0 hardly moves until most of the bond is lost. Mild losses are invisible (POD at
+// the limit's false-call level), all ten bonds are found from a loss of 0.9-0.96, and the
+// a90 of one magnet is never below that of all ten.
+TEST(Detectability, ModelPodRisesOnlyForSevereLoss) {
+  const DetectabilitySummary s = PredictDetectability(Options(1.0));
+  ASSERT_TRUE(s.usable) << s.message;
+  ASSERT_EQ(s.pod.size(), 2u);
+  const ModelPod& one = s.pod[0];
+  const ModelPod& all = s.pod[1];
+  ASSERT_EQ(all.name, "all_magnets");
+  ASSERT_EQ(all.points.size(), DetectabilityOptions{}.pod_losses.size());
+  EXPECT_LT(all.points.front().pod, 0.01);  // loss 0.2
+  EXPECT_GE(all.points.back().pod, 0.9);    // loss 0.99
+  EXPECT_GT(all.a90, 0.9);
+  EXPECT_LT(all.a90, 0.96);
+  // Beyond a90 POD stays at or above 0.9 (the reading of a90).
+  for (const ModelPod* m : {&one, &all})
+    for (const ModelPodPoint& p : m->points)
+      EXPECT_TRUE(p.loss < m->a90 || p.pod >= 0.9) << m->name << " " << p.loss << " " << p.pod;
+  EXPECT_GE(one.a90, all.a90);
+  // f0 falls with the loss (all ten soft).
+  EXPECT_LT(all.points.back().f0_hz, all.points.front().f0_hz - 20.0);
+}
+
+// a90/95 from the spread's sampling error: with the spread from 40 golden units every spread
+// is taken at its 95 % upper bound, sqrt(39 / chi2_39(0.05)) = sqrt(39 / 25.6954) = 1.23199
+// times (chi-square table); the lower POD equals the POD of a run with the spreads so scaled.
+TEST(Detectability, ModelA9095TakesTheSpreadAtItsUpperBound) {
+  DetectabilityOptions o = Options(1.0);
+  const DetectabilitySummary given = PredictDetectability(o);
+  ASSERT_TRUE(given.usable) << given.message;
+  EXPECT_TRUE(std::isnan(given.pod[1].a90_95));  // not a sample: no confidence bound
+  o.spread_units = 40;
+  const DetectabilitySummary sampled = PredictDetectability(o);
+  ASSERT_TRUE(sampled.usable) << sampled.message;
+  DetectabilityOptions wide = Options(1.0);
+  for (auto& [name, spread] : wide.unit_spread) spread *= std::sqrt(39.0 / 25.6954);
+  const DetectabilitySummary upper = PredictDetectability(wide);
+  ASSERT_TRUE(upper.usable) << upper.message;
+  for (std::size_t c = 0; c < 2; ++c) {
+    const ModelPod& p = sampled.pod[c];
+    EXPECT_DOUBLE_EQ(p.a90, given.pod[c].a90) << p.name;
+    EXPECT_NEAR(p.a90_95, upper.pod[c].a90, 1e-4) << p.name;
+    EXPECT_GE(p.a90_95, p.a90) << p.name;
+    for (std::size_t k = 0; k < p.points.size(); ++k)
+      EXPECT_NEAR(p.points[k].pod_lower, upper.pod[c].points[k].pod, 1e-4)
+          << p.name << " " << p.points[k].loss;
+  }
 }
 
 TEST(Detectability, InvalidOptionsAreNamed) {

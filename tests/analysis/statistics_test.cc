@@ -1,4 +1,4 @@
-// Known answers for capability, drift and the type-1 gauge study (analysis/qc/statistics.h),
+// Known answers for drift and the type-1 gauge study (analysis/qc/statistics.h),
 // on data small enough to compute by hand; each expected value is worked out in a comment.
 #include "analysis/qc/statistics.h"
 
@@ -14,37 +14,6 @@ Limit Both(double lo, double hi) {
   l.lo = lo;
   l.hi = hi;
   return l;
-}
-
-TEST(Capability, KnownAnswerTwoSided) {
-  // {1..5}: mean 3, s = sqrt(10 / 4) = 1.58113883.
-  // Cp = 10 / (6 s) = 1.05409255; Cpk = min(10 - 3, 3 - 0) / (3 s) = 0.63245553.
-  const Capability c = ComputeCapability({1, 2, 3, 4, 5}, Both(0, 10));
-  ASSERT_TRUE(c.usable) << c.message;
-  EXPECT_EQ(c.sample.n, 5u);
-  EXPECT_DOUBLE_EQ(c.sample.mean, 3.0);
-  EXPECT_NEAR(c.sample.sd, 1.58113883, 1e-8);
-  EXPECT_NEAR(*c.cp, 1.05409255, 1e-8);
-  EXPECT_NEAR(*c.cpk, 0.63245553, 1e-8);
-  EXPECT_DOUBLE_EQ(c.sample.min, 1.0);
-  EXPECT_DOUBLE_EQ(c.sample.max, 5.0);
-}
-
-TEST(Capability, OneSidedLimitGivesCpkOnlyFromThatSide) {
-  // hi = 10 only: no Cp; Cpk = (10 - 3) / (3 s) = 1.47572957.
-  Limit hi_only;
-  hi_only.hi = 10;
-  const Capability c = ComputeCapability({1, 2, 3, 4, 5}, hi_only);
-  EXPECT_FALSE(c.cp.has_value());
-  EXPECT_NEAR(*c.cpk, 1.47572957, 1e-8);
-}
-
-TEST(Capability, NoSpreadOrTooFewValuesIsNotUsable) {
-  EXPECT_FALSE(ComputeCapability({2.0}, Both(0, 10)).usable);
-  const Capability flat = ComputeCapability({2, 2, 2}, Both(0, 10));
-  EXPECT_FALSE(flat.usable);
-  EXPECT_FALSE(flat.cpk.has_value());
-  EXPECT_NE(flat.message.find("no spread"), std::string::npos);
 }
 
 TEST(Drift, KnownAnswerNoisyLine) {

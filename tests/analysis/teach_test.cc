@@ -166,7 +166,8 @@ const std::vector<MeasurementSpec> kStationSpecs = {
     Spec("resonance_f_hz", true, true), Spec("resonance_q", true, true),
     Spec("fit_chi2_per_dof", false, true), Spec("winding_r_ohm", true, true)};
 
-// The budget goes where defects move the measurements: f0 and Q low, chi2 high; the other
+// The budget goes where defects move the measurements: f0 and Q low, chi2 high (in the
+// proportions of teach.h's table); the other
 // side of f0 and Q is a plausibility bound. Shares add up to the target.
 TEST(Teach, PhysicsAllocationSpendsTheBudgetOnTheDefectSide) {
   TeachOptions o;
@@ -186,7 +187,7 @@ TEST(Teach, PhysicsAllocationSpendsTheBudgetOnTheDefectSide) {
   }
   EXPECT_NEAR(total, 1.0 - o.coverage, 1e-12);
   EXPECT_GT(f0_lo, 100.0 * f0_hi);
-  EXPECT_GT(f0_lo, chi2_hi);
+  EXPECT_NEAR(f0_lo / chi2_hi, 0.30 / 0.35, 1e-9) << "teach.h's table: f0 lo 0.30, chi2 hi 0.35";
   EXPECT_GT(chi2_hi, 10.0 * r_lo);
   // Against an even split of the same budget: the lower f0 limit is tighter, the upper wider.
   TeachOptions e = Even();
@@ -196,6 +197,65 @@ TEST(Teach, PhysicsAllocationSpendsTheBudgetOnTheDefectSide) {
   EXPECT_GT(*s.limits[0].limit.lo, *t.limits[0].limit.lo + 1.0);
   EXPECT_GT(*s.limits[0].limit.hi, *t.limits[0].limit.hi);
   EXPECT_NE(s.message.find("expected false rejects"), std::string::npos) << s.message;
+}
+
+// Known-bad units: two escapes just below the good units' f0 move budget to the f0 lower
+// bound from the bounds that catch none of them (Q lo, R lo and hi; chi2 catches the third
+// known-bad unit, so it keeps its share); the total stays the target; the limit ends just above
+// the higher escape. A unit inside the good spread stays an escape and is named.
+TEST(Teach, KnownBadUnitsMoveBudgetToTheF0Bound) {
+  TeachOptions o;
+  o.mask_segments = 0;
+  o.known_bad_max_donation = 1.0;  // all a donor has above plausibility (the default is half)
+  const std::vector<GoldenUnit> golden = StationUnits(40, 3);
+  const TeachSummary plain = TeachLimits(kStationSpecs, golden, o);
+  ASSERT_TRUE(plain.usable) << plain.message;
+  const double f0_lo = *plain.limits[0].limit.lo;
+  auto bad = [&](const std::string& label, double f0, double chi2) {
+    GoldenUnit u = golden.front();
+    u.label = label;
+    u.values["resonance_f_hz"] = f0;
+    u.values["resonance_q"] = 50.0;
+    u.values["winding_r_ohm"] = 0.5;
+    u.values["fit_chi2_per_dof"] = chi2;
+    return u;
+  };
+  // What the movable share (Q lo, R lo and hi down to plausibility: 0.084 of 0.744 in weight)
+  // can reach: k from 3.69 to about 3.62, 0.28 Hz with a spread of 4 Hz.
+  const std::vector<GoldenUnit> known = {bad("escape-a", f0_lo + 0.1, 1.0),
+                                         bad("escape-b", f0_lo + 0.2, 1.0),
+                                         bad("chi2-caught", 389.0, 5.0), bad("hidden", 389.0, 1.0)};
+  const TeachSummary s = TeachLimits(kStationSpecs, golden, o, known);
+  ASSERT_TRUE(s.usable) << s.message;
+  EXPECT_EQ(s.known_bad_units, 4);
+  EXPECT_NEAR(s.f0_lo_budget_hz, f0_lo, 1e-3);
+  EXPECT_EQ(s.known_bad_escapes_budget,
+            (std::vector<std::string>{"escape-a", "escape-b", "hidden"}));
+  EXPECT_EQ(s.known_bad_escapes, std::vector<std::string>{"hidden"});
+  EXPECT_GT(*s.limits[0].limit.lo, f0_lo + 0.2);
+  EXPECT_LT(*s.limits[0].limit.lo, f0_lo + 0.2 + 0.005);  // 1e-5 margin over the escape
+  EXPECT_GT(s.known_bad_moved_share, 0.0);
+  double total = 0.0, chi2 = 0.0, plain_chi2 = 0.0;
+  for (const TaughtBound& b : s.taught_bounds) {
+    total += b.share;
+    if (b.statistic == "fit_chi2_per_dof") chi2 = b.share;
+  }
+  for (const TaughtBound& b : plain.taught_bounds)
+    if (b.statistic == "fit_chi2_per_dof") plain_chi2 = b.share;
+  EXPECT_NEAR(total, 1.0 - o.coverage, 1e-12);
+  EXPECT_DOUBLE_EQ(chi2, plain_chi2);
+  EXPECT_EQ(s.known_bad_donors,
+            (std::vector<std::string>{"resonance_q lo", "winding_r_ohm lo", "winding_r_ohm hi"}));
+  EXPECT_NE(s.message.find("1 pass the taught limits"), std::string::npos) << s.message;
+  // By default a donor gives at most half: escape-b is out of reach, escape-a is caught.
+  o.known_bad_max_donation = 0.5;
+  const TeachSummary half = TeachLimits(kStationSpecs, golden, o, known);
+  ASSERT_TRUE(half.usable) << half.message;
+  EXPECT_EQ(half.known_bad_escapes, (std::vector<std::string>{"escape-b", "hidden"}));
+  EXPECT_GT(*half.limits[0].limit.lo, f0_lo + 0.1);
+  EXPECT_LT(*half.limits[0].limit.lo, f0_lo + 0.1 + 0.005);
+  // Only the physics allocation has shares to move.
+  EXPECT_FALSE(TeachLimits(kStationSpecs, golden, Even(), known).usable);
 }
 
 // Over repeated teaching from 40 units, the true false-reject rate of the taught limits

@@ -118,6 +118,34 @@ TEST(TorsionalChain, SingleModeMatchesClampedRotor) {
   EXPECT_NEAR(modes[0].f_hz, z.f0_hz, 1e-9 * z.f0_hz);
   EXPECT_NEAR(modes[0].q, 50.0, 1e-9);
   EXPECT_NEAR(modes[0].RpOhm(0.05), z.rp_ohm, 1e-9 * z.rp_ohm);
+  // The residue Rp w0 / Q is T^2 / J whatever the stiffness and damping.
+  EXPECT_NEAR(z.ResidueOhmPerS(), 0.05 * 0.05 / 1e-4, 1e-9 * z.ResidueOhmPerS());
+}
+
+// The first mode's residue T^2 / J_eff (motor_model.h) against its frequency: softer bonds
+// let less inertia follow the magnets, so the residue rises many times faster than f0 falls,
+// while a stiffer or softer clamp moves f0 and leaves the residue nearly where it was.
+TEST(RotorChain, ResidueRisesWithSoftBondsAndIgnoresTheClamp) {
+  auto first = [](const RotorChainParams& p) {
+    ClampedMotor motor{0.5, 2e-3, 0.05, BuildRotorChain(p)};
+    return motor.ModalTerms().at(0);
+  };
+  const RotorChainParams good;
+  const MotionalImpedance g = first(good);
+  const MotionalImpedance soft = first(AllSoft(good));
+  RotorChainParams stiff_clamp = good;
+  stiff_clamp.fixture->stiffness_nm_per_rad *= 1.2;
+  const MotionalImpedance clamp = first(stiff_clamp);
+  const double df_soft = 1.0 - soft.f0_hz / g.f0_hz;
+  const double da_soft = soft.ResidueOhmPerS() / g.ResidueOhmPerS() - 1.0;
+  EXPECT_GT(df_soft, 0.05);           // 390 -> 366 Hz
+  EXPECT_GT(da_soft, 8.0 * df_soft);  // +73 %
+  const double df_clamp = clamp.f0_hz / g.f0_hz - 1.0;
+  const double da_clamp = std::abs(clamp.ResidueOhmPerS() / g.ResidueOhmPerS() - 1.0);
+  EXPECT_GT(df_clamp, 0.03);
+  EXPECT_LT(da_clamp, 0.5 * df_clamp);
+  // Good rotor: close to T^2 over the whole rotor's inertia (1.05e-4 kg m^2 with the clamp).
+  EXPECT_NEAR(g.ResidueOhmPerS(), 0.05 * 0.05 / 1.05e-4, 0.15 * 0.05 * 0.05 / 1.05e-4);
 }
 
 TEST(TorsionalChain, InvalidChainsAreNamed) {

@@ -167,9 +167,9 @@ TEST_F(StoreTest, OpenCreatesTheSchemaWithWalAndVersion) {
   EXPECT_EQ(raw.Column("PRAGMA journal_mode"), std::vector<std::string>{"wal"});
   EXPECT_EQ(raw.Column("PRAGMA user_version"),
             std::vector<std::string>{std::to_string(Store::kSchemaVersion)});
-  EXPECT_EQ(
-      raw.Column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
-      (std::vector<std::string>{"curves", "measurements", "recipe_audit", "self_checks", "tests"}));
+  EXPECT_EQ(raw.Column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
+            (std::vector<std::string>{"curves", "measurements", "outbox", "outbox_cursors",
+                                      "recipe_audit", "self_checks", "sqlite_sequence", "tests"}));
   const auto indexes = raw.Column("SELECT name FROM sqlite_schema WHERE type = 'index'");
   for (const char* name : {"tests_serial_started", "tests_started", "measurements_name"})
     EXPECT_NE(std::find(indexes.begin(), indexes.end(), name), indexes.end()) << name;
@@ -464,8 +464,9 @@ TEST_F(StoreTest, FileThatIsNotADatabaseFailsNamingThePath) {
 TEST_F(StoreTest, UnwritablePathFailsNamingThePath) {
   // A directory that does not exist (a read-only file does not stop root, who runs CI).
   const fs::path missing = dir_ / "no_such_dir" / "eol.db";
+  // The writer's lock beside the file is the first thing that cannot be created.
   EXPECT_STORE_ERROR(Store::Open(missing.string()), "'" + missing.string() + "'", "open",
-                     "unable to open");
+                     "No such file or directory");
   // A directory where the file should be.
   EXPECT_STORE_ERROR(Store::Open(dir_.string()), "'" + dir_.string() + "'", "open");
 }
@@ -584,7 +585,7 @@ TEST_F(StoreTest, TestsFiltersByOutcomeTimeSerialAndLimit) {
 
 TEST_F(StoreTest, TwoStoresOnOneFileSeeEachOthersCommits) {
   auto writer = Open();
-  auto reader = Open();
+  auto reader = Store::Open(path_.string(), Store::Role::kReader);  // one writer per file
   TestRecord r = MakeRecord("M-1", "2024-05-01T10:00:00.000Z");
   writer->Insert(r);
   EXPECT_TRUE(reader->Test(r.id).has_value());
@@ -694,6 +695,32 @@ TEST_F(StoreMigrationTest, AuditLogRoundTripsNewestFirst) {
   EXPECT_EQ(log[1].who, "qe-anna");
   EXPECT_EQ(log[1].old_version, 1);
   EXPECT_EQ(log[1].old_hash, std::string(64, 'a'));
+}
+
+// One station per database: a second writer is refused before it recovers (aborts) the
+// first one's running test; readers are not affected.
+TEST_F(StoreTest, ASecondWriterIsRefusedWhileTheFirstIsOpen) {
+  auto first = Open();
+  TestRecord running;
+  running.serial = "RUN-1";
+  running.station_id = "s1";
+  running.recipe_id = "r";
+  running.recipe_hash = std::string(64, 'a');
+  running.software_version = "t";
+  running.started_at = "2026-11-20T08:00:00.000Z";
+  first->BeginTest(running);
+  try {
+    Store::Open(path_.string());
+    ADD_FAILURE() << "a second writer opened the store";
+  } catch (const StoreError& e) {
+    EXPECT_EQ(std::string(e.what()), "store '" + path_.string() +
+                                         "': lock: another station holds " + path_.string() +
+                                         ".lock (one station per database; stop the other first)");
+  }
+  EXPECT_NO_THROW(Store::Open(path_.string(), Store::Role::kReader));
+  first.reset();
+  auto second = Open();
+  EXPECT_EQ(second->aborted_on_open(), 1) << "the lock is released with the first store";
 }
 
 }  // namespace

@@ -58,16 +58,20 @@ inline std::optional<int> WaitForReadyPort(ChildProcess& child, const std::strin
   return port;
 }
 
-// Runs the pymodbus client script to completion and returns its JSON results (one per
-// operation); a JSON null when it failed (the reason is in `log`).
-inline nlohmann::json RunPymodbusClient(const std::vector<std::string>& transport_args,
-                                        const nlohmann::json& ops, std::string* log) {
-  std::vector<std::string> argv = {kPython, PeerScript("pymodbus_fixture_client.py")};
+// Runs a pymodbus client script of tests/peers/ (pymodbus_fixture_client.py, or
+// pymodbus_plc_client.py for the line PLC) to completion and returns its JSON results (one
+// per operation); a JSON null when it failed or took longer than `timeout` (the reason is in
+// `log`).
+inline nlohmann::json RunPymodbusClientScript(
+    const std::string& script, const std::vector<std::string>& transport_args,
+    const nlohmann::json& ops, std::string* log,
+    std::chrono::seconds timeout = std::chrono::seconds(60)) {
+  std::vector<std::string> argv = {kPython, PeerScript(script)};
   argv.insert(argv.end(), transport_args.begin(), transport_args.end());
   argv.push_back("--ops");
   argv.push_back(ops.dump());
   ChildProcess client(argv, /*merge_stderr=*/false);
-  const auto code = client.Wait(std::chrono::seconds(60));
+  const auto code = client.Wait(timeout);
   *log = "exit " + (code ? std::to_string(*code) : std::string("none (timed out)")) +
          ", stdout: " + client.output();
   if (code != 0) return nullptr;
@@ -76,6 +80,11 @@ inline nlohmann::json RunPymodbusClient(const std::vector<std::string>& transpor
   } catch (const nlohmann::json::exception&) {
     return nullptr;
   }
+}
+
+inline nlohmann::json RunPymodbusClient(const std::vector<std::string>& transport_args,
+                                        const nlohmann::json& ops, std::string* log) {
+  return RunPymodbusClientScript("pymodbus_fixture_client.py", transport_args, ops, log);
 }
 
 }  // namespace eol::testing::modbus_peers

@@ -8,7 +8,11 @@ other unit. A unit is rejected when its verdict is not PASS (FAIL, or ERROR / no
 analysable: the station would not ship it either); the table says which.
 
 Prints the table (class, units judged, rejected, FAIL, ERROR/unusable, lowest f0 of the
-class) and, with --json FILE, writes the same as JSON for tests. Exit 0 when everything ran,
+class) and, with --json FILE, writes the same as JSON for tests. With --hits FILE it writes
+the per-unit hit/miss table (class, size = the truth's bond stiffness loss, hit, f0_hz) and
+runs `eol pod --hits FILE --json` on it: POD(a) and a90/95 per defect class, fitted by eol
+(analysis/qc/pod.h), printed and added to the JSON; --pod-svg FILE draws it with the taught
+f0 lower limit. Exit 0 when everything ran,
 1 when teach failed (its stderr is printed), 2 on usage errors.
 """
 import argparse
@@ -41,7 +45,10 @@ def judge(eol, recipe, path):
 def run_population(a, seed, workdir):
     pop = os.path.join(workdir, "pop-%d" % seed)
     counts = ["--good", str(a.golden + a.good), "--one-soft", str(a.one_soft),
-              "--three-soft", str(a.three_soft), "--all-soft", str(a.all_soft)]
+              "--three-soft", str(a.three_soft), "--all-soft", str(a.all_soft),
+              "--loss-lo", str(a.loss_lo), "--loss-hi", str(a.loss_hi)]
+    if a.poor_loss_factor is not None:
+        counts += ["--poor-loss-factor", str(a.poor_loss_factor)]
     subprocess.run([sys.executable, os.path.join(HERE, "independent_population.py"),
                     "--out", pop, "--seed", str(seed)] + counts, check=True)
     with open(os.path.join(pop, "truth.csv")) as f:
@@ -74,6 +81,14 @@ def main():
     ap.add_argument("--one-soft", type=int, default=20)
     ap.add_argument("--three-soft", type=int, default=20)
     ap.add_argument("--all-soft", type=int, default=20)
+    ap.add_argument("--loss-lo", type=float, default=0.20,
+                    help="smallest bond stiffness loss of a soft magnet (generator)")
+    ap.add_argument("--loss-hi", type=float, default=0.99,
+                    help="largest bond stiffness loss of a soft magnet (generator)")
+    ap.add_argument("--poor-loss-factor", type=float,
+                    help="loss factor of a soft bond (generator; default: the generator's)")
+    ap.add_argument("--hits", help="write the per-unit hit/miss CSV here and fit POD with eol pod")
+    ap.add_argument("--pod-svg", help="with --hits: the POD figure (eol pod --pod-svg)")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--teach-arg", action="append", default=[],
                     help="extra argument passed to eol teach (repeat)")
@@ -110,11 +125,35 @@ def main():
         print("teach seed %d: %s" % (t["seed"], t["message"]))
         for lim in t["limits"] or []:
             print("  %s: lo %s hi %s" % (lim.get("name"), lim.get("lo"), lim.get("hi")))
+    pod = None
+    if a.hits:
+        with open(a.hits, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["class", "size", "hit", "f0_hz", "unit"])
+            for t in rows:
+                w.writerow([t["class"], t["defect_size"], 0 if t["outcome"] == "PASS" else 1,
+                            "" if t.get("f0_hz") is None else "%.3f" % t["f0_hz"], t["unit"]])
+        cmd = [a.eol, "pod", "--hits", a.hits, "--json"]
+        if a.pod_svg:
+            cmd += ["--pod-svg", a.pod_svg]
+            for t in teach:
+                for lim in t["limits"] or []:
+                    if lim.get("name") == "resonance_f_hz" and lim.get("lo") is not None:
+                        cmd += ["--f0-limit", str(lim["lo"])]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        try:
+            pod = json.loads(r.stdout)["pod"]
+        except (ValueError, KeyError):
+            sys.stderr.write("eol pod failed: %s\n" % (r.stderr or r.stdout))
+            return 1
+        for cls, fit in pod.items():
+            print("POD %s: %s" % (cls, fit.get("message")))
     if a.json:
         with open(a.json, "w") as f:
-            json.dump({"table": table, "teach": teach,
+            json.dump({"table": table, "teach": teach, "pod": pod,
                        "units": [{k: t.get(k) for k in ("unit", "class", "outcome", "f0_hz",
-                                                        "first_mode_hz")} for t in rows]},
+                                                        "first_mode_hz", "defect_size")}
+                                 for t in rows]},
                       f, indent=1)
     return 0
 

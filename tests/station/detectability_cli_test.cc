@@ -38,7 +38,7 @@ TEST(DetectabilityCli, FixtureFromTheGapDiagnosis) {
   r = Eol({"simulate", "--motor", kMotors + "pmsm-10pole.json", "--out", dir / "meas.csv",
            "--model", "steady_state"});
   ASSERT_EQ(r.code, 0) << r.out;
-  r = Eol({"gap", "--sim", dir / "sim.csv", "--measured", dir / "meas.csv", "--json",
+  r = Eol({"gap", "--sim", dir / "sim.csv", "--measured", dir / "meas.csv", "--json-out",
            dir / "gap.json"});
   ASSERT_EQ(r.code, 0) << r.out;
   r = Eol({"detectability", "--gap", dir / "gap.json", "--json"}, false);
@@ -50,6 +50,21 @@ TEST(DetectabilityCli, FixtureFromTheGapDiagnosis) {
   const nlohmann::json* all = Class(j, "all_soft");
   ASSERT_NE(all, nullptr);
   EXPECT_TRUE((*all)["separable"].get<bool>()) << all->dump();
+  // Model POD against the bond stiffness loss, text and JSON: all ten bonds reach POD 0.9
+  // only beyond a loss of 0.9.
+  ASSERT_EQ(j["pod"].size(), 2u) << r.out;
+  EXPECT_EQ(j["pod"][1]["name"], "all_magnets");
+  ASSERT_TRUE(j["pod"][1]["a90"].is_number()) << j["pod"].dump();
+  EXPECT_GT(j["pod"][1]["a90"].get<double>(), 0.9) << j["pod"].dump();
+  EXPECT_LT(j["pod"][1]["a90"].get<double>(), 0.97) << j["pod"].dump();
+  // The spread comes from the recipe's limits here, not from units: no a90/95, and it says so.
+  EXPECT_TRUE(j["pod"][1]["a90_95"].is_null()) << j["pod"].dump();
+  CliRun text = Eol({"detectability", "--gap", dir / "gap.json"});
+  ASSERT_EQ(text.code, 0) << text.out;
+  EXPECT_NE(text.out.find("  all_magnets: a90 0.9"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("a90/95 needs the spread from golden units (--golden)"),
+            std::string::npos)
+      << text.out;
 }
 
 TEST(DetectabilityCli, SoftFixtureWarnsStiffFixtureSeparates) {

@@ -13,7 +13,8 @@ namespace {
 
 TEST(FitBenchCliTest, TinyRunReportsEveryFigure) {
   testing::ChildProcess p(
-      {EOL_BINARY, "fit-bench", "--runs", "4", "--check-runs", "3", "--peer-runs", "2", "--json"},
+      {EOL_BINARY, "fit-bench", "--runs", "4", "--check-runs", "3", "--peer-runs", "2", "--json",
+       "--recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
       /*merge_stderr=*/false);
   const auto code = p.Wait(std::chrono::seconds(300));
   ASSERT_TRUE(code.has_value()) << "fit-bench did not finish";

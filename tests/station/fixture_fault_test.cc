@@ -92,6 +92,7 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
 
   std::ofstream(dir / "station.json") << nlohmann::json{
       {"station_id", "faults"},
+      // The shipped recipe's 5 s of excitation: the fault comes 300 ms into it.
       {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
       {"db", db_path},
       {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},

@@ -26,7 +26,7 @@ nlohmann::json Diagnose(const std::string& recording, const TempDir& dir, std::s
   std::ofstream(dir / "rigid.json")
       << R"({"model": "rigid_shaft", "gain_rad_per_s2_per_a": 100.0, "damping_per_s": 13.8})";
   ChildProcess p({EOL_BINARY, "gap", "--quantity", "mobility", "--sim", dir / "rigid.json",
-                  "--measured", kDir + recording, "--json", dir / "out.json", "--plot",
+                  "--measured", kDir + recording, "--json-out", dir / "out.json", "--plot",
                   dir / "bench.svg"});
   const auto code = p.Wait(std::chrono::seconds(120));
   *text = p.output();

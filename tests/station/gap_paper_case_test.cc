@@ -30,7 +30,7 @@ using testing::ChildProcess;
 using testing::TempDir;
 
 nlohmann::json RunGap(const std::vector<std::string>& args, const TempDir& dir, std::string* text) {
-  std::vector<std::string> argv = {EOL_BINARY, "gap", "--json", dir / "out.json"};
+  std::vector<std::string> argv = {EOL_BINARY, "gap", "--json-out", dir / "out.json"};
   argv.insert(argv.end(), args.begin(), args.end());
   ChildProcess p(argv);
   const auto code = p.Wait(std::chrono::seconds(120));

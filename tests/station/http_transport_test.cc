@@ -205,7 +205,7 @@ TEST(HttpTransport, PutRecipeChecksRoleAndBodyThenMapsTheStationsAnswer) {
   EXPECT_EQ(put(kOperatorToken, recipe), "403 forbidden");
   EXPECT_EQ(put(kEngineerToken, "{not json"), "400 bad_json");
   // Above the server's 64 KiB limit the request is refused before any handler runs.
-  EXPECT_EQ(put(kEngineerToken, std::string(kMaxBodyBytes + 1, ' ')), "413 ");
+  EXPECT_EQ(put(kEngineerToken, std::string(kMaxBodyBytes + 1, ' ')), "413 too_large");
   EXPECT_EQ(asked, 0) << "the station was asked although the route refused";
 
   EXPECT_EQ(put(kEngineerToken, recipe), "200 ");

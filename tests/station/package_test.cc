@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -53,6 +55,33 @@ TEST(DebianPackage, HoldsProgramUnitConfigRecipesAndPage) {
   EXPECT_NE(control.output().find("conffiles"), std::string::npos) << control.output();
   EXPECT_NE(control.output().find("postinst"), std::string::npos);
   EXPECT_NE(control.output().find("Depends:"), std::string::npos) << "shlibdeps found no libraries";
+
+  // The config may hold API tokens: it is installed readable by owner and group only.
+  eol::testing::TempDir root;
+  eol::testing::ChildProcess extract({"/usr/bin/dpkg-deb", "-x", deb, root.path()});
+  ASSERT_EQ(extract.Wait(60s).value_or(-1), 0) << extract.output();
+  namespace fs = std::filesystem;
+  const fs::perms config = fs::status(fs::path(root.path()) / "etc/eol/station.json").permissions();
+  EXPECT_EQ(config & fs::perms::others_all, fs::perms::none) << "station.json is world-readable";
+  EXPECT_EQ(config & fs::perms::group_write, fs::perms::none);
+}
+
+// Issue 14: the unit is hardened; systemd's own rating of it stays below 3 ("OK").
+TEST(DebianPackage, ServiceUnitIsHardened) {
+  const std::string unit = std::string(EOL_SOURCE_DIR) + "/deploy/eol-station.service";
+  eol::testing::ChildProcess analyze(
+      {"/usr/bin/systemd-analyze", "security", "--offline=true", unit});
+  ASSERT_EQ(analyze.Wait(60s).value_or(-1), 0) << analyze.output();
+  const std::string out = analyze.output();
+  const std::string key = "Overall exposure level for eol-station.service: ";
+  const auto at = out.find(key);
+  ASSERT_NE(at, std::string::npos) << out;
+  const double exposure = std::stod(out.substr(at + key.size()));
+  EXPECT_LT(exposure, 3.0) << out;
+  // The service user reaches serial adapters and sound cards.
+  std::ifstream in(unit);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("SupplementaryGroups=dialout audio"), std::string::npos);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // `eol production-bench` at reduced size through the built binary, fixed seed: limits taught
 // from 50 golden units let no rotor with every magnet poorly cemented escape, reject at most
-// 0.3 % of good units, and every unit is counted once per rule.
+// 0.3 % of good units, every unit is counted once per rule, and the POD sweeps give a90/95.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -50,6 +50,20 @@ TEST(ProductionBenchCli, TaughtLimitsMeetTheTargetsAtReducedSize) {
   EXPECT_GT(all_soft, 20);  // 2 % all_soft: the target is exercised
   EXPECT_LE(j["rates"]["taught"]["false_reject_rate"].get<double>(), 0.003) << j.dump();
   EXPECT_EQ(j["teach"]["units_used"].get<int>() <= 50, true);
+  // POD sweeps (400 units each, losses 0.8-0.99): the all-magnets curve is fitted and its
+  // a90/95 lies where the model puts the rise (eol detectability: a90 0.937, f0 down 15 Hz
+  // at 0.94), above its own a90; one magnet is found later than all ten.
+  ASSERT_EQ(j["pod"].size(), 2u) << j["pod"].dump();
+  const auto& one = j["pod"][0];
+  const auto& all = j["pod"][1];
+  EXPECT_EQ(all["name"], "all_magnets");
+  ASSERT_TRUE(all["usable"].get<bool>()) << all.dump();
+  ASSERT_TRUE(all["a90_95_lr"].is_number()) << all.dump();
+  EXPECT_GT(all["a90"].get<double>(), 0.9) << all.dump();
+  EXPECT_LT(all["a90_95_lr"].get<double>(), 0.97) << all.dump();
+  EXPECT_GT(all["a90_95_lr"].get<double>(), all["a90"].get<double>());
+  ASSERT_TRUE(one["usable"].get<bool>()) << one.dump();
+  EXPECT_GT(one["a50"].get<double>(), all["a50"].get<double>()) << one.dump() << all.dump();
 }
 
 TEST(ProductionBenchCli, BadOptionsAreNamed) {

@@ -12,6 +12,7 @@
 
 #include "tests/support/child_process.h"
 #include "tests/support/station_ready.h"
+#include "tests/support/token_station.h"
 
 namespace eol {
 namespace {
@@ -33,23 +34,12 @@ class QcApi : public ::testing::Test {
   void SetUp() override {
     std::filesystem::copy_file(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json",
                                dir_ / "pmsm-10pole.json");
-    std::ofstream(dir_ / "station.json")
-        << nlohmann::json{{"station_id", "qc-api"},
-                          {"recipe", "pmsm-10pole.json"},
-                          {"db", "s.sqlite"},
-                          {"http",
-                           {{"listen", "127.0.0.1"},
-                            {"port", 0},
-                            {"tokens",
-                             {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
-                              {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
-                          {"fixture", {{"driver", "sim"}}},
-                          {"daq", {{"driver", "sim"}}},
-                          {"sim",
-                           {{"clamp_close_s", 0.02},
-                            {"clamp_open_s", 0.02},
-                            {"population", {{"defect_share", 0.0}, {"seed", 5}}}}}}
-               .dump();
+    nlohmann::json config =
+        testing::TokenStationConfig("qc-api", "pmsm-10pole.json", kOperator, kEngineer);
+    config["sim"] = {{"clamp_close_s", 0.02},
+                     {"clamp_open_s", 0.02},
+                     {"population", {{"defect_share", 0.0}, {"seed", 5}}}};
+    std::ofstream(dir_ / "station.json") << config.dump();
     station_ = std::make_unique<ChildProcess>(
         std::vector<std::string>{EOL_BINARY, "station", "--config", dir_ / "station.json"});
     ASSERT_TRUE(
@@ -126,14 +116,22 @@ TEST_F(QcApi, EngineersTeachFromStoredUnitsAndTheProposalIsAValidNextVersion) {
   }
   EXPECT_TRUE(saw_f0);
   EXPECT_GT(taught["units_needed"].get<int>(), 8);
-  // Nothing changed yet; PUT makes it the recipe in use, and the next test is judged with it.
+  // Nothing changed yet. The taught recipe is a proposal: PUT refuses it; an engineer's
+  // approval makes it the recipe in use, and the next test is judged with it.
   EXPECT_EQ(nlohmann::json::parse(http_->Get("/api/recipe")->body)["version"], 1);
+  EXPECT_EQ(taught["recipe"]["approval"]["state"], "proposed");
   res = http_->Put("/api/recipe", Bearer(kEngineer), taught["recipe"].dump(), "application/json");
   ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 409) << res->body;
+  res = http_->Post("/api/recipe/approve", Bearer(kEngineer),
+                    nlohmann::json{{"recipe", taught["recipe"]}}.dump(), "application/json");
+  ASSERT_TRUE(res);
   ASSERT_EQ(res->status, 200) << res->body;
+  const auto approved = nlohmann::json::parse(res->body);
   const auto in_use = nlohmann::json::parse(http_->Get("/api/recipe")->body);
   EXPECT_EQ(in_use["version"], 2);
-  EXPECT_EQ(in_use["hash"], taught["recipe_hash"]);
+  EXPECT_EQ(in_use["hash"], approved["hash"]);
+  EXPECT_NE(in_use["hash"], taught["recipe_hash"]) << "the approval is part of the recipe";
   EXPECT_EQ(Test("AFTER-TEACH"), "PASS");
 }
 
@@ -141,7 +139,16 @@ TEST_F(QcApi, DetectabilityReportsEveryDefectClassAndRejectsBadParameters) {
   auto res = http_->Get("/api/detectability?k_fixture=abc");
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 400);
-  EXPECT_NE(res->body.find("k_fixture must be a positive number"), std::string::npos);
+  EXPECT_NE(res->body.find("k_fixture must be a number in [0.1, 10000000.0], got 'abc'"),
+            std::string::npos)
+      << res->body;
+  // Out of range is the client's error, not the station's (this used to be a 500).
+  for (const char* q : {"k_fixture=1e308", "k_fixture=-1", "limit_sigmas=1e308",
+                        "required_sigmas=nan", "k_fixture=864abc"}) {
+    res = http_->Get(std::string("/api/detectability?") + q);
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 400) << q << ": " << res->body;
+  }
 
   res = http_->Get("/api/detectability?k_fixture=864");
   ASSERT_TRUE(res);

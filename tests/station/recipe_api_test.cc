@@ -10,6 +10,7 @@
 
 #include "../support/child_process.h"
 #include "../support/station_ready.h"
+#include "../support/token_station.h"
 #include "db/store.h"
 #include "drivers/io/json_config.h"
 
@@ -29,18 +30,8 @@ TEST(RecipeApi, EngineersChangeRecipesAuditedAndVersioned) {
   const std::string recipe_path = dir / "pmsm-10pole.json";
   std::filesystem::copy_file(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json",
                              recipe_path);
-  std::ofstream(dir / "station.json") << nlohmann::json{
-      {"station_id", "recipe-api"},
-      {"recipe", "pmsm-10pole.json"},
-      {"db", "s.sqlite"},
-      {"http",
-       {{"listen", "127.0.0.1"},
-        {"port", 0},
-        {"tokens",
-         {{{"name", "line-op"}, {"role", "operator"}, {"token", kOperator}},
-          {{"name", "qe-anna"}, {"role", "engineer"}, {"token", kEngineer}}}}}},
-      {"fixture", {{"driver", "sim"}}},
-      {"daq", {{"driver", "sim"}}}}.dump();
+  std::ofstream(dir / "station.json")
+      << testing::TokenStationConfig("recipe-api", "pmsm-10pole.json", kOperator, kEngineer).dump();
   ChildProcess station({EOL_BINARY, "station", "--config", dir / "station.json"});
   ASSERT_TRUE(station.WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; }, 30s))
       << station.output();

@@ -49,6 +49,31 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
        "/excitation/periods: must be in [2, 1000]"},
       {[](auto& j) { j["fixture"]["clamp_pressure_bar"]["hi"] = 1.0; },
        "/fixture/clamp_pressure_bar/hi: must be greater than /fixture/clamp_pressure_bar/lo"},
+      // Issue 14: physical and resource bounds (a recipe cannot exhaust the station or switch
+      // off an interlock).
+      {[](auto& j) { j["excitation"]["sample_rate_hz"] = 1e10; },
+       "/excitation/sample_rate_hz: must be at most 1000000 Hz"},
+      {[](auto& j) { j["excitation"]["crest_iterations"] = 600000; },
+       "/excitation/crest_iterations: must be in [0, 2000]"},
+      {[](auto& j) {
+         j["excitation"]["line_spacing_hz"] = 0.1;
+         j["excitation"]["periods"] = 10;
+         j["excitation"]["transient_periods"] = 1;
+       },
+       "/excitation/periods: (periods + transient_periods) / line_spacing_hz is 110.0 s"},
+      {[](auto& j) {
+         j["excitation"]["sample_rate_hz"] = 900000;
+         j["excitation"]["line_spacing_hz"] = 0.25;
+       },
+       "/excitation/sample_rate_hz: gives more than 2097152 samples per period"},
+      {[](auto& j) {
+         j["fixture"]["clamp_pressure_bar"] = {{"lo", 0.001}, {"hi", 1e6}};
+       },
+       "/fixture/clamp_pressure_bar/lo: must be at least 0.5 bar"},
+      {[](auto& j) {
+         j["fixture"]["clamp_pressure_bar"] = {{"lo", 1.0}, {"hi", 9.0}};
+       },
+       "/fixture/clamp_pressure_bar/hi: must be at most 2 x /fixture/clamp_pressure_bar/lo"},
       {[](auto& j) { j["limits"][0]["name"] = "resonance_hz"; },
        "/limits/0/name: is not a measurement the analysis produces"},
       {[](auto& j) { j["limits"][1]["lo"] = 500; }, "/limits/1/hi: must be greater than lo"},
@@ -59,6 +84,9 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
       {[](auto& j) { j["analysis"]["f0_max_hz"] = 900; },
        "/analysis/f0_max_hz: must lie inside the excited band"},
       {[](auto& j) { j["version"] = 0; }, "/version: must be a whole number >= 1"},
+      {[](auto& j) { j["analysis"]["frf_method"] = "lpm"; },
+       "/analysis/frf_method: must be \"discard_transient\" or \"transient_lpm\" (got "
+       "\"lpm\")"},
       {[](auto& j) {
          j["excitation"]["phase_pairs"] = {0, 1};
        },
@@ -86,6 +114,28 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
     EXPECT_NE(err.find(c.expected), std::string::npos)
         << "got: " << err << "\nwant: " << c.expected;
   }
+}
+
+// Issue 16: the analysis block chooses the FRF estimator; absent, the discarding one. The
+// shipped recipe discards the first period; its 0.5 s variant removes the transient.
+TEST(Recipe, FrfMethodIsChosenInTheAnalysisBlock) {
+  EXPECT_EQ(LoadRecipe(kRecipe).analysis.frf_method, analysis::FrfMethod::kDiscardTransient);
+  EXPECT_EQ(LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json")
+                .analysis.frf_method,
+            analysis::FrfMethod::kTransientLpm);
+  nlohmann::json j = Good();
+  j["analysis"].erase("frf_method");
+  EXPECT_EQ(ParseRecipe(j, "test.json").analysis.frf_method,
+            analysis::FrfMethod::kDiscardTransient);
+  j["analysis"]["frf_method"] = "transient_lpm";
+  j["excitation"]["transient_periods"] = 0;
+  j["excitation"]["periods"] = 2;
+  const Recipe r = ParseRecipe(j, "test.json");
+  EXPECT_EQ(r.analysis.frf_method, analysis::FrfMethod::kTransientLpm);
+  EXPECT_EQ(RecipeToJson(r)["analysis"]["frf_method"], "transient_lpm");
+  j["analysis"]["frf_method"] = "discard_transient";
+  EXPECT_EQ(ParseRecipe(j, "test.json").analysis.frf_method,
+            analysis::FrfMethod::kDiscardTransient);
 }
 
 TEST(Recipe, PhasePairsInOrder) {
@@ -195,6 +245,42 @@ TEST(RecipeJson, OneFieldListReadsAndWritesEveryKey) {
   EXPECT_EQ(again.phase_pairs, r.phase_pairs);
   EXPECT_EQ(again.masks.size(), r.masks.size());
   EXPECT_FALSE(again.conditions.error_when_out);
+  EXPECT_EQ(again.instructions, r.instructions);
+}
+
+// Issue 17: what the operator does after FAIL, ERROR or ABORTED comes from the recipe; a key
+// left out keeps its default, and nothing but short text is accepted.
+TEST(RecipeInstructions, ShippedTextDefaultsAndStrictValidation) {
+  const Recipe shipped = LoadRecipe(kRecipe);
+  EXPECT_EQ(shipped.instructions.fail, "Red bin: put the rotor in the red reject bin");
+
+  nlohmann::json j = Good();
+  j.erase("instructions");
+  EXPECT_EQ(ParseRecipe(j, "none").instructions, OperatorInstructions{});
+  j["instructions"] = {{"error", "Call line 3 maintenance"}};
+  const Recipe partial = ParseRecipe(j, "partial");
+  EXPECT_EQ(partial.instructions.error, "Call line 3 maintenance");
+  EXPECT_EQ(partial.instructions.fail, OperatorInstructions{}.fail);
+  EXPECT_EQ(RecipeToJson(partial)["instructions"]["aborted"], OperatorInstructions{}.aborted);
+
+  const std::string rule = "must be 1 to 200 bytes of text without control characters";
+  const std::vector<std::pair<nlohmann::json, std::string>> bad = {
+      {{{"fail", 3}}, "/instructions/fail: must be a string (got 3)"},
+      {{{"error", ""}}, "/instructions/error: " + rule},
+      {{{"aborted", std::string(201, 'x')}}, "/instructions/aborted: " + rule},
+      {{{"fail", "red\nbin"}}, "/instructions/fail: " + rule},
+      {{{"pass", "green bin"}}, "/instructions/pass: unknown field"},
+      {"red bin", "/instructions: must be a JSON object"},
+  };
+  for (const auto& [instructions, expected] : bad) {
+    j = Good();
+    j["instructions"] = instructions;
+    const std::string err = ErrorOf(j);
+    EXPECT_NE(err.find(expected), std::string::npos) << "got: " << err << "\nwant: " << expected;
+  }
+  j = Good();
+  j["instructions"] = {{"fail", std::string(200, 'x')}};
+  EXPECT_EQ(ErrorOf(j), "");
 }
 
 }  // namespace

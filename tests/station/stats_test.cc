@@ -73,7 +73,9 @@ class StatsKnownAnswer : public ::testing::Test {
   void SetUp() override {
     auto store = db::Store::Open(db_);
     // Production under recipe A: 388..392, mean 390, s = sqrt(10 / 4) = 1.58113883;
-    // Cp = 50 / (6 s) = 5.27046277, Cpk = min(420 - 390, 390 - 370) / (3 s) = 4.21637021.
+    // Pp = 50 / (6 s) = 5.27046277, Ppk = min(420 - 390, 390 - 370) / (3 s) = 4.21637021.
+    // Moving ranges all 1: sigma within = 1 / 1.128; Cp = 50 * 1.128 / 6 = 9.4,
+    // Cpk = 20 * 1.128 / 3 = 7.52.
     int minute = 0;
     for (double f : {388.0, 389.0, 390.0, 391.0, 392.0}) {
       auto r = Record("P-" + std::to_string(minute), minute, Outcome::kPass, f);
@@ -109,8 +111,12 @@ class StatsKnownAnswer : public ::testing::Test {
     EXPECT_EQ(f0.at("n"), 5);
     EXPECT_NEAR(f0.at("mean").get<double>(), 390.0, 1e-9);
     EXPECT_NEAR(f0.at("sd").get<double>(), 1.58113883, 1e-8);
-    EXPECT_NEAR(f0.at("cp").get<double>(), 5.27046277, 1e-7);
-    EXPECT_NEAR(f0.at("cpk").get<double>(), 4.21637021, 1e-7);
+    EXPECT_NEAR(f0.at("pp").get<double>(), 5.27046277, 1e-7);
+    EXPECT_NEAR(f0.at("ppk").get<double>(), 4.21637021, 1e-7);
+    EXPECT_NEAR(f0.at("cp").get<double>(), 9.4, 1e-9);
+    EXPECT_NEAR(f0.at("cpk").get<double>(), 7.52, 1e-9);
+    EXPECT_EQ(f0.at("population"), "PASS units");
+    EXPECT_EQ(f0.at("sigma_within_method"), "MRbar/d2 (d2 = 1.128)");
     EXPECT_FALSE(f0.at("drift").at("usable").get<bool>());  // 5 < 10 tests
   }
 

@@ -12,6 +12,7 @@
 #include "db/test_record.h"
 #include "station/recipe.h"
 #include "tests/support/eol_cli.h"
+#include "tests/support/pass_records.h"
 
 namespace eol {
 namespace {
@@ -33,7 +34,7 @@ std::string Simulated(const eol::testing::TempDir& dir, const std::string& name,
   const std::string out = dir / name;
   const CliRun r =
       Eol({"simulate", "--motor", kMotor, "--out", out, "--defect", defect, "--seed",
-           std::to_string(seed), "--model", "steady_state", "--noise-v",
+           std::to_string(seed), "--recipe", kRecipe, "--model", "steady_state", "--noise-v",
            std::to_string(2e-3 * noise_scale), "--noise-a", std::to_string(1e-3 * noise_scale)});
   EXPECT_EQ(r.code, 0) << r.out;
   return out;
@@ -127,31 +128,15 @@ TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
   EXPECT_GT(j["units_needed"].get<int>(), 6);
 }
 
-// `eol export --format json` records: PASS production records of this recipe are golden
+// `eol export --format records` records: PASS production records of this recipe are golden
 // units; a FAIL, ERROR or ABORTED record, a master's self-check and a record of another recipe
 // hash are refused, naming the record.
 TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
   const std::string hash = station::LoadRecipe(kRecipe).hash;
   auto records = [&](auto spoil) {
-    nlohmann::json list = nlohmann::json::array();
-    const char* names[] = {"resonance_f_hz", "resonance_q", "winding_r_ohm", "winding_l_h",
-                           "fit_chi2_per_dof"};
-    for (int i = 0; i < 10; ++i) {
-      db::TestRecord r;
-      r.serial = "SN" + std::to_string(i);
-      r.outcome = analysis::Outcome::kPass;
-      r.recipe_hash = hash;
-      const double values[] = {390.0 + 0.7 * (i % 5) - 1.4, 50.0 + (i % 3), 0.5 + 0.002 * (i % 4),
-                               2e-3 * (1.0 + 0.01 * (i % 2)), 1.0 + 0.02 * (i % 3)};
-      for (int k = 0; k < 5; ++k) {
-        analysis::Measurement m;
-        m.name = names[k];
-        m.value = values[k];
-        r.measurements.push_back(m);
-      }
-      if (i == 4) spoil(r);
-      list.push_back(r);
-    }
+    std::vector<db::TestRecord> units = testing::PassRecords(hash, 10);
+    spoil(units[4]);
+    const nlohmann::json list = units;
     const std::string path = dir_ / "export.json";
     std::ofstream(path) << list.dump(1);
     return path;
@@ -188,6 +173,37 @@ TEST_F(TeachCli, ReadsExportedRecordsAndRefusesWhatIsNotAGoodUnit) {
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("SN4 was tested with recipe hash abc123, not " + hash), std::string::npos)
       << r.out;
+}
+
+// Known-bad units (`--bad`): one with every magnet poorly cemented is caught by the limits the
+// budget sets; a unit an engineer marked bad that measures like the good ones passes any limit
+// within the budget, and teach says so by name (text and JSON). The even split has no share to
+// move and refuses known-bad units.
+TEST_F(TeachCli, KnownBadUnitsAreReportedWithTheirEscapes) {
+  const std::string caught = Simulated(dir_, "bad-all-soft.csv", 997, "all_soft", 1.0);
+  const std::string hidden = Simulated(dir_, "bad-hidden.csv", 996, "none", 1.0);
+  std::vector<std::string> args = TeachArgs(dir_ / "kb.json");
+  args.insert(args.end(), {"--bad", caught, hidden, "--json"});
+  CliRun r = Eol(args, false);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("known_bad")) << r.out;
+  EXPECT_EQ(j["known_bad"]["units"], 2);
+  EXPECT_EQ(j["known_bad"]["escapes"], nlohmann::json::array({hidden})) << r.out;
+  EXPECT_NE(
+      j["message"].get<std::string>().find("no bound within the budget catches them: " + hidden),
+      std::string::npos)
+      << r.out;
+  std::vector<std::string> text = TeachArgs(dir_ / "kb-text.json");
+  text.insert(text.end(), {"--bad", caught, hidden});
+  r = Eol(text);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("known-bad unit passes: " + hidden), std::string::npos) << r.out;
+  std::vector<std::string> even = TeachArgs(dir_ / "kb-even.json");
+  even.insert(even.end(), {"--bad", caught, "--allocation", "even"});
+  r = Eol(even);
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("known-bad units need allocation physics"), std::string::npos) << r.out;
 }
 
 TEST_F(TeachCli, ErrorsNameTheFile) {

@@ -30,6 +30,7 @@ try {
     masks: await page.locator("#plot polygon.mask").count(),
     measurements: await page.locator("#measurements tr").count() - 1,
     history: await page.locator("#history tr").count() - 1,
+    simulation: (await page.isVisible("#simulation")) ? await page.textContent("#simulation") : "",
   };
   // A new test started elsewhere shows up without a reload.
   const res = await fetch(base + "/api/tests", { method: "POST", body: JSON.stringify({ serial: serial2 }),

@@ -1,0 +1,310 @@
+#include "db/export_schema.h"
+
+#include <charconv>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+#include "analysis/qc/measurement_names.h"
+
+namespace eol::db {
+namespace {
+
+using Get = std::function<ExportValue(const TestRecord&)>;
+
+ExportValue Text(const std::string& s) { return s; }
+
+ExportValue Number(double v) {
+  if (!std::isfinite(v)) return std::monostate{};
+  return v;
+}
+
+// A condition the record carries as a JSON number; empty when absent, null or not a number.
+Get Condition(const char* key) {
+  return [key](const TestRecord& r) -> ExportValue {
+    const auto it = r.conditions.find(key);
+    if (it == r.conditions.end() || !it->is_number()) return std::monostate{};
+    if (it->is_number_integer()) return it->get<std::int64_t>();
+    return Number(it->get<double>());
+  };
+}
+
+ExportColumn Base(const char* key, ExportType type, const char* unit, const char* meaning,
+                  Get get) {
+  return {key, "", key, type, unit, meaning, std::move(get)};
+}
+
+// The base columns of schema version 1, in row order. Append only (export_schema.h).
+static_assert(kExportSchemaVersion == 2, "say the new version in schema_version's meaning");
+
+std::vector<ExportColumn> BaseColumns() {
+  using T = ExportType;
+  std::vector<ExportColumn> c;
+  c.push_back(
+      Base("schema_version", T::kInteger, "", "Version of this export schema (2)",
+           [](const TestRecord&) -> ExportValue { return std::int64_t{kExportSchemaVersion}; }));
+  c.push_back(Base("id", T::kInteger, "", "Test id in the station's database",
+                   [](const TestRecord& r) -> ExportValue { return r.id; }));
+  c.push_back(Base("serial", T::kText, "", "Serial number of the unit",
+                   [](const TestRecord& r) { return Text(r.serial); }));
+  c.push_back(Base("station_id", T::kText, "", "Station that ran the test",
+                   [](const TestRecord& r) { return Text(r.station_id); }));
+  c.push_back(Base("started_at", T::kTime, "", "Start, ISO 8601 UTC with milliseconds",
+                   [](const TestRecord& r) { return Text(r.started_at); }));
+  c.push_back(Base("finished_at", T::kTime, "", "End, ISO 8601 UTC with milliseconds",
+                   [](const TestRecord& r) { return Text(r.finished_at); }));
+  c.push_back(Base("outcome", T::kText, "",
+                   "PASS, FAIL (the motor is out of limits), ERROR (the station could not "
+                   "measure) or ABORTED",
+                   [](const TestRecord& r) { return Text(analysis::ToString(r.outcome)); }));
+  c.push_back(Base("reason_code", T::kText, "",
+                   "Code of the decisive (first) reason: limit, mask, condition, interlock, "
+                   "fixture, ...; empty for a clean PASS",
+                   [](const TestRecord& r) -> ExportValue {
+                     if (r.reasons.empty()) return std::monostate{};
+                     return Text(analysis::ToString(r.reasons.front().code));
+                   }));
+  c.push_back(Base("reason_text", T::kText, "", "Text of the decisive (first) reason",
+                   [](const TestRecord& r) -> ExportValue {
+                     if (r.reasons.empty()) return std::monostate{};
+                     return Text(r.reasons.front().text);
+                   }));
+  c.push_back(Base("reason_count", T::kInteger, "", "Number of reasons the record carries",
+                   [](const TestRecord& r) -> ExportValue {
+                     return static_cast<std::int64_t>(r.reasons.size());
+                   }));
+  c.push_back(Base("kind", T::kText, "",
+                   "production, or self_check (a master part checking the station; never "
+                   "production statistics)",
+                   [](const TestRecord& r) { return Text(ToString(r.kind)); }));
+  c.push_back(Base("recipe_id", T::kText, "", "Recipe the unit was tested with",
+                   [](const TestRecord& r) { return Text(r.recipe_id); }));
+  c.push_back(Base("recipe_version", T::kInteger, "", "Its version",
+                   [](const TestRecord& r) -> ExportValue {
+                     return static_cast<std::int64_t>(r.recipe_version);
+                   }));
+  c.push_back(Base("recipe_hash", T::kText, "", "SHA-256 of the recipe's canonical JSON",
+                   [](const TestRecord& r) { return Text(r.recipe_hash); }));
+  c.push_back(Base("software_version", T::kText, "", "Station software version and revision",
+                   [](const TestRecord& r) { return Text(r.software_version); }));
+  c.push_back(Base("retest_of", T::kInteger, "", "Id of the serial's first test, for a retest",
+                   [](const TestRecord& r) -> ExportValue {
+                     if (!r.retest_of) return std::monostate{};
+                     return *r.retest_of;
+                   }));
+  c.push_back(Base("operator_id", T::kText, "", "Operator's badge or login, when given",
+                   [](const TestRecord& r) { return Text(r.work.operator_id); }));
+  c.push_back(Base("shift", T::kText, "", "Shift name, when given",
+                   [](const TestRecord& r) { return Text(r.work.shift); }));
+  c.push_back(Base("order_number", T::kText, "", "Production order or batch, when given",
+                   [](const TestRecord& r) { return Text(r.work.order_number); }));
+  c.push_back(Base("winding_temperature_c", T::kNumber, "degC",
+                   "Winding temperature estimated from the fitted resistance",
+                   Condition("winding_temperature_c")));
+  c.push_back(Base("clamp_pressure_bar", T::kNumber, "bar", "Clamp pressure read before exciting",
+                   Condition("clamp_pressure_bar")));
+  c.push_back(Base("excitation_v_rms", T::kNumber, "V", "Excitation voltage, rms",
+                   Condition("excitation_v_rms")));
+  c.push_back(Base("excitation_a_rms", T::kNumber, "A", "Excitation current, rms",
+                   Condition("excitation_a_rms")));
+  c.push_back(Base("phase_pair", T::kInteger, "", "First phase pair excited: 0 U-V, 1 V-W, 2 W-U",
+                   Condition("phase_pair")));
+  c.push_back(Base("conditions_in_window", T::kBool, "",
+                   "Every judged condition was inside its recipe window; empty when the "
+                   "recipe judges none",
+                   [](const TestRecord& r) -> ExportValue {
+                     const auto it = r.conditions.find("conditions_in_window");
+                     if (it == r.conditions.end() || !it->is_boolean()) return std::monostate{};
+                     return it->get<bool>();
+                   }));
+  c.push_back(
+      Base("simulated", T::kBool, "", "true when the test ran on a simulator (never a real motor)",
+           [](const TestRecord& r) -> ExportValue {
+             const auto it = r.conditions.find("simulation");
+             return it != r.conditions.end() && it->is_string() && !it->get<std::string>().empty();
+           }));
+  c.push_back(Base("simulation", T::kText, "", "Why it is a simulation (empty on hardware)",
+                   [](const TestRecord& r) -> ExportValue {
+                     const auto it = r.conditions.find("simulation");
+                     if (it == r.conditions.end() || !it->is_string()) return std::monostate{};
+                     return it->get<std::string>();
+                   }));
+  return c;
+}
+
+const analysis::Measurement* Find(const TestRecord& r, const std::string& name) {
+  for (const auto& m : r.measurements)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+// The six fields of every declared measurement, in order. Append only (export_schema.h).
+struct MeasurementField {
+  const char* key;
+  ExportType type;
+  bool unit_of_value;  // the unit is the row's <name>_unit
+  const char* meaning;
+  ExportValue (*get)(const analysis::Measurement&);
+};
+
+constexpr MeasurementField kMeasurementFields[] = {
+    {"value", ExportType::kNumber, true, "Measured value",
+     [](const analysis::Measurement& m) { return Number(m.value); }},
+    {"sigma", ExportType::kNumber, true, "Its standard uncertainty",
+     [](const analysis::Measurement& m) { return Number(m.sigma); }},
+    {"lo", ExportType::kNumber, true, "Lower limit the test judged it by (empty: open)",
+     [](const analysis::Measurement& m) -> ExportValue {
+       return m.limit.lo ? Number(*m.limit.lo) : ExportValue{};
+     }},
+    {"hi", ExportType::kNumber, true, "Upper limit the test judged it by (empty: open)",
+     [](const analysis::Measurement& m) -> ExportValue {
+       return m.limit.hi ? Number(*m.limit.hi) : ExportValue{};
+     }},
+    {"unit", ExportType::kText, false, "Unit of value, sigma, lo and hi",
+     [](const analysis::Measurement& m) { return Text(m.unit); }},
+    {"outcome", ExportType::kText, false, "PASS, FAIL or UNSET (not judged)",
+     [](const analysis::Measurement& m) { return Text(analysis::ToString(m.outcome)); }},
+};
+
+}  // namespace
+
+const char* ToString(ExportType t) {
+  switch (t) {
+    case ExportType::kInteger:
+      return "integer";
+    case ExportType::kNumber:
+      return "number";
+    case ExportType::kText:
+      return "text";
+    case ExportType::kTime:
+      return "time";
+    case ExportType::kBool:
+      return "bool";
+  }
+  return "?";
+}
+
+std::vector<std::string> ExportMeasurementNames(const std::vector<std::string>& extra) {
+  std::vector<std::string> names;
+  std::set<std::string> seen;
+  auto add = [&](const std::string& n) {
+    if (seen.insert(n).second) names.push_back(n);
+  };
+  for (std::string_view n : analysis::names::kAll) add(std::string(n));
+  for (const std::string& n : extra) add(n);
+  return names;
+}
+
+std::vector<ExportColumn> ExportColumns(const std::vector<std::string>& measurement_names) {
+  std::vector<ExportColumn> columns = BaseColumns();
+  std::set<std::string> seen;
+  for (const std::string& name : measurement_names) {
+    if (name.empty()) throw std::invalid_argument("export: an empty measurement name");
+    if (!seen.insert(name).second)
+      throw std::invalid_argument("export: measurement " + name + " declared twice");
+    for (const MeasurementField& f : kMeasurementFields) {
+      ExportColumn c;
+      c.name = name + "_" + f.key;
+      c.measurement = name;
+      c.key = f.key;
+      c.type = f.type;
+      c.unit = f.unit_of_value ? "(" + name + "_unit)" : "";
+      c.meaning = f.meaning;
+      c.get = [name, get = f.get](const TestRecord& r) -> ExportValue {
+        const analysis::Measurement* m = Find(r, name);
+        return m ? get(*m) : ExportValue{};
+      };
+      columns.push_back(std::move(c));
+    }
+  }
+  return columns;
+}
+
+namespace {
+
+std::string Quote(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return q + "\"";
+}
+
+std::string CsvCell(const ExportValue& v) {
+  struct Visit {
+    std::string operator()(std::monostate) const { return ""; }
+    std::string operator()(std::int64_t i) const { return std::to_string(i); }
+    std::string operator()(double d) const {
+      char buf[64];
+      const auto res = std::to_chars(buf, buf + sizeof buf, d);  // shortest round trip
+      return std::string(buf, res.ptr);
+    }
+    std::string operator()(const std::string& s) const { return Quote(s); }
+    std::string operator()(bool b) const { return b ? "true" : "false"; }
+  };
+  return std::visit(Visit{}, v);
+}
+
+nlohmann::ordered_json JsonCell(const ExportValue& v) {
+  struct Visit {
+    nlohmann::ordered_json operator()(std::monostate) const { return nullptr; }
+    nlohmann::ordered_json operator()(std::int64_t i) const { return i; }
+    nlohmann::ordered_json operator()(double d) const {
+      if (!std::isfinite(d)) return nullptr;
+      return d;
+    }
+    nlohmann::ordered_json operator()(const std::string& s) const { return s; }
+    nlohmann::ordered_json operator()(bool b) const { return b; }
+  };
+  return std::visit(Visit{}, v);
+}
+
+}  // namespace
+
+std::string ExportCsvHeader(const std::vector<ExportColumn>& columns) {
+  std::string line;
+  for (const auto& c : columns) line += (line.empty() ? "" : ",") + Quote(c.name);
+  return line + "\n";
+}
+
+std::string ExportCsvRow(const std::vector<ExportColumn>& columns, const TestRecord& record) {
+  std::string line;
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (i > 0) line += ",";
+    line += CsvCell(columns[i].get(record));
+  }
+  return line + "\n";
+}
+
+nlohmann::ordered_json ExportJsonRow(const std::vector<ExportColumn>& columns,
+                                     const TestRecord& record) {
+  nlohmann::ordered_json row = nlohmann::ordered_json::object();
+  nlohmann::ordered_json measurements = nlohmann::ordered_json::object();
+  for (const auto& c : columns) {
+    if (c.measurement.empty())
+      row[c.key] = JsonCell(c.get(record));
+    else
+      measurements[c.measurement][c.key] = JsonCell(c.get(record));
+  }
+  row["measurements"] = std::move(measurements);
+  return row;
+}
+
+std::string ExportSchemaMarkdown(const std::vector<ExportColumn>& columns) {
+  std::string md = "| column | type | unit | meaning |\n|---|---|---|---|\n";
+  for (const auto& c : columns)
+    md += "| `" + c.name + "` | " + ToString(c.type) + " | " + c.unit + " | " + c.meaning + " |\n";
+  return md;
+}
+
+std::vector<std::string> ExportUndeclared(const std::vector<ExportColumn>& columns,
+                                          const TestRecord& record) {
+  std::set<std::string> declared;
+  for (const auto& c : columns)
+    if (!c.measurement.empty()) declared.insert(c.measurement);
+  std::vector<std::string> out;
+  for (const auto& m : record.measurements)
+    if (!declared.count(m.name)) out.push_back(m.name);
+  return out;
+}
+
+}  // namespace eol::db

@@ -1,0 +1,27 @@
+// What every request passes before its route's handler (httplib's pre-routing hook), so that
+// no handler and no body buffering sees a request the API refuses:
+//
+//   no route for the path                      404 "not_found"
+//   a route, not with this method              405 "method_not_allowed" with Allow
+//   GET/HEAD with a body                       400 "unexpected_body"
+//   Transfer-Encoding other than "chunked",
+//     or with Content-Length                   400 "bad_framing"
+//   POST/PUT without either framing            411 "length_required" (httplib would read to EOF)
+//   Content-Length above kMaxBodyBytes         413 "too_large" (the body is not read)
+//   POST/PUT not application/json              415 "unsupported_media_type": a cross-site page
+//                                              can send text/plain without a preflight
+//   POST/PUT with an Origin that is not
+//     http://<Host of the request>             403 "cross_origin"
+//
+// Refused bodies are not read: the connection is closed after the answer. Errors httplib
+// answers itself (a malformed request line, a URI too long) get the same JSON body.
+#pragma once
+
+#include "station/http/context.h"
+#include "station/http/server.h"
+
+namespace eol::station::http {
+
+void InstallGate(ApiServer& s, ApiContext& c);
+
+}  // namespace eol::station::http
