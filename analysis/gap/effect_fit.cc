@@ -163,19 +163,26 @@ void Residual(const NominalNetwork& n, const Lines& lines, const Layout& layout,
   }
 }
 
-// Central differences in theta (every theta is O(1): a logarithm or value / scale).
-void Jacobian(const NominalNetwork& n, const Lines& lines, const Layout& layout,
-              const Eigen::VectorXd& theta, Eigen::MatrixXd* jac) {
-  jac->resize(static_cast<long>(2 * lines.f.size()), theta.size());
+// Finite differences in theta (every theta is O(1): a logarithm or value / scale). Forward
+// (p + 1 residuals) for Levenberg-Marquardt's steps, whose optimum does not depend on them;
+// central (2 p) for the information at the optimum, which the covariance and the evidence use.
+void DifferenceJacobian(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>& res,
+                        const Eigen::VectorXd& theta, bool central, Eigen::MatrixXd* jac) {
   Eigen::VectorXd up, down;
+  if (!central) res(theta, &down);
   for (long i = 0; i < theta.size(); ++i) {
-    const double h = 1e-6 * std::max(1.0, std::abs(theta(i)));
+    const double h = (central ? 1e-6 : 1e-7) * std::max(1.0, std::abs(theta(i)));
     Eigen::VectorXd t = theta;
     t(i) = theta(i) + h;
-    Residual(n, lines, layout, t, &up);
-    t(i) = theta(i) - h;
-    Residual(n, lines, layout, t, &down);
-    jac->col(i) = (up - down) / (2.0 * h);
+    res(t, &up);
+    if (i == 0) jac->resize(up.size(), theta.size());
+    if (central) {
+      t(i) = theta(i) - h;
+      res(t, &down);
+      jac->col(i) = (up - down) / (2.0 * h);
+    } else {
+      jac->col(i) = (up - down) / h;
+    }
   }
 }
 
@@ -212,7 +219,8 @@ double OccamPenalty(const Layout& layout, const std::vector<AppliedEffect>& at,
 }  // namespace
 
 std::complex<double> LineResidual(const GapUnit& u, std::size_t k, std::complex<double> h) {
-  if (u.admittance) return (1.0 / u.value[k] - 1.0 / h) * (std::norm(u.value[k]) / u.sigma[k]);
+  if (u.admittance)
+    return (Reciprocal(u.value[k]) - Reciprocal(h)) * (std::norm(u.value[k]) / u.sigma[k]);
   return (u.value[k] - h) / u.sigma[k];
 }
 
@@ -503,7 +511,7 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
     Residual(nominal_, lines, layout, t, r);
   };
   problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* j) {
-    Jacobian(nominal_, lines, layout, t, j);
+    DifferenceJacobian(problem.residual, t, false, j);
   };
   LeastSquaresSettings settings;
   settings.max_iterations = max_iterations;
@@ -533,7 +541,7 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   out.chi2 = Chi2(out.effects, mask);
   // Covariance in theta from the Jacobian at the optimum, then natural units.
   Eigen::MatrixXd jac;
-  problem.jacobian(theta, &jac);
+  DifferenceJacobian(problem.residual, theta, true, &jac);
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(problem.parameters, problem.parameters,
                                                   std::numeric_limits<double>::quiet_NaN());
   Eigen::MatrixXd inverse;
@@ -623,17 +631,7 @@ EffectFit EffectFitter::FitWithNominal(const NominalNetwork& nominal,
     Residual(WithMotional(nominal, t), lines, layout, effects, r);
   };
   problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jac) {
-    jac->resize(out.residuals, t.size());
-    Eigen::VectorXd up, down;
-    for (long i = 0; i < t.size(); ++i) {
-      const double h = 1e-6 * std::max(1.0, std::abs(t(i)));
-      Eigen::VectorXd x = t;
-      x(i) = t(i) + h;
-      problem.residual(x, &up);
-      x(i) = t(i) - h;
-      problem.residual(x, &down);
-      jac->col(i) = (up - down) / (2.0 * h);
-    }
+    DifferenceJacobian(problem.residual, t, false, jac);
   };
   LeastSquaresSettings settings;
   settings.max_iterations = max_iterations;
@@ -673,11 +671,26 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
       }
     }
   }
+  // A plausible, converged optimum beats a lower cost outside the bounds: a fit that runs off
+  // to a degenerate corner (a fixture spring of zero stiffness with a second inertia as the
+  // support) from one start is no answer when another start settles on a physical one.
+  auto admissible = [&](const EffectFit& f) {
+    std::string why;
+    for (const AppliedEffect& e : f.effects)
+      if (!IsPlausible(Spec(e.kind), e, &why)) return false;
+    return f.converged;
+  };
   EffectFit best;
   best.chi2 = best.cost = std::numeric_limits<double>::infinity();
+  bool best_admissible = false;
   for (const auto& s : starts) {
     EffectFit f = Fit(s, mask, max_iterations);
-    if (std::isfinite(f.cost) && f.cost < best.cost) best = std::move(f);
+    if (!std::isfinite(f.cost)) continue;
+    const bool ok = admissible(f);
+    if ((ok && !best_admissible) || (ok == best_admissible && f.cost < best.cost)) {
+      best = std::move(f);
+      best_admissible = ok;
+    }
   }
   return best;
 }

@@ -27,7 +27,8 @@
 // lowers f0 and raises Q) is not charged for parameters the data do not need.
 // Parameters are fitted as ln(value) (positive, wide-ranging ones) or value / scale, with
 // analysis::MinimizeLeastSquares (fit/least_squares.h: MINPACK Levenberg-Marquardt) on
-// central-difference Jacobians; the covariance (Jr^T Jr)^-1 at the optimum
+// forward-difference Jacobians; the covariance (Jr^T Jr)^-1 at the optimum, from a central-
+// difference Jacobian there,
 // (fit/least_squares.h InvertInformation) is mapped to natural units to first order.
 //
 // Starting values (Starts) come from the residual against a base model (the nominal plus any
@@ -125,7 +126,8 @@ class EffectFitter {
 
   // The best of the fits started from Starts(kind) for each kind in `kinds`, the kinds
   // fitted jointly; for a pair the second kind's starts are taken on top of `seeds` (the
-  // kinds' single fits, same order as kinds) and vice versa.
+  // kinds' single fits, same order as kinds) and vice versa. Best: the lowest cost among the
+  // plausible (IsPlausible) converged fits; the lowest cost of all only when none is.
   EffectFit FitKinds(const std::vector<EffectKind>& kinds, const std::vector<AppliedEffect>& seeds,
                      const LineMask& mask, int max_iterations) const;
 

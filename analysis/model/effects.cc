@@ -54,22 +54,24 @@ Cplx MotionalWithEffects(const MotionalImpedance& m, const AppliedEffect* creep,
     const double n = Param(creep, 0) / std::numbers::ln10;
     compliance *= std::pow(s / w0, -n);
   }
-  Cplx support = 1.0 / m.rp_ohm + 1.0 / (s * compliance);
+  const Cplx inv_s = Reciprocal(s);
+  Cplx support = 1.0 / m.rp_ohm + inv_s * Reciprocal(compliance);
   if (fixture) {
     const double kappa = Param(fixture, 0);
     const double eta = Param(fixture, 1);
-    support = 1.0 / (1.0 / support + s * lp / (kappa * Cplx(1.0, eta)));
+    support = Reciprocal(Reciprocal(support) + s * lp * Reciprocal(kappa * Cplx(1.0, eta)));
   }
   if (coupled) {
     const double c2 = Param(coupled, 0) * cp;
     const double w2 = TwoPi() * Param(coupled, 1);
     const double x = std::clamp(Param(coupled, 3), 0.0, 0.999);
-    const Cplx spring2 = w2 * c2 / Param(coupled, 2) + w2 * w2 * c2 / s;
-    const Cplx branch = 1.0 / (1.0 / (s * c2) + 1.0 / spring2);
-    support =
-        x > 0.0 ? 1.0 / (x / support + 1.0 / (support / (1.0 - x) + branch)) : support + branch;
+    const Cplx spring2 = w2 * c2 / Param(coupled, 2) + w2 * w2 * c2 * inv_s;
+    const Cplx branch = Reciprocal(inv_s / c2 + Reciprocal(spring2));
+    support = x > 0.0
+                  ? Reciprocal(x * Reciprocal(support) + Reciprocal(support / (1.0 - x) + branch))
+                  : support + branch;
   }
-  return 1.0 / (s * cp + support);
+  return Reciprocal(s * cp + support);
 }
 
 }  // namespace
@@ -81,7 +83,7 @@ std::complex<double> FractionalShape(double order, double f_hz, double ref_hz) {
 
 std::complex<double> RigidShaftMobility::At(double f_hz) const {
   const Cplx s(0.0, TwoPi() * f_hz);
-  return gain_rad_per_s2_per_a / (s + damping_per_s);
+  return gain_rad_per_s2_per_a * Reciprocal(s + damping_per_s);
 }
 
 std::complex<double> NominalNetwork::At(double f_hz) const {
@@ -252,7 +254,7 @@ std::complex<double> EvaluateNetwork(const NominalNetwork& n,
     }
     if (eddy) {
       const double l2 = Param(eddy, 0);
-      winding -= s * s * l2 * l2 / (s * l2 + Param(eddy, 1));
+      winding -= s * s * l2 * l2 * Reciprocal(s * l2 + Param(eddy, 1));
     }
     if (const AppliedEffect* frac = FindEffect(effects, EffectKind::kFractionalInductance))
       winding += m.l_h * Param(frac, 0) *
@@ -265,16 +267,17 @@ std::complex<double> EvaluateNetwork(const NominalNetwork& n,
     const Cplx motional =
         creep || fixture || coupled
             ? MotionalWithEffects(m, creep, fixture, coupled, s)
-            : m.rp_ohm / (1.0 + m.q * (s / (TwoPi() * m.f0_hz) + TwoPi() * m.f0_hz / s));
+            : m.rp_ohm * Reciprocal(1.0 + m.q * (s / (TwoPi() * m.f0_hz) +
+                                                 TwoPi() * m.f0_hz * Reciprocal(s)));
     inside = winding + motional;
   }
   if (mode) {
     const double w2 = TwoPi() * Param(mode, 0);
-    inside += Param(mode, 2) / (1.0 + Param(mode, 1) * (s / w2 + w2 / s));
+    inside += Param(mode, 2) * Reciprocal(1.0 + Param(mode, 1) * (s / w2 + w2 * Reciprocal(s)));
   }
   if (n.quantity == Quantity::kImpedanceOhm) {
     if (const AppliedEffect* stray = FindEffect(effects, EffectKind::kStrayCapacitance))
-      inside = inside / (1.0 + s * Param(stray, 0) * inside);
+      inside = inside * Reciprocal(1.0 + s * Param(stray, 0) * inside);
   }
   if (const AppliedEffect* delay = FindEffect(effects, EffectKind::kChannelDelay))
     inside *= std::exp(-s * Param(delay, 0));

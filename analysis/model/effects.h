@@ -109,6 +109,14 @@ struct RigidShaftMobility {
   std::complex<double> At(double f_hz) const;
 };
 
+// 1 / z as conj(z) / |z|^2. The network's impedances and admittances lie far inside
+// 1e-150..1e150, where this is exact to rounding; std::complex's division goes through
+// libgcc's range-scaled __divdc3, which was most of the gap diagnosis' run time.
+inline std::complex<double> Reciprocal(std::complex<double> z) {
+  const double n = z.real() * z.real() + z.imag() * z.imag();
+  return {z.real() / n, -z.imag() / n};
+}
+
 // The network an effect modifies: the clamped motor's impedance or the rigid shaft's mobility.
 struct NominalNetwork {
   Quantity quantity = Quantity::kImpedanceOhm;

@@ -256,7 +256,7 @@ def score(out_dir, eol, extra):
     for t in truth:
         base = os.path.join(out_dir, t["case"])
         cmd = [eol, "gap", "--sim", base + "-sim.csv", "--measured", base + "-meas.csv",
-               "--json", "-"] + extra
+               "--json"] + extra
         p = subprocess.run(cmd, capture_output=True, text=True)
         if p.returncode != 0:
             answer = "error: " + p.stderr.strip().splitlines()[-1] if p.stderr else "error"
