@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -77,6 +78,37 @@ std::string JoinNames(const std::vector<AppliedEffect>& effects) {
   return s;
 }
 
+// The first torsional mode of the nominal with the structural effects among `effects`
+// (fixture_compliance, coupled_inertia, adhesive_creep): where Re of the motional part
+// Z - (R + s L) peaks (NOTES.md 2: Re Z peaks at f0), on a fine log grid over half the band's
+// bottom to twice its top. Impedance only.
+double FirstModeHz(const NominalNetwork& n, std::span<const AppliedEffect> effects, double f_lo,
+                   double f_hi) {
+  std::vector<AppliedEffect> structural;
+  for (const AppliedEffect& e : effects)
+    if (e.kind == EffectKind::kFixtureCompliance || e.kind == EffectKind::kCoupledInertia ||
+        e.kind == EffectKind::kAdhesiveCreep)
+      structural.push_back(e);
+  double best_f = n.motional.f0_hz, best = -std::numeric_limits<double>::infinity();
+  const int points = 4000;
+  for (int i = 0; i < points; ++i) {
+    const double f = 0.5 * f_lo * std::pow(4.0 * f_hi / f_lo, i / (points - 1.0));
+    const Cplx winding(n.motional.r_ohm, 2.0 * std::numbers::pi * f * n.motional.l_h);
+    const double re = (EvaluateNetwork(n, structural, f) - winding).real();
+    if (re > best) {
+      best = re;
+      best_f = f;
+    }
+  }
+  return best_f;
+}
+
+// Two modes within 4 % of each other draw one peak at these rotors' Q of about 50 (two
+// half-power bandwidths; gap_bench.h draws second modes at least 4 % from f0 for the same
+// reason): a second_mode there is the measured mode re-drawn, the nominal's own f0, Q and
+// Rp refitted (the calibration of GapSplit), not a mode of another part.
+constexpr double kModeSeparation = 0.04;
+
 RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit) {
   RankedEffect r;
   r.effects = fit.effects;
@@ -109,6 +141,21 @@ RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit) {
       r.plausible = false;
       r.rejected = std::string(ToString(e.kind)) + ": implausible, " + why;
       break;
+    }
+  }
+  const NominalNetwork& nominal = fitter.nominal();
+  for (const AppliedEffect& e : fit.effects) {
+    if (!r.plausible || e.kind != EffectKind::kSecondMode ||
+        nominal.quantity != Quantity::kImpedanceOhm)
+      continue;
+    const double first = FirstModeHz(nominal, fit.effects, fitter.f_lo_hz(), fitter.f_hi_hz());
+    if (std::abs(e.params[0] / first - 1.0) < kModeSeparation) {
+      std::ostringstream os;
+      os.precision(4);
+      os << "second_mode: at " << e.params[0] << " Hz, within 4 % of the first mode (" << first
+         << " Hz): the measured mode re-drawn, not a second one";
+      r.plausible = false;
+      r.rejected = os.str();
     }
   }
   if (r.plausible && !fit.converged) {
