@@ -80,8 +80,8 @@ std::string JoinNames(const std::vector<AppliedEffect>& effects) {
 
 // The first torsional mode of the nominal with the structural effects among `effects`
 // (fixture_compliance, coupled_inertia, adhesive_creep): where Re of the motional part
-// Z - (R + s L) peaks (NOTES.md 2: Re Z peaks at f0), on a fine log grid over half the band's
-// bottom to twice its top. Impedance only.
+// Z - (R + s L) peaks inside the band (NOTES.md 2: Re Z peaks at f0), on a fine log grid;
+// 0 when it has no peak inside (the structure moved every mode out). Impedance only.
 double FirstModeHz(const NominalNetwork& n, std::span<const AppliedEffect> effects, double f_lo,
                    double f_hi) {
   std::vector<AppliedEffect> structural;
@@ -89,18 +89,20 @@ double FirstModeHz(const NominalNetwork& n, std::span<const AppliedEffect> effec
     if (e.kind == EffectKind::kFixtureCompliance || e.kind == EffectKind::kCoupledInertia ||
         e.kind == EffectKind::kAdhesiveCreep)
       structural.push_back(e);
-  double best_f = n.motional.f0_hz, best = -std::numeric_limits<double>::infinity();
   const int points = 4000;
+  int best_i = 0;
+  double best = -std::numeric_limits<double>::infinity();
+  auto freq = [&](int i) { return f_lo * std::pow(f_hi / f_lo, i / (points - 1.0)); };
   for (int i = 0; i < points; ++i) {
-    const double f = 0.5 * f_lo * std::pow(4.0 * f_hi / f_lo, i / (points - 1.0));
+    const double f = freq(i);
     const Cplx winding(n.motional.r_ohm, 2.0 * std::numbers::pi * f * n.motional.l_h);
     const double re = (EvaluateNetwork(n, structural, f) - winding).real();
     if (re > best) {
       best = re;
-      best_f = f;
+      best_i = i;
     }
   }
-  return best_f;
+  return best_i == 0 || best_i == points - 1 ? 0.0 : freq(best_i);
 }
 
 // Two modes within 4 % of each other draw one peak at these rotors' Q of about 50 (two
@@ -148,12 +150,21 @@ RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit) {
     if (!r.plausible || e.kind != EffectKind::kSecondMode ||
         nominal.quantity != Quantity::kImpedanceOhm)
       continue;
-    const double first = FirstModeHz(nominal, fit.effects, fitter.f_lo_hz(), fitter.f_hi_hz());
-    if (std::abs(e.params[0] / first - 1.0) < kModeSeparation) {
-      std::ostringstream os;
-      os.precision(4);
+    const double lo = fitter.f_lo_hz(), hi = fitter.f_hi_hz();
+    const double first = FirstModeHz(nominal, fit.effects, lo, hi);
+    const double f0 = nominal.motional.f0_hz;
+    std::ostringstream os;
+    os.precision(4);
+    if (first > 0.0 && std::abs(e.params[0] / first - 1.0) < kModeSeparation) {
       os << "second_mode: at " << e.params[0] << " Hz, within 4 % of the first mode (" << first
          << " Hz): the measured mode re-drawn, not a second one";
+    } else if (first == 0.0 && f0 > lo && f0 < hi) {
+      // The structure moved the nominal's in-band mode out of the band: the second_mode is
+      // then the only mode left there, the measured one re-drawn.
+      os << "second_mode: at " << e.params[0] << " Hz, the only mode in the band (the other "
+         << "effects move the nominal's " << f0 << " Hz out of it): the measured mode re-drawn";
+    }
+    if (!os.str().empty()) {
       r.plausible = false;
       r.rejected = os.str();
     }
