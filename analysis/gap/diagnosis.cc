@@ -198,20 +198,27 @@ LineMask UnitMask(const std::vector<GapUnit>& units, std::size_t which, bool inv
   return m;
 }
 
+// (fit on, predict): one unit -> two-fold interleaved lines; several -> leave-one-unit-out.
+using Fold = std::pair<LineMask, LineMask>;
+std::vector<Fold> HeldOutFolds(const std::vector<GapUnit>& units, std::string* method) {
+  std::vector<Fold> folds;
+  if (units.size() == 1) {
+    *method = "interleaved-2fold";
+    folds.push_back({ParityMask(units, 0), ParityMask(units, 1)});
+    folds.push_back({ParityMask(units, 1), ParityMask(units, 0)});
+  } else {
+    *method = "leave-one-unit-out";
+    for (std::size_t u = 0; u < units.size(); ++u)
+      folds.push_back({UnitMask(units, u, true), UnitMask(units, u, false)});
+  }
+  return folds;
+}
+
 HeldOutGap HeldOut(const EffectFitter& fitter, const std::vector<AppliedEffect>& winner,
                    const GapOptions& o) {
   const std::vector<GapUnit>& units = fitter.units();
   HeldOutGap h;
-  std::vector<std::pair<LineMask, LineMask>> folds;  // (fit on, predict)
-  if (units.size() == 1) {
-    h.method = "interleaved-2fold";
-    folds.push_back({ParityMask(units, 0), ParityMask(units, 1)});
-    folds.push_back({ParityMask(units, 1), ParityMask(units, 0)});
-  } else {
-    h.method = "leave-one-unit-out";
-    for (std::size_t u = 0; u < units.size(); ++u)
-      folds.push_back({UnitMask(units, u, true), UnitMask(units, u, false)});
-  }
+  const std::vector<Fold> folds = HeldOutFolds(units, &h.method);
   double before = 0.0, after = 0.0;
   int n = 0;
   for (const auto& [fit_on, predict] : folds) {
@@ -295,16 +302,7 @@ GapSplit SplitGap(const EffectFitter& fitter, const std::vector<AppliedEffect>& 
   // Held out: interleaved lines (one unit) or leave-one-unit-out, both refitted together from
   // the full fit.
   const std::vector<GapUnit>& units = fitter.units();
-  std::vector<std::pair<LineMask, LineMask>> folds;
-  if (units.size() == 1) {
-    s.heldout_method = "interleaved-2fold";
-    folds.push_back({ParityMask(units, 0), ParityMask(units, 1)});
-    folds.push_back({ParityMask(units, 1), ParityMask(units, 0)});
-  } else {
-    s.heldout_method = "leave-one-unit-out";
-    for (std::size_t u = 0; u < units.size(); ++u)
-      folds.push_back({UnitMask(units, u, true), UnitMask(units, u, false)});
-  }
+  const std::vector<Fold> folds = HeldOutFolds(units, &s.heldout_method);
   double before = 0.0, after = 0.0;
   int n = 0;
   for (const auto& [fit_on, predict] : folds) {
