@@ -1,7 +1,7 @@
 # Installation layout and the Debian package (cpack -G DEB, or `cmake --build build --target
 # package`). See README "Installing on a station PC".
 #   /usr/bin/eol                              the program
-#   /usr/share/eol/recipes/, /usr/share/eol/web/   shipped recipes and the operator page
+#   /usr/share/eol/recipes/, /usr/share/eol/web/   shipped recipes, the operator and engineer pages
 #   /usr/share/eol/bench/                     the SciPy peer of `eol fit-bench`
 #   /etc/eol/station.json                     the station config (a conffile)
 #   /lib/systemd/system/eol-station.service   the daemon, with systemd's watchdog
@@ -11,6 +11,9 @@ install(TARGETS eol RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/recipes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/recipes)
 install(FILES ${PROJECT_SOURCE_DIR}/station/web/index.html ${PROJECT_SOURCE_DIR}/station/web/app.js
               ${PROJECT_SOURCE_DIR}/station/web/style.css
+              ${PROJECT_SOURCE_DIR}/station/web/engineer.html
+              ${PROJECT_SOURCE_DIR}/station/web/engineer.js
+              ${PROJECT_SOURCE_DIR}/station/web/engineer.css
         DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/web)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/deploy/bench/ DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/bench)
 # The config may hold API tokens: readable by root and the service's group only (postinst

@@ -31,8 +31,9 @@
 namespace eol::db {
 
 // Version 2 (issue 12) appended the standard measurement motional_residue_ohm_per_s after
-// fit_chi2_per_dof; version 1 files have the same columns up to there.
-inline constexpr int kExportSchemaVersion = 2;
+// fit_chi2_per_dof; version 1 files have the same columns up to there. Version 3 appended
+// bond_index_pct (analysis/qc/bond_index.h) after it.
+inline constexpr int kExportSchemaVersion = 3;
 
 enum class ExportType { kInteger, kNumber, kText, kTime, kBool };
 const char* ToString(ExportType t);  // "integer", "number", "text", "time", "bool"

@@ -23,12 +23,13 @@ void HttpApi::Start() {
   const HttpOptions& o = context_->options;
   context_->db = db::Store::Open(o.db_path, db::Store::Role::kReader);
   server_ = std::make_unique<http::ApiServer>(o.limits);
-  server_->set_payload_max_length(http::kMaxBodyBytes);
+  server_->set_payload_max_length(http::kMaxUploadBytes);  // each route enforces its own
   http::InstallGate(*server_, *context_);
   http::AddBoardRoutes(*server_, *context_);
   http::AddRecipeRoutes(*server_, *context_);
   http::AddTestRoutes(*server_, *context_);
   http::AddQcRoutes(*server_, *context_);
+  http::AddFigureRoutes(*server_, *context_);
   server_->set_exception_handler(
       [](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
         std::string what = "unknown";

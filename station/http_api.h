@@ -28,12 +28,17 @@
 //                               learned from those units' latest stored tests; returns the
 //                               proposed recipe (version + 1) and the summary; engineer
 //                               token; nothing changes until the recipe is PUT
+//   POST /api/pod.svg           {"hits_csv": "<text>", ...}: the POD figure of `eol pod`
+//   POST /api/gap.svg           {"simulation": {"name", "text"}, "measured": [...], ...}: the
+//                               plot of `eol gap` (both station/http/figure_routes.cc;
+//                               engineer token when tokens are configured)
 //   GET  /metrics               Prometheus text: tests by outcome, state, last resonance
 //   GET  /                      the operator page (station/web)
+//   GET  /engineer              the engineer page (station/web/engineer.html)
 //
 // Errors are JSON {"error": {"code": "...", "message": "..."}} with a fitting HTTP status.
-// Reads need no token; request bodies are limited to 64 KiB. Reads of the database go
-// through a connection of the API's own that never recovers unfinished tests.
+// Reads need no token; request bodies are limited to 64 KiB (4 MiB for the figure uploads). Reads
+// of the database go through a connection of the API's own that never recovers unfinished tests.
 //
 // This is a thin transport: one handler per route in station/http/*_routes.cc, sharing
 // RequireRole and ParseBody (station/http/request.h); the station decides (RecipeChange,

@@ -34,6 +34,7 @@ PairJudgement JudgePair(const Recipe& recipe, const PairMeasurement& p, nlohmann
     return j;
   }
   std::map<std::string, analysis::Estimate> values = a.values;
+  if (recipe.bond_index) analysis::AddBondIndex(values, *recipe.bond_index);
   std::vector<analysis::MeasurementSpec> mask_specs;
   std::vector<Reason> mask_details;
   for (const analysis::CurveMask& mask : recipe.masks) {

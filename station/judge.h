@@ -7,6 +7,8 @@
 //                                             nothing else is judged for that pair.
 //   2. scalar limits (recipe "limits")     -> FAIL "limit" outside; ERROR "analysis" when a
 //                                             declared value is missing or not finite.
+//                                             bond_index_pct is computed here from f0 and the
+//                                             residue when the recipe has "bond_index".
 //   3. curve masks (recipe "masks")        -> the count of lines outside is a measurement
 //                                             mask_<name>_lines_outside judged against
 //                                             max_lines_outside (FAIL "mask"); when the pair

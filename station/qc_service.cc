@@ -20,6 +20,7 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
     }
   }
   if (!s.masks.empty()) taught.masks = s.masks;
+  if (s.bond_index) taught.bond_index = s.bond_index;
   std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
                      std::to_string(s.units_used) + " golden units (" +
                      analysis::ToString(o.method) + ", allocation " + o.allocation +
@@ -38,6 +39,11 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
 
 json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOptions& o) {
   json limits = json::array(), stats = json::array(), masks = json::array();
+  json bond_index = nullptr;
+  if (s.bond_index)
+    bond_index = {{"f0_exponent", s.bond_index->f0_exponent},
+                  {"f0_ref_hz", s.bond_index->f0_ref_hz},
+                  {"residue_ref_ohm_per_s", s.bond_index->residue_ref_ohm_per_s}};
   for (const auto& l : s.limits) limits.push_back(LimitJson(l));
   for (const auto& t : s.statistics)
     stats.push_back({{"name", t.name}, {"centre", t.centre}, {"scale", t.scale}});
@@ -74,6 +80,7 @@ json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOpti
           {"limits", limits},
           {"masks", masks},
           {"statistics", stats},
+          {"bond_index", bond_index},
           {"message", s.message}};
 }
 

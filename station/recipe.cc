@@ -234,6 +234,20 @@ void ParseConditions(const JsonObject& c, Recipe& r) {
   c.RejectUnknown();
 }
 
+void ParseBondIndex(const JsonObject& o, Recipe& r) {
+  analysis::BondIndexDefinition d;
+  d.f0_exponent = o.RequiredNumber("f0_exponent");
+  d.f0_ref_hz = o.RequiredNumber("f0_ref_hz");
+  d.residue_ref_ohm_per_s = o.RequiredNumber("residue_ref_ohm_per_s");
+  o.Require(d.f0_exponent >= 0.0 && d.f0_exponent <= 1000.0, "f0_exponent", "must be in [0, 1000]");
+  o.Require(d.f0_ref_hz > 0.0, "f0_ref_hz", "must be positive");
+  o.Require(d.residue_ref_ohm_per_s > 0.0, "residue_ref_ohm_per_s", "must be positive");
+  std::string why;
+  o.Require(d.IsValid(&why), "f0_exponent", why);  // finite (the checks above pass NaN)
+  o.RejectUnknown();
+  r.bond_index = d;
+}
+
 void ParseApproval(const JsonObject& o, Recipe& r) {
   RecipeApproval a;
   a.state = o.String("state", "");
@@ -323,6 +337,14 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
     if (auto c = root.OptionalObject("conditions")) ParseConditions(*c, r);
     if (auto i = root.OptionalObject("instructions")) ParseInstructions(*i, r);
     if (auto a = root.OptionalObject("approval")) ParseApproval(*a, r);
+    if (auto b = root.OptionalObject("bond_index")) ParseBondIndex(*b, r);
+    const bool index_declared =
+        std::any_of(r.limits.begin(), r.limits.end(), [](const analysis::MeasurementSpec& s) {
+          return s.name == analysis::names::kBondIndexPct;
+        });
+    root.Require(!index_declared || r.bond_index.has_value(), "bond_index",
+                 "is required when a limit is declared on bond_index_pct (eol teach sets it; "
+                 "analysis/qc/bond_index.h)");
     root.RejectUnknown();
     r.source = j;
     r.hash = CanonicalHash(j);
@@ -444,6 +466,10 @@ nlohmann::json RecipeToJson(const Recipe& r) {
       {"masks", masks},
       {"instructions", InstructionsJson(r.instructions)}};
   if (r.conditions.enabled) j["conditions"] = ConditionsJson(r.conditions);
+  if (r.bond_index)
+    j["bond_index"] = {{"f0_exponent", r.bond_index->f0_exponent},
+                       {"f0_ref_hz", r.bond_index->f0_ref_hz},
+                       {"residue_ref_ohm_per_s", r.bond_index->residue_ref_ohm_per_s}};
   if (r.approval) {
     j["approval"] = {{"state", r.approval->state}, {"by", r.approval->by}, {"at", r.approval->at}};
     if (!r.approval->note.empty()) j["approval"]["note"] = r.approval->note;

@@ -22,6 +22,9 @@
 //                  "excitation_v_rms": {"lo": 1.2, "hi": 1.45}, "excitation_a_rms": {...},
 //                  "out_of_window": "error" | "record"}       optional, station/conditions.h
 //   "instructions": {"fail": "...", "error": "...", "aborted": "..."}  optional, each optional
+//   "bond_index": {"f0_exponent": 5.3, "f0_ref_hz": 390, "residue_ref_ohm_per_s": 25.6}
+//                  optional; required by a limit on bond_index_pct (analysis/qc/bond_index.h;
+//                  eol teach writes it from the golden units)
 // }
 // Validated on load: every message names the JSON path and the rule broken, and a recipe
 // that fails validation is never used. The hash is the SHA-256 of the canonical JSON (keys
@@ -35,6 +38,7 @@
 #include <vector>
 
 #include "analysis/impedance_analysis.h"
+#include "analysis/qc/bond_index.h"
 #include "analysis/qc/curve_mask.h"
 #include "analysis/qc/measurement.h"
 #include "analysis/signal/multisine.h"
@@ -116,6 +120,7 @@ struct Recipe {
   ConditionWindows conditions;
   OperatorInstructions instructions;
   std::optional<RecipeApproval> approval;
+  std::optional<analysis::BondIndexDefinition> bond_index;
 
   bool Approved() const { return !approval || approval->state == "approved"; }
   // Empty when Approved(); else why the station refuses it, naming how to approve it.

@@ -44,9 +44,10 @@ Measured MeasureUnit(const ProductionBenchOptions& o, const LineMeasurementSetup
 }
 
 Outcome JudgeWith(const std::vector<MeasurementSpec>& limits, const std::vector<CurveMask>& masks,
-                  const Measured& m) {
+                  const std::optional<BondIndexDefinition>& bond_index, const Measured& m) {
   std::vector<MeasurementSpec> specs = limits;
   std::map<std::string, Estimate> values = m.analysis.values;
+  if (bond_index) AddBondIndex(values, *bond_index);
   for (const CurveMask& mask : masks) {
     specs.push_back(mask.Spec());
     if (m.analysis.usable)
@@ -97,7 +98,7 @@ void RunPodSweep(const ProductionBenchOptions& o, const LineMeasurementSetup& se
     const LineUnit unit = DrawLineUnit(nominal, o.spread, w.defect, o.seed, index);
     const Measured m = MeasureUnit(o, setup, unit, index);
     const auto k = static_cast<std::size_t>(i);
-    w.data[k] = {loss, JudgeWith(teach.limits, teach.masks, m) != Outcome::kPass};
+    w.data[k] = {loss, JudgeWith(teach.limits, teach.masks, teach.bond_index, m) != Outcome::kPass};
     w.f0_hz[k] = ResonanceHz(m);
   });
   w.fit = FitPod(w.data, o.pod);
@@ -217,8 +218,8 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
       const LineUnit unit = DrawLineUnit(o.rotor, o.spread, o.rates, o.seed, index);
       const Measured m = MeasureUnit(o, setup, unit, index);
       const std::size_t c = ClassIndex(unit.defect);
-      Count(local.counts[0][c], JudgeWith(s.teach.limits, s.teach.masks, m));
-      Count(local.counts[1][c], JudgeWith(o.declared, o.recipe_masks, m));
+      Count(local.counts[0][c], JudgeWith(s.teach.limits, s.teach.masks, s.teach.bond_index, m));
+      Count(local.counts[1][c], JudgeWith(o.declared, o.recipe_masks, o.recipe_bond_index, m));
       Count(local.counts[2][c], NaivePass(m.frf, o.naive) ? Outcome::kPass : Outcome::kFail);
       const double f0 = ResonanceHz(m);
       if (std::isfinite(f0)) local.f0_hz[c].push_back(f0);

@@ -23,12 +23,14 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "analysis/bench/naive_rule.h"
 #include "analysis/fit/resonance_fit.h"
 #include "analysis/progress.h"
+#include "analysis/qc/bond_index.h"
 #include "analysis/qc/line_population.h"
 #include "analysis/qc/pod.h"
 #include "analysis/qc/teach.h"
@@ -45,9 +47,10 @@ struct ProductionBenchOptions {
   std::size_t periods = 4;
   double voltage_noise_v = 2.0e-3;  // the simulated DAQ's, rms per sample
   double current_noise_a = 1.0e-3;
-  ResonanceFitOptions fit;                // the recipe's analysis options
-  std::vector<MeasurementSpec> declared;  // the recipe's scalar limits
-  std::vector<CurveMask> recipe_masks;    // the recipe's masks (the "recipe" rule)
+  ResonanceFitOptions fit;                               // the recipe's analysis options
+  std::vector<MeasurementSpec> declared;                 // the recipe's scalar limits
+  std::vector<CurveMask> recipe_masks;                   // the recipe's masks (the "recipe" rule)
+  std::optional<BondIndexDefinition> recipe_bond_index;  // the recipe's (the "recipe" rule)
   TeachOptions teach;
   RotorChainParams rotor;  // nominal geometry, default fixture
   LineSpread spread;

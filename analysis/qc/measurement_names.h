@@ -15,10 +15,13 @@ inline constexpr std::string_view kMotionalRpOhm = "motional_rp_ohm";  // ohm: p
 // ohm/s: T^2 / J = Rp w0 / Q, the resonance's residue (motor_model.h): rises as bonds soften
 inline constexpr std::string_view kMotionalResidueOhmPerS = "motional_residue_ohm_per_s";
 inline constexpr std::string_view kFitChi2PerDof = "fit_chi2_per_dof";  // 1: goodness of fit
+// %: 100 [ln(A/A_ref) - m ln(f0/f0_ref)], f0 and residue weighed by the good units' spread
+// (bond_index.h); only where the recipe defines it ("bond_index" block, set by teaching)
+inline constexpr std::string_view kBondIndexPct = "bond_index_pct";
 
 // In the export schema's column order (db/export_schema.h): append only.
-inline constexpr std::array<std::string_view, 7> kAll = {
-    kResonanceFHz,  kResonanceQ,    kWindingROhm,           kWindingLH,
-    kMotionalRpOhm, kFitChi2PerDof, kMotionalResidueOhmPerS};
+inline constexpr std::array<std::string_view, 8> kAll = {
+    kResonanceFHz,           kResonanceQ,  kWindingROhm, kWindingLH, kMotionalRpOhm, kFitChi2PerDof,
+    kMotionalResidueOhmPerS, kBondIndexPct};
 
 }  // namespace eol::analysis::names

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "analysis/enum_names.h"
+#include "analysis/qc/bond_index.h"
 #include "analysis/qc/measurement_names.h"
 #include "analysis/qc/statistics.h"
 #include "analysis/qc/tolerance.h"
@@ -24,7 +25,9 @@ constexpr double kPlausibilityWeight = 0.002;
 constexpr double kOtherWeight = 0.02;
 constexpr double kMaskMaxWeight = 0.20;   // all segments together
 constexpr double kMaskMinWeight = 0.005;  // all segments together
-constexpr double kResidueWeight = 0.30;
+constexpr double kResidueWeight = 0.10;
+constexpr double kBondIndexWeight = 0.30;
+constexpr double kResonanceLoWeight = 0.20;
 
 struct SideWeights {
   double lo = 0.0, hi = 0.0;
@@ -34,10 +37,11 @@ struct SideWeights {
 SideWeights DesignWeights(const std::string& name) {
   namespace n = names;
   const double p = kPlausibilityWeight;
-  if (name == n::kResonanceFHz) return {0.30, p, true, false};
+  if (name == n::kResonanceFHz) return {kResonanceLoWeight, p, true, false};
   if (name == n::kFitChi2PerDof) return {p, 0.35, false, true};
   if (name == n::kResonanceQ) return {0.05, p, true, false};
   if (name == n::kMotionalResidueOhmPerS) return {p, kResidueWeight, false, true};
+  if (name == n::kBondIndexPct) return {p, kBondIndexWeight, false, true};
   return {kOtherWeight, kOtherWeight, true, true};
 }
 
@@ -207,9 +211,9 @@ bool TeachOptions::IsValid(std::string* why) const {
   return true;
 }
 
-TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
-                         const std::vector<GoldenUnit>& golden, const TeachOptions& o,
-                         const std::vector<GoldenUnit>& known_bad) {
+static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
+                                  const std::vector<GoldenUnit>& golden, const TeachOptions& o,
+                                  const std::vector<GoldenUnit>& known_bad) {
   TeachSummary s;
   s.units_given = static_cast<int>(golden.size());
   std::string why;
@@ -571,6 +575,46 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
     s.message +=
         "; WARNING: taught from fewer golden units than needed (forced), the limits "
         "are wide";
+  return s;
+}
+
+// A declared bond index is taught first: its exponent and references from the golden units'
+// f0 and residue (bond_index.h), then its value is added to every unit and it is taught as
+// any other measurement.
+TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
+                         const std::vector<GoldenUnit>& golden, const TeachOptions& o,
+                         const std::vector<GoldenUnit>& known_bad) {
+  const bool index_declared =
+      std::any_of(declared.begin(), declared.end(),
+                  [](const MeasurementSpec& d) { return d.name == names::kBondIndexPct; });
+  if (!index_declared) return TeachOnValues(declared, golden, o, known_bad);
+  const std::string f0_name(names::kResonanceFHz), a_name(names::kMotionalResidueOhmPerS);
+  std::vector<std::pair<double, double>> f0_and_residue;
+  for (const GoldenUnit& u : golden) {
+    const auto f0 = u.values.find(f0_name);
+    const auto a = u.values.find(a_name);
+    if (f0 == u.values.end() || a == u.values.end() || !(f0->second > 0.0) || !(a->second > 0.0) ||
+        !std::isfinite(f0->second) || !std::isfinite(a->second)) {
+      TeachSummary s;
+      s.units_given = static_cast<int>(golden.size());
+      s.message = "golden unit " + u.label + " has no positive " + f0_name + " and " + a_name +
+                  " to teach bond_index_pct from";
+      return s;
+    }
+    f0_and_residue.emplace_back(f0->second, a->second);
+  }
+  const BondIndexDefinition index = TeachBondIndex(f0_and_residue);
+  const auto with_index = [&](std::vector<GoldenUnit> units) {
+    for (GoldenUnit& u : units) {
+      std::map<std::string, Estimate> values;
+      for (const auto& [name, v] : u.values) values[name] = Estimate{v, 0.0};
+      if (const auto e = BondIndex(values, index))
+        u.values[std::string(names::kBondIndexPct)] = e->value;
+    }
+    return units;
+  };
+  TeachSummary s = TeachOnValues(declared, with_index(golden), o, with_index(known_bad));
+  s.bond_index = index;
   return s;
 }
 

@@ -15,14 +15,26 @@
 // defect moves keeps a plausibility bound (weight 0.002: wrong motor, station fault) so that
 // the recipe keeps its shape without spending the budget there.
 //   measurement        defect side  weight  why
-//   resonance_f_hz     lo           0.30    a softer bond (or looser clamp) only lowers the mode
-//   motional_residue   hi           0.30    T^2/J: a softer bond lets less inertia follow the
+//   resonance_f_hz     lo           0.20    a softer bond (or looser clamp) only lowers the mode
+//   motional_residue   hi           0.10    T^2/J: a softer bond lets less inertia follow the
 //     _ohm_per_s                            magnets (where the torque acts); it rises about
 //                                           twelve times faster than f0 falls and hardly moves
 //                                           with the clamp (motor_model.h). Evidence: on the
 //                                           independent generator, all ten bonds at losses of
 //                                           0.85-0.94, 29 of 80 rejected with it, 19 without
 //                                           (independent_population_test part 4)
+//   bond_index_pct     hi           0.30    f0 and residue together, weighed by the golden
+//                                           units' spread (bond_index.h; taught first: its
+//                                           exponent and references from the golden units).
+//                                           Evidence for 0.20 / 0.10 / 0.30 against f0 0.30
+//                                           and residue 0.30 without it (README, "Learning
+//                                           limits"): independent generator, 400 all-ten
+//                                           rotors at losses 0.8-0.99, seeds 1 and 2: 188 and
+//                                           160 rejected against 174 and 157, three soft
+//                                           71 / 89 against 66 / 88, 0 of 400 good; line model
+//                                           (10000 units): one soft magnet 156 escapes
+//                                           against 157, weak bonds 202 against 203, good
+//                                           false rejects 1 against 3
 //   fit_chi2_per_dof   hi           0.35    a soft magnet's local mode is a peak the one-mode
 //                                           model cannot follow; it only raises chi2
 //   Re Z mask max      hi           0.20    (all segments together) an extra motional peak
@@ -80,11 +92,13 @@
 #include <array>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "analysis/frf.h"
+#include "analysis/qc/bond_index.h"
 #include "analysis/qc/curve_mask.h"
 #include "analysis/qc/measurement.h"
 
@@ -170,6 +184,9 @@ struct TeachSummary {
   double f0_lo_hz = 0.0;                              // the taught one
   double known_bad_moved_share = 0.0;         // share of the budget moved to the f0 lower bound
   std::vector<std::string> known_bad_donors;  // bounds it was taken from ("name lo|hi")
+  // When bond_index_pct is declared: its definition taught from the golden units (bond_index.h),
+  // to be written into the taught recipe's "bond_index" block.
+  std::optional<BondIndexDefinition> bond_index;
 };
 
 // Never throws for bad data: usable == false with the reason (names the unit or measurement).

@@ -1,11 +1,8 @@
 // `eol pod --hits FILE [--link logit|probit] [--scale linear|log] [--confidence 0.95]
 // [--pod-svg FILE] [--f0-limit HZ]... [--json]`: probability of detection from hit/miss data
 // (analysis/qc/pod.h, MIL-HDBK-1823A), e.g. the per-unit table of
-// tests/peers/population_rejects.py. The hits file is CSV with a header naming at least the
-// columns size (the defect size a, > 0 for a defective unit, 0 for a good one) and hit (1 the
-// unit was rejected, 0 it passed); optional columns class (one POD per class, default "all")
-// and f0_hz (the fitted resonance, for the figure's distributions; empty when not fitted).
-// Good units (size 0) are not part of any POD fit; they are drawn in the figure.
+// tests/peers/population_rejects.py; the hits CSV and the figure: station/pod_chart.h (shared
+// with POST /api/pod.svg).
 // Exit: 0 every class fitted, 1 a class could not be fitted (the reason is printed), 2 usage.
 #include <cmath>
 #include <fstream>
@@ -18,8 +15,8 @@
 #include "analysis/qc/pod.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/cli/pod_svg.h"
 #include "station/cli/progress.h"
+#include "station/pod_chart.h"
 
 namespace eol::station::cli {
 namespace {
@@ -34,75 +31,12 @@ struct PodArgs {
   bool json = false;
 };
 
-std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream in(line);
-  std::string cell;
-  while (std::getline(in, cell, ',')) out.push_back(cell);
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
-double ParseNumber(const std::string& text, const std::string& where) {
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size())
-    throw std::runtime_error(where + ": '" + text + "' is not a number");
-  return v;
-}
-
-struct HitsFile {
-  std::map<std::string, std::vector<analysis::HitMiss>> defective;  // by class
-  std::map<std::string, std::vector<double>> f0_hz;                 // by class, every unit
-};
-
-HitsFile ReadHits(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read the hits file '" + path + "'");
-  std::string line;
-  if (!std::getline(in, line)) throw std::runtime_error(path + ": empty (no header)");
-  const std::vector<std::string> header = SplitCsv(line);
-  std::map<std::string, std::size_t> col;
-  for (std::size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
-  for (const char* need : {"size", "hit"})
-    if (!col.count(need))
-      throw std::runtime_error(path + ": the header has no column '" + need +
-                               "' (needs size and hit; class and f0_hz optional)");
-  HitsFile h;
-  for (int n = 2; std::getline(in, line); ++n) {
-    if (line.empty()) continue;
-    const std::vector<std::string> cells = SplitCsv(line);
-    const std::string where = path + ":" + std::to_string(n);
-    auto cell = [&](const std::string& name) -> std::string {
-      const std::size_t i = col.at(name);
-      if (i >= cells.size()) throw std::runtime_error(where + ": no value in column " + name);
-      return cells[i];
-    };
-    const std::string cls = col.count("class") ? cell("class") : "all";
-    const double size = ParseNumber(cell("size"), where + " size");
-    const std::string hit = cell("hit");
-    if (hit != "0" && hit != "1") throw std::runtime_error(where + ": hit must be 0 or 1");
-    if (size < 0.0) throw std::runtime_error(where + ": size must be >= 0");
-    if (size > 0.0) h.defective[cls].push_back({size, hit == "1"});
-    if (col.count("f0_hz") && col.at("f0_hz") < cells.size() && !cells[col.at("f0_hz")].empty())
-      h.f0_hz[cls].push_back(ParseNumber(cells[col.at("f0_hz")], where + " f0_hz"));
-  }
-  if (h.defective.empty())
-    throw std::runtime_error(path + ": no defective unit (size > 0): nothing to fit");
-  return h;
-}
-
 std::string Bound(double v) {
   return std::isfinite(v) ? std::to_string(v) : std::string("none (not bounded by the data)");
 }
 
 int RunPod(const PodArgs& a) {
-  const HitsFile h = ReadHits(a.hits);
+  const HitsTable h = ReadHitsFile(a.hits);
   json fits = json::object();
   std::vector<PodCurve> curves;
   bool all_usable = true;
@@ -130,11 +64,9 @@ int RunPod(const PodArgs& a) {
     }
   }
   if (!a.svg.empty()) {
-    std::vector<F0Group> groups;
-    for (const auto& [cls, f0] : h.f0_hz) groups.push_back({cls, f0});
     std::vector<F0Limit> limits;
     for (double f : a.f0_limits) limits.push_back({"f0 limit", f});
-    WritePodSvg(a.svg, "POD from " + a.hits, curves, groups, limits);
+    WritePodSvg(a.svg, "POD from " + a.hits, curves, F0Groups(h), limits);
     if (!a.json) std::cout << "figure: " << a.svg << "\n";
   }
   if (a.json) std::cout << json{{"hits", a.hits}, {"pod", fits}}.dump() << std::endl;

@@ -10,9 +10,9 @@
 #include "analysis/bench/production_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/cli/pod_svg.h"
 #include "station/cli/progress.h"
 #include "station/data_files.h"
+#include "station/pod_chart.h"
 #include "station/recipe.h"
 
 namespace eol::station::cli {
@@ -91,6 +91,7 @@ int RunBench(BenchArgs a) {
   o.fit = r.analysis.fit;
   o.declared = r.limits;
   o.recipe_masks = r.masks;
+  o.recipe_bond_index = r.bond_index;
   o.naive.search_lo_hz = r.analysis.fit.f0_min_hz;
   o.naive.search_hi_hz = r.analysis.fit.f0_max_hz;
   analysis::ProductionBenchSummary s;

@@ -1,4 +1,5 @@
-// The live station: status, server-sent events, Prometheus metrics and the operator page.
+// The live station: status, server-sent events, Prometheus metrics, the operator page and the
+// engineer page.
 #include <fstream>
 #include <sstream>
 
@@ -57,14 +58,25 @@ std::string ReadFile(const std::string& path) {
   return s.str();
 }
 
-void GetOperatorPage(ApiContext& c, const httplib::Request&, httplib::Response& res) {
+// A page of the web root, or a short page that says it is not installed.
+void SendPage(const ApiContext& c, const std::string& file, const std::string& what,
+              httplib::Response& res) {
   std::string page;
-  if (!c.options.web_root.empty()) page = ReadFile(c.options.web_root + "/index.html");
+  if (!c.options.web_root.empty()) page = ReadFile(c.options.web_root + "/" + file);
   if (page.empty())
     page =
-        "<!doctype html><title>EOL station</title><h1>EOL station</h1>"
-        "<p>The operator page is not installed; see <a href=\"/api/status\">/api/status</a>.";
+        "<!doctype html><html lang=\"en\"><title>EOL station</title><h1>EOL station</h1>"
+        "<p>The " +
+        what + " is not installed; see <a href=\"/api/status\">/api/status</a>.";
   res.set_content(page, "text/html; charset=utf-8");
+}
+
+void GetOperatorPage(ApiContext& c, const httplib::Request&, httplib::Response& res) {
+  SendPage(c, "index.html", "operator page", res);
+}
+
+void GetEngineerPage(ApiContext& c, const httplib::Request&, httplib::Response& res) {
+  SendPage(c, "engineer.html", "engineer page", res);
 }
 
 }  // namespace
@@ -74,6 +86,7 @@ void AddBoardRoutes(httplib::Server& s, ApiContext& c) {
   Route(s, c, "GET", "/api/events", GetEvents);
   Route(s, c, "GET", "/metrics", GetMetrics);
   Route(s, c, "GET", "/", GetOperatorPage);
+  Route(s, c, "GET", "/engineer", GetEngineerPage);
   if (!c.options.web_root.empty()) s.set_mount_point("/static", c.options.web_root);
 }
 

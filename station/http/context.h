@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "db/store.h"
+#include "station/http/request.h"
 #include "station/http_api.h"
 
 namespace httplib {
@@ -34,6 +35,7 @@ struct ApiContext {
   struct RouteEntry {
     std::string method;
     std::regex pattern;
+    std::size_t max_body_bytes = 0;  // POST and PUT
   };
   std::vector<RouteEntry> routes;
 };
@@ -43,9 +45,10 @@ using RouteHandler = void (*)(ApiContext&, const httplib::Request&, httplib::Res
 
 // Registers `handler` for `method` ("GET", "POST" or "PUT") and `pattern` on the server and
 // in c.routes. POST and PUT bodies are read through httplib's content reader, so that a body
-// of any framing (Content-Length or chunked) stops at kMaxBodyBytes (413, nothing more is
-// buffered); the handler then finds it in req.body.
+// of any framing (Content-Length or chunked) stops at `max_body_bytes` (413, nothing more is
+// buffered; the gate refuses a larger Content-Length unread); the handler then finds it in
+// req.body. The server's own cap (HttpApi) is the largest route's.
 void Route(httplib::Server& s, ApiContext& c, const std::string& method, const std::string& pattern,
-           RouteHandler handler);
+           RouteHandler handler, std::size_t max_body_bytes = kMaxBodyBytes);
 
 }  // namespace eol::station::http

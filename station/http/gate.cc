@@ -38,9 +38,13 @@ httplib::Server::HandlerResponse Check(const ApiContext& c, const httplib::Reque
   const std::string method = req.method == "HEAD" ? "GET" : req.method;
   std::string allow;
   bool allowed = false;
+  std::size_t max_body = kMaxBodyBytes;
   for (const auto& r : c.routes) {
     if (!std::regex_match(req.path, r.pattern)) continue;
-    if (r.method == method) allowed = true;
+    if (r.method == method) {
+      allowed = true;
+      max_body = r.max_body_bytes;
+    }
     if (allow.find(r.method) == std::string::npos) allow += (allow.empty() ? "" : ", ") + r.method;
   }
   const bool static_file =
@@ -77,10 +81,10 @@ httplib::Server::HandlerResponse Check(const ApiContext& c, const httplib::Reque
   if (te.empty() && !has_length)
     return Refuse(res, ApiErrorKind::kLengthRequired, "length_required",
                   "a request body needs Content-Length or chunked Transfer-Encoding");
-  if (length > kMaxBodyBytes)
+  if (length > max_body)
     return Refuse(res, ApiErrorKind::kTooLarge, "too_large",
                   "request body is " + std::to_string(length) + " bytes; the limit is " +
-                      std::to_string(kMaxBodyBytes));
+                      std::to_string(max_body));
   const std::string type = Lower(Trim(req.get_header_value("Content-Type")));
   if (type.substr(0, type.find(';')) != "application/json")
     return Refuse(res, ApiErrorKind::kUnsupportedMedia, "unsupported_media_type",
@@ -98,8 +102,8 @@ httplib::Server::HandlerResponse Check(const ApiContext& c, const httplib::Reque
 }  // namespace
 
 void Route(httplib::Server& s, ApiContext& c, const std::string& method, const std::string& pattern,
-           RouteHandler handler) {
-  c.routes.push_back({method, std::regex(pattern)});
+           RouteHandler handler, std::size_t max_body_bytes) {
+  c.routes.push_back({method, std::regex(pattern), max_body_bytes});
   if (method == "GET") {
     s.Get(pattern, [&c, handler](const httplib::Request& req, httplib::Response& res) {
       handler(c, req, res);
@@ -107,12 +111,12 @@ void Route(httplib::Server& s, ApiContext& c, const std::string& method, const s
     return;
   }
   httplib::Server::HandlerWithContentReader read_then_handle =
-      [&c, handler](const httplib::Request& req, httplib::Response& res,
-                    const httplib::ContentReader& read) {
+      [&c, handler, max_body_bytes](const httplib::Request& req, httplib::Response& res,
+                                    const httplib::ContentReader& read) {
         std::string body;
         bool too_large = false;
         const bool ok = read([&](const char* data, std::size_t n) {
-          if (body.size() + n > kMaxBodyBytes) {
+          if (body.size() + n > max_body_bytes) {
             too_large = true;
             return false;
           }
@@ -123,7 +127,7 @@ void Route(httplib::Server& s, ApiContext& c, const std::string& method, const s
           CloseAfterResponse();
           return Send(res, too_large ? ApiError{ApiErrorKind::kTooLarge, "too_large",
                                                 "request body exceeds the limit of " +
-                                                    std::to_string(kMaxBodyBytes) + " bytes"}
+                                                    std::to_string(max_body_bytes) + " bytes"}
                                      : ApiError{ApiErrorKind::kBadRequest, "bad_body",
                                                 "the request body ended early or its chunked "
                                                 "framing is malformed"});

@@ -7,7 +7,8 @@
 //   Transfer-Encoding other than "chunked",
 //     or with Content-Length                   400 "bad_framing"
 //   POST/PUT without either framing            411 "length_required" (httplib would read to EOF)
-//   Content-Length above kMaxBodyBytes         413 "too_large" (the body is not read)
+//   Content-Length above the route's limit     413 "too_large" (the body is not read;
+//                                              kMaxBodyBytes, kMaxUploadBytes for figures)
 //   POST/PUT not application/json              415 "unsupported_media_type": a cross-site page
 //                                              can send text/plain without a preflight
 //   POST/PUT with an Origin that is not

@@ -24,6 +24,9 @@ namespace eol::station::http {
 
 // Request bodies are small JSON documents (a serial, a recipe, a list of serials).
 inline constexpr std::size_t kMaxBodyBytes = 64 * 1024;
+// The figure routes' bodies carry files (a hits table, FRF curves, a raw recording of a few
+// periods): larger, but bounded all the same.
+inline constexpr std::size_t kMaxUploadBytes = 4 * 1024 * 1024;
 
 // The token of "Authorization: Bearer <token>", or "" when the header is absent or other.
 std::string BearerToken(const httplib::Request& req);

@@ -9,7 +9,8 @@
 
 namespace eol::station::http {
 
-// GET /api/status, GET /api/events, GET /metrics, GET / and /static (station/http/board_routes.cc)
+// GET /api/status, GET /api/events, GET /metrics, GET /, GET /engineer and /static
+// (station/http/board_routes.cc)
 void AddBoardRoutes(httplib::Server& s, ApiContext& c);
 // GET /api/recipe, PUT /api/recipe, GET /api/recipe/audit, POST /api/recipe/approve
 // (station/http/recipe_routes.cc)
@@ -19,6 +20,8 @@ void AddTestRoutes(httplib::Server& s, ApiContext& c);
 // GET /api/stats, GET /api/charts/{measurement}.svg, GET /api/detectability, POST /api/teach
 // (station/http/qc_routes.cc)
 void AddQcRoutes(httplib::Server& s, ApiContext& c);
+// POST /api/pod.svg, POST /api/gap.svg (station/http/figure_routes.cc)
+void AddFigureRoutes(httplib::Server& s, ApiContext& c);
 
 // kChanged: 200 with {id, version, hash, path, previous: {version, hash, kept_as}};
 // kInvalid: 400 "invalid_recipe"; kBusy: 409 "busy"; kWrongRecipe: 409 "wrong_recipe";

@@ -175,60 +175,92 @@ function maskAt(points, key, f) {
   return null;
 }
 
+// A legend key: [kind, text] or [kind, text, pair index]; the pair picks the swatch colour.
 function renderLegend(keys) {
-  $("legend").replaceChildren(...keys.map(([cls, text]) => el("span", {class: "key " + cls}, text)));
+  $("legend").replaceChildren(...keys.map(([cls, text, pair]) =>
+      el("span", pair === undefined ? {class: "key " + cls} : {class: "key " + cls, "data-pair": pair}, text)));
 }
 
+const PLOTS = ["plot", "plot-abs"];
+
 function clearPlot(note) {
-  $("plot").replaceChildren();
-  $("plot").removeAttribute("data-serial");
-  $("plot").setAttribute("aria-label", "no curve" + (note ? ": " + note : ""));
+  for (const id of PLOTS) {
+    $(id).replaceChildren();
+    $(id).removeAttribute("data-serial");
+    $(id).setAttribute("aria-label", "no curve" + (note ? ": " + note : ""));
+  }
+  $("plot-abs").toggleAttribute("hidden", true);  // an SVG element has no .hidden property
   $("curve-note").textContent = note ? "(" + note + ")" : "";
   renderLegend([]);
 }
 
-// The measured Re Z, every limit the verdict used on it (the resonance window from the
-// record's own limit, the recipe's Re Z masks) and the fitted model on top.
-function plotCurves(record) {
-  const svg = $("plot");
-  svg.replaceChildren();
-  const meas = (record.curves || []).find(c => c.name === "impedance");
-  const model = (record.curves || []).find(c => c.name === "model");
-  if (!meas) {
-    clearPlot("no curve: " + reasonText((record.reasons || [""])[0]));
-    return;
+// The recorder's phase-pair names (station/judge.cc PairName), by conditions.phase_pair.
+const PAIR_NAMES = ["U-V", "V-W", "W-U"];
+
+// Every phase pair the record measured, the recipe's first pair first: its curves are
+// "impedance" and "model", a further pair's "impedance@V-W" and "model@V-W", and so are its
+// measurements ("resonance_f_hz@V-W").
+function measuredPairs(record) {
+  const curves = record.curves || [];
+  const first = PAIR_NAMES[(record.conditions || {}).phase_pair] || "first pair";
+  const pairs = [];
+  for (const c of curves) {
+    const m = /^impedance(?:@(.+))?$/.exec(c.name);
+    if (!m) continue;
+    const suffix = m[1] ? "@" + m[1] : "";
+    const resonance = (record.measurements || []).find(x => x.name === "resonance_f_hz" + suffix);
+    pairs.push({name: m[1] || first, measured: c, model: curves.find(x => x.name === "model" + suffix),
+                f0: resonance && isFinite(resonance.value) ? resonance.value : null});
   }
-  const W = 800, H = 420, L = 60, R = 15, T = 15, B = 40;
-  const f0 = meas.freq_hz[0], f1 = meas.freq_hz[meas.freq_hz.length - 1];
-  const masks = ((recipe && recipe.masks) || []).filter(m => (m.quantity || "re_ohm") === "re_ohm");
-  const sameRecipe = recipe && record.recipe && recipe.hash === record.recipe.hash;
-  const resonance = (record.measurements || []).find(m => m.name === "resonance_f_hz");
-  const win = resonance && resonance.limit;
-  let ys = meas.re.filter(isFinite);
-  if (model) ys = ys.concat(model.re.filter(isFinite));
+  return pairs;
+}
+
+// What a mask bounds (analysis/qc/curve_mask.h MaskQuantity), from a curve's Re and Im in ohm.
+const QUANTITIES = {
+  re_ohm: {label: "Re Z", value: (c, i) => c.re[i]},
+  abs_ohm: {label: "|Z|", value: (c, i) => Math.hypot(c.re[i], c.im[i])},
+};
+
+// One panel: the resonance window, the masks on this quantity, each pair's measured curve and
+// resonance, and each pair's fitted model last (on top, never hidden under a measured curve).
+// Returns the number of mask areas drawn.
+function drawPanel(svg, pairs, quantity, masks, win) {
+  svg.replaceChildren();
+  const q = QUANTITIES[quantity];
+  const [, , W, H] = svg.getAttribute("viewBox").split(" ").map(Number);
+  const L = 60, R = 15, T = 15, B = 40;
+  const freqs = pairs.flatMap(p => [p.measured.freq_hz[0], p.measured.freq_hz[p.measured.freq_hz.length - 1]]);
+  const f0 = Math.min(...freqs), f1 = Math.max(...freqs);
+  const values = c => c.freq_hz.map((_, i) => q.value(c, i));
+  let ys = [];
+  for (const p of pairs) {
+    p[quantity] = {measured: values(p.measured), model: p.model ? values(p.model) : null};
+    ys = ys.concat(p[quantity].measured.filter(isFinite), (p[quantity].model || []).filter(isFinite));
+  }
   for (const m of masks) for (const p of m.points) for (const k of ["lo", "hi"]) if (p[k] != null) ys.push(p[k]);
   let y0 = Math.min(...ys), y1 = Math.max(...ys);
   const pad = 0.08 * (y1 - y0 || 1);
   y0 -= pad; y1 += pad;
   const X = f => L + (Math.min(Math.max(f, f0), f1) - f0) / (f1 - f0) * (W - L - R);
   const Y = y => T + (y1 - y) / (y1 - y0) * (H - T - B);
-  const keys = [["measured", "measured Re Z"]];
   if (win && (win.lo != null || win.hi != null)) {
     const lo = win.lo ?? f0, hi = win.hi ?? f1;
     svg.appendChild(el("rect", {class: "window", x: X(lo), width: X(hi) - X(lo), y: T, height: H - T - B,
                                 "data-lo": lo, "data-hi": hi}));
-    const range = win.lo == null ? "≤ " + num(win.hi, 6) : win.hi == null ? "≥ " + num(win.lo, 6)
-        : num(win.lo, 6) + "–" + num(win.hi, 6);
-    keys.push(["window", `resonance window ${range} Hz`]);
   }
+  const rows = H > 300 ? 6 : 4;
   for (let i = 0; i <= 6; i++) {
-    const f = f0 + i * (f1 - f0) / 6, y = y0 + i * (y1 - y0) / 6;
+    const f = f0 + i * (f1 - f0) / 6;
     svg.append(el("line", {class: "grid", x1: X(f), x2: X(f), y1: T, y2: H - B}),
-               el("line", {class: "grid", x1: L, x2: W - R, y1: Y(y), y2: Y(y)}),
-               el("text", {x: X(f) - 15, y: H - B + 18}, f.toFixed(0)),
+               el("text", {x: X(f) - 15, y: H - B + 18}, f.toFixed(0)));
+  }
+  for (let i = 0; i <= rows; i++) {
+    const y = y0 + i * (y1 - y0) / rows;
+    svg.append(el("line", {class: "grid", x1: L, x2: W - R, y1: Y(y), y2: Y(y)}),
                el("text", {x: 5, y: Y(y) + 4}, y.toFixed(2)));
   }
-  svg.append(el("text", {x: W / 2 - 30, y: H - 5}, "f (Hz)"));
+  svg.append(el("text", {x: W / 2 - 30, y: H - 5}, "f (Hz)"),
+             el("text", {class: "quantity", x: L + 8, y: T + 16}, q.label + " (Ω)"));
   let maskCount = 0;
   for (const m of masks) {
     for (const key of ["lo", "hi"]) {
@@ -242,31 +274,65 @@ function plotCurves(record) {
       if (pts.length < 2) continue;
       const edge = key === "hi" ? T : H - B;
       const poly = pts.map(p => p.join(",")).concat([`${pts[pts.length - 1][0]},${edge}`, `${pts[0][0]},${edge}`]);
-      svg.appendChild(el("polygon", {class: "mask", points: poly.join(" "), "data-mask": m.name}));
+      svg.appendChild(el("polygon", {class: "mask", points: poly.join(" "), "data-mask": m.name,
+                                     "data-bound": key}));
       ++maskCount;
     }
   }
-  if (maskCount)
-    keys.push(["mask", "limit mask: Re Z must stay out of the shaded area" + (sameRecipe ? "" : " (recipe in use)")]);
-  const absMasks = ((recipe && recipe.masks) || []).filter(m => m.quantity === "abs_ohm").length;
-  if (absMasks) keys.push(["note", `${absMasks} |Z| mask${absMasks > 1 ? "s" : ""} judged, not drawn here`]);
-  const line = (c, cls) => {
-    const d = c.freq_hz.map((f, i) => (i ? "L" : "M") + X(f).toFixed(1) + "," + Y(c.re[i]).toFixed(1)).join("");
-    svg.appendChild(el("path", {class: cls, d, "data-points": c.freq_hz.length}));
+  const line = (c, y, cls, k, name) => {
+    const d = c.freq_hz.map((f, i) => (i ? "L" : "M") + X(f).toFixed(1) + "," + Y(y[i]).toFixed(1)).join("");
+    svg.appendChild(el("path", {class: cls, d, "data-points": c.freq_hz.length, "data-pair": k,
+                                "data-pair-name": name}));
   };
-  line(meas, "measured");
-  if (resonance && isFinite(resonance.value)) {
-    svg.appendChild(el("line", {class: "f0", x1: X(resonance.value), x2: X(resonance.value), y1: T, y2: H - B}));
-    keys.push(["f0", `measured resonance ${num(resonance.value, 4, true)} Hz`]);
+  pairs.forEach((p, k) => line(p.measured, p[quantity].measured, "measured", k, p.name));
+  pairs.forEach((p, k) => {
+    if (p.f0 !== null)
+      svg.appendChild(el("line", {class: "f0", x1: X(p.f0), x2: X(p.f0), y1: T, y2: H - B, "data-pair": k}));
+  });
+  pairs.forEach((p, k) => { if (p.model) line(p.model, p[quantity].model, "model", k, p.name); });
+  return maskCount;
+}
+
+// Re Z, and |Z| below it when the recipe bounds |Z|: every phase pair's measured curve and
+// fitted model against every limit the verdict used (the resonance window from the record's own
+// limit, the recipe's masks on each quantity).
+function plotCurves(record) {
+  const pairs = measuredPairs(record);
+  if (!pairs.length) {
+    clearPlot("no curve: " + reasonText((record.reasons || [""])[0]));
+    return;
   }
-  if (model) {  // last: on top of the measured curve, never hidden under it
-    line(model, "model");
-    keys.splice(1, 0, ["model", "fitted model"]);
+  const masks = (recipe && recipe.masks) || [];
+  const reMasks = masks.filter(m => (m.quantity || "re_ohm") === "re_ohm");
+  const absMasks = masks.filter(m => m.quantity === "abs_ohm");
+  const sameRecipe = recipe && record.recipe && recipe.hash === record.recipe.hash;
+  const resonance = (record.measurements || []).find(m => m.name === "resonance_f_hz");
+  const win = resonance && resonance.limit;
+  const several = pairs.length > 1;
+  const pairText = p => (several ? " " + p.name : "");
+  const keys = pairs.map((p, k) => ["measured", "measured" + pairText(p), k]);
+  pairs.forEach((p, k) => { if (p.model) keys.push(["model", "fitted model" + pairText(p), k]); });
+  if (win && (win.lo != null || win.hi != null)) {
+    const range = win.lo == null ? "≤ " + num(win.hi, 6) : win.hi == null ? "≥ " + num(win.lo, 6)
+        : num(win.lo, 6) + "–" + num(win.hi, 6);
+    keys.push(["window", `resonance window ${range} Hz`]);
   }
+  const note = sameRecipe ? "" : " (recipe in use)";
+  if (drawPanel($("plot"), pairs, "re_ohm", reMasks, win))
+    keys.push(["mask", "limit mask: Re Z must stay out of the shaded area" + note]);
+  $("plot-abs").toggleAttribute("hidden", absMasks.length === 0);
+  if (!absMasks.length) $("plot-abs").replaceChildren();
+  else if (drawPanel($("plot-abs"), pairs, "abs_ohm", absMasks, win))
+    keys.push(["mask", "limit mask: |Z| must stay out of the shaded area" + note]);
+  pairs.forEach((p, k) => {
+    if (p.f0 !== null) keys.push(["f0", `measured resonance${pairText(p)} ${num(p.f0, 4, true)} Hz`, k]);
+  });
   renderLegend(keys);
-  $("curve-note").textContent = "— " + record.serial;
-  svg.setAttribute("data-serial", record.serial);
-  svg.setAttribute("aria-label", `Re Z of ${record.serial} over frequency: ` + keys.map(k => k[1]).join(", "));
+  $("curve-note").textContent = "— " + record.serial + (several ? ", phase pairs " + pairs.map(p => p.name).join(", ") : "");
+  for (const [id, q] of [["plot", "Re Z"], ["plot-abs", "|Z|"]]) {
+    $(id).setAttribute("data-serial", record.serial);
+    $(id).setAttribute("aria-label", `${q} of ${record.serial} over frequency: ` + keys.map(k => k[1]).join(", "));
+  }
 }
 
 async function showTest(id) {

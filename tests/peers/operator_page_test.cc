@@ -5,7 +5,6 @@
 // and be readable at two screen sizes, with axe-core in the page. Screenshots are kept in
 // build/artifacts/ for CI.
 #include <gtest/gtest.h>
-#include <httplib.h>
 
 #include <cmath>
 #include <ctime>
@@ -15,10 +14,17 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <set>
 #include <sstream>
+#include <thread>
 
 #include "../support/child_process.h"
+#include "../support/gap_units.h"
 #include "../support/station_ready.h"
+#include "drivers/io/frf_files.h"
+
+// After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
+#include <httplib.h>
 
 namespace eol {
 namespace {
@@ -33,6 +39,23 @@ using eol::testing::PortFromReadyLine;
 std::string NodeBinary() {
   for (const char* p : {"/usr/local/bin/node", "/usr/bin/node", "/usr/bin/nodejs"})
     if (std::filesystem::exists(p)) return p;
+  return "";
+}
+
+// node.js, once Debian's chromium, node and the npm modules the browser checks use are there;
+// otherwise "" and the test has failed saying which is missing.
+std::string BrowserCheckNode() {
+  const std::string node = NodeBinary();
+  if (!std::filesystem::exists("/usr/bin/chromium"))
+    ADD_FAILURE() << "Debian's chromium is a declared test dependency "
+                     "(deploy/install-deps.sh --tests)";
+  else if (node.empty())
+    ADD_FAILURE() << "node.js is a declared test dependency";
+  else if (!std::filesystem::exists(kBrowserDir + "/node_modules/axe-core/axe.min.js") ||
+           !std::filesystem::exists(kBrowserDir + "/node_modules/playwright-core"))
+    ADD_FAILURE() << "run `npm ci` in tests/peers/browser (deploy/run-tests.sh does)";
+  else
+    return node;
   return "";
 }
 
@@ -56,13 +79,39 @@ int ShippedRecipeLines() {
          1;
 }
 
+// `eol station --config DIR/station.json --web-root station/web` with `config`, started and
+// listening (its port in *port).
+std::unique_ptr<ChildProcess> StartPageStation(const eol::testing::TempDir& dir,
+                                               const nlohmann::json& config, int* port) {
+  std::ofstream(dir / "station.json") << config.dump();
+  auto station = std::make_unique<ChildProcess>(
+      std::vector<std::string>{EOL_BINARY, "station", "--config", dir / "station.json",
+                               "--web-root", std::string(EOL_SOURCE_DIR) + "/station/web"});
+  EXPECT_TRUE(station->WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; }, 30s))
+      << station->output();
+  *port = PortFromReadyLine(station->output());
+  return station;
+}
+
+// Starts a test of `serial` over the API and returns its stored summary once finished (null
+// when it was not started or not stored within 30 s).
+nlohmann::json RunStoredTest(httplib::Client& http, const std::string& serial) {
+  auto res = http.Post("/api/tests", nlohmann::json{{"serial", serial}}.dump(), "application/json");
+  if (!res || res->status != 202) return nullptr;
+  for (int i = 0; i < 600; ++i) {
+    res = http.Get("/api/units/" + serial);
+    if (res && res->status == 200) {
+      const auto tests = nlohmann::json::parse(res->body)["tests"];
+      if (!tests.empty() && !tests[0]["finished_at"].get<std::string>().empty()) return tests[0];
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  return nullptr;
+}
+
 TEST(OperatorPage, ShowsVerdictCurveAndFollowsTestsLive) {
-  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
-      << "Debian's chromium is a declared test dependency (deploy/install-deps.sh --tests)";
-  const std::string node = NodeBinary();
-  ASSERT_FALSE(node.empty()) << "node.js is a declared test dependency";
-  ASSERT_TRUE(std::filesystem::exists(kBrowserDir + "/node_modules/playwright-core"))
-      << "run `npm ci` in tests/peers/browser (deploy/run-tests.sh does)";
+  const std::string node = BrowserCheckNode();
+  ASSERT_FALSE(node.empty());
 
   eol::testing::TempDir dir;
   std::ofstream(dir / "station.json") << nlohmann::json{
@@ -118,6 +167,95 @@ TEST(OperatorPage, ShowsVerdictCurveAndFollowsTestsLive) {
   station.Stop(SIGTERM, 20s);
 }
 
+// Issue 17: a recipe that measures two phase pairs and bounds |Z| as well as Re Z. The page
+// draws what the record stored, every pair (not only the first), and the |Z| mask in its own
+// panel under the Re Z one; the legend names the pairs and both kinds of mask.
+TEST(OperatorPage, DrawsEveryPhasePairAndTheAbsZMasks) {
+  const std::string node = BrowserCheckNode();
+  ASSERT_FALSE(node.empty());
+
+  eol::testing::TempDir dir;
+  nlohmann::json recipe = ShippedRecipe();
+  recipe["excitation"].erase("phase_pair");
+  recipe["excitation"]["phase_pairs"] = {0, 1};
+  // |Z| of the shipped motor is about 2 pi f L = 6.3 ohm at 500 Hz and 10 ohm at 800 Hz.
+  recipe["masks"].push_back(
+      {{"name", "abs_z_band"},
+       {"quantity", "abs_ohm"},
+       {"max_lines_outside", 0},
+       {"points",
+        {{{"f_hz", 500}, {"lo", 4.0}, {"hi", 14.0}}, {{"f_hz", 800}, {"lo", 4.0}, {"hi", 14.0}}}}});
+  std::ofstream(dir / "pairs.json") << recipe.dump();
+  int port = 0;
+  const auto station = StartPageStation(dir,
+                                        {{"station_id", "page-pairs"},
+                                         {"recipe", dir / "pairs.json"},
+                                         {"db", dir / "s.sqlite"},
+                                         {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
+                                         {"fixture", {{"driver", "sim"}}},
+                                         {"daq", {{"driver", "sim"}}},
+                                         {"sim", {{"population", {{"defect_share", 0.0}}}}}},
+                                        &port);
+  ASSERT_GT(port, 0);
+  httplib::Client http("127.0.0.1", port);
+  const nlohmann::json stored = RunStoredTest(http, "PAIRS-0001");
+  ASSERT_FALSE(stored.is_null()) << "the test was not stored";
+  ASSERT_EQ(stored["outcome"], "PASS") << stored["reasons"];
+  const auto res = http.Get("/api/tests/" + std::to_string(stored["id"].get<long long>()));
+  ASSERT_TRUE(res && res->status == 200);
+  const nlohmann::json record = nlohmann::json::parse(res->body);
+  std::set<std::string> curves;
+  for (const auto& c : record["curves"]) curves.insert(c["name"]);
+  ASSERT_EQ(curves, (std::set<std::string>{"impedance", "model", "impedance@V-W", "model@V-W"}));
+
+  const std::string artifacts = std::filesystem::path(EOL_BINARY).parent_path() / "artifacts";
+  std::filesystem::create_directories(artifacts);
+  ChildProcess browser({node, kBrowserDir + "/check_curves.mjs",
+                        "http://127.0.0.1:" + std::to_string(port), artifacts, "PAIRS-0001"},
+                       /*merge_stderr=*/false);
+  const auto code = browser.Wait(120s);
+  ASSERT_TRUE(code.has_value()) << "browser did not finish";
+  ASSERT_EQ(*code, 0) << browser.output();
+  const auto j = nlohmann::json::parse(browser.output());
+  const int lines = ShippedRecipeLines();
+  const nlohmann::json both = {{{"pair", "U-V"}, {"points", lines}},
+                               {{"pair", "V-W"}, {"points", lines}}};
+  for (const char* panel : {"re", "abs"}) {
+    const nlohmann::json& p = j[panel];
+    EXPECT_FALSE(p["hidden"].get<bool>()) << panel;
+    EXPECT_EQ(p["serial"], "PAIRS-0001") << panel;
+    EXPECT_EQ(p["measured"], both) << panel << ": every pair's measured curve";
+    EXPECT_EQ(p["model"], both) << panel << ": every pair's fitted model";
+    EXPECT_EQ(p["last"], "model") << panel << ": the models on top";
+    EXPECT_EQ(p["f0_lines"], 2) << panel;
+    EXPECT_DOUBLE_EQ(p["window"]["lo"].get<double>(), 370.0) << panel;
+    EXPECT_DOUBLE_EQ(p["window"]["hi"].get<double>(), 420.0) << panel;
+  }
+  // Re Z: the shipped recipe's ceiling (hi only); |Z|: the band's two bounds.
+  EXPECT_EQ(j["re"]["masks"], (nlohmann::json{{{"mask", "re_z_low_band"}, {"bound", "hi"}}}));
+  EXPECT_EQ(j["abs"]["masks"], (nlohmann::json{{{"mask", "abs_z_band"}, {"bound", "lo"}},
+                                               {{"mask", "abs_z_band"}, {"bound", "hi"}}}));
+  EXPECT_NE(j["abs"]["label"].get<std::string>().find("|Z| of PAIRS-0001"), std::string::npos);
+  std::vector<std::string> legend;
+  for (const auto& k : j["legend"]) legend.push_back(k[1]);
+  for (const char* want : {"measured U-V", "measured V-W", "fitted model U-V", "fitted model V-W",
+                           "limit mask: Re Z must stay out of the shaded area",
+                           "limit mask: |Z| must stay out of the shaded area"})
+    EXPECT_NE(std::find(legend.begin(), legend.end(), want), legend.end())
+        << want << " not in the legend: " << j["legend"];
+  std::set<std::string> rows(j["measurements"].begin(), j["measurements"].end());
+  EXPECT_TRUE(rows.count("resonance_f_hz@V-W") && rows.count("mask_abs_z_band_lines_outside"))
+      << j["measurements"];
+  for (const char* size : {"1280x800", "1920x1080"}) {
+    EXPECT_TRUE(j["sizes"][size]["axe"].empty()) << size << ": " << j["sizes"][size]["axe"];
+    EXPECT_GT(j["sizes"][size]["abs_height_px"].get<double>(), 100.0) << size;
+  }
+  EXPECT_TRUE(j["page_errors"].empty()) << j["page_errors"];
+  for (const auto& shot : j["screenshots"])
+    EXPECT_GT(std::filesystem::file_size(shot.get<std::string>()), 10000u) << shot;
+  station->Stop(SIGTERM, 20s);
+}
+
 // The recipe's instructions (issue 17): the page shows the one for the outcome.
 nlohmann::json ShippedInstructions() {
   std::ifstream in(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json");
@@ -130,12 +268,8 @@ nlohmann::json ShippedInstructions() {
 // verdict used; the lockout and the simulation are banners; times are local with their zone;
 // axe-core finds nothing serious. Screenshots of each state at both sizes are kept.
 TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
-  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
-      << "Debian's chromium is a declared test dependency (deploy/install-deps.sh --tests)";
-  const std::string node = NodeBinary();
-  ASSERT_FALSE(node.empty()) << "node.js is a declared test dependency";
-  ASSERT_TRUE(std::filesystem::exists(kBrowserDir + "/node_modules/axe-core/axe.min.js"))
-      << "run `npm ci` in tests/peers/browser (deploy/run-tests.sh does)";
+  const std::string node = BrowserCheckNode();
+  ASSERT_FALSE(node.empty());
 
   eol::testing::TempDir dir;
   // Self-checks configured on a fresh database: the station starts locked out. The sim's
@@ -346,6 +480,142 @@ TEST(OperatorPage, AsksForTheOperatorsTokenWhenTheStationHasTokens) {
   ASSERT_EQ(tests.size(), 1u) << "the refused scan must not have started a test";
   EXPECT_EQ(j["verdict"], tests[0]["outcome"]);
   station.Stop(SIGTERM, 20s);
+}
+
+// Issue 17: the engineer page (GET /engineer, linked from the operator page) against a
+// station with stored tests: its capability table is the API's, its charts are the API's
+// SVGs with their series, the window and the measurement picker change what is drawn, the
+// detectability table lists every class, uploads give the POD and gap figures; axe-core finds
+// nothing serious at 1920x1080 and 1280x800. Screenshots are kept in build/artifacts/.
+TEST(EngineerPage, ShowsChartsCapabilityDetectabilityAndFiguresFromFiles) {
+  const std::string node = BrowserCheckNode();
+  ASSERT_FALSE(node.empty());
+  eol::testing::TempDir dir;
+  int port = 0;
+  const auto station =
+      StartPageStation(dir,
+                       {{"station_id", "page-engineer"},
+                        {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
+                        {"db", dir / "s.sqlite"},
+                        {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
+                        {"fixture", {{"driver", "sim"}}},
+                        {"daq", {{"driver", "sim"}}},
+                        {"sim",
+                         {{"clamp_close_s", 0.02},
+                          {"clamp_open_s", 0.02},
+                          {"population", {{"defect_share", 0.0}, {"seed", 3}}}}}},
+                       &port);
+  ASSERT_GT(port, 0);
+  httplib::Client http("127.0.0.1", port);
+  constexpr int kTests = 12;
+  for (int i = 0; i < kTests; ++i)
+    ASSERT_FALSE(RunStoredTest(http, "ENG-" + std::to_string(100 + i)).is_null()) << i;
+  // What the page must agree with: the API's own capability figures.
+  const auto stats = nlohmann::json::parse(http.Get("/api/stats")->body);
+  nlohmann::json f0;
+  for (const auto& m : stats["recipes"][0]["measurements"])
+    if (m["name"] == "resonance_f_hz") f0 = m;
+  ASSERT_FALSE(f0.is_null()) << stats;
+  const auto detect = nlohmann::json::parse(http.Get("/api/detectability")->body);
+
+  // Files to upload: a hits table and the gap inputs (a nominal simulation, a unit measured
+  // with a channel delay).
+  {
+    std::ofstream hits(dir / "hits.csv");
+    hits << "class,size,hit,f0_hz\n";
+    const double sizes[] = {0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45};
+    const int hit[] = {0, 0, 1, 0, 1, 1, 1, 1};
+    for (int i = 0; i < 8; ++i) hits << "one_magnet," << sizes[i] << "," << hit[i] << ",380\n";
+    for (int i = 0; i < 8; ++i) hits << "good,0,0," << 388 + i % 4 << "\n";
+  }
+  io::WriteFrfCsv(dir / "sim.csv", eol::testing::GapSimulation());
+  io::WriteFrfCsv(dir / "meas.csv",
+                  eol::testing::GapMeasured({{analysis::EffectKind::kChannelDelay, {6e-6}}}, 3));
+
+  const std::string artifacts = std::filesystem::path(EOL_BINARY).parent_path() / "artifacts";
+  std::filesystem::create_directories(artifacts);
+  ChildProcess browser(
+      {node, kBrowserDir + "/check_engineer.mjs", "http://127.0.0.1:" + std::to_string(port),
+       artifacts, "5", dir / "hits.csv", dir / "sim.csv", dir / "meas.csv"},
+      /*merge_stderr=*/false);
+  const auto code = browser.Wait(300s);
+  ASSERT_TRUE(code.has_value()) << "browser did not finish";
+  ASSERT_EQ(*code, 0) << browser.output();
+  const auto j = nlohmann::json::parse(browser.output());
+  EXPECT_EQ(j["link"], "/engineer");
+  EXPECT_EQ(j["url"], "http://127.0.0.1:" + std::to_string(port) + "/engineer");
+
+  // The default view: resonance over the last 100 tests (all 12), the API's figures.
+  const nlohmann::json& first = j["initial"];
+  ASSERT_EQ(first["capability"].size(), 1u) << first;
+  const nlohmann::json& row = first["capability"][0];
+  EXPECT_EQ(row["name"], "resonance_f_hz");
+  EXPECT_EQ(row["n"], f0["n"]);
+  for (const char* key : {"cp", "cpk", "pp", "ppk"}) {
+    ASSERT_TRUE(f0[key].is_number()) << key << " " << f0;
+    EXPECT_NEAR(std::stod(row[key].get<std::string>()), f0[key].get<double>(),
+                0.006 * std::abs(f0[key].get<double>()))
+        << key;
+  }
+  const std::string units = std::to_string(f0["n"].get<int>()) + " PASS units";
+  const std::map<std::string, std::vector<std::string>> want = {
+      {"chart-imr",
+       {"resonance_f_hz individuals / moving range (I-MR)", "individuals (I chart), " + units,
+        "UCL ", "LCL "}},
+      {"chart-xbar", {"resonance_f_hz: subgroup means (X-bar chart)", "subgroup ranges (R chart)"}},
+      {"chart-hist",
+       {"resonance_f_hz: histogram of " + units, "LSL 370 Hz", "USL 420 Hz", "Cpk ", "Ppk "}}};
+  for (const auto& [id, words] : want) {
+    const nlohmann::json& c = first["charts"][id];
+    ASSERT_TRUE(c.is_object()) << id << " not shown: " << first;
+    EXPECT_TRUE(c["rendered"].get<bool>()) << id;
+    EXPECT_EQ(c["root"], "svg") << id;
+    EXPECT_GT(c["paths"].get<int>(), 10) << id << ": no series drawn";
+    const std::string all = c["title"].get<std::string>() + "\n" + c["desc"].get<std::string>();
+    for (const std::string& w : words) EXPECT_NE(all.find(w), std::string::npos) << id << ": " << w;
+  }
+  // The window: the last 5 tests (all PASS) are 5 units, in the table and on the charts.
+  ASSERT_EQ(j["last"]["capability"].size(), 1u);
+  EXPECT_EQ(j["last"]["capability"][0]["n"], 5);
+  EXPECT_NE(j["last"]["charts"]["chart-imr"]["desc"].get<std::string>().find(
+                "individuals (I chart), 5 PASS units"),
+            std::string::npos)
+      << j["last"]["charts"]["chart-imr"];
+  EXPECT_NE(j["last"]["charts"]["chart-imr"]["url"].get<std::string>().find("from="),
+            std::string::npos);
+  // The picker: Q's charts.
+  EXPECT_EQ(j["q"]["capability"][0]["name"], "resonance_q");
+  for (const char* id : {"chart-imr", "chart-xbar", "chart-hist"})
+    EXPECT_NE(j["q"]["charts"][id]["title"].get<std::string>().find("resonance_q"),
+              std::string::npos)
+        << id << ": " << j["q"]["charts"][id]["title"];
+  // Detectability: every class the API reports.
+  ASSERT_EQ(j["detectability"].size(), detect["classes"].size());
+  for (std::size_t i = 0; i < detect["classes"].size(); ++i) {
+    EXPECT_EQ(j["detectability"][i]["defect"], detect["classes"][i]["defect"]);
+    EXPECT_EQ(j["detectability"][i]["detectable"],
+              detect["classes"][i]["separable"].get<bool>() ? "yes" : "no");
+  }
+  // Figures from the uploaded files.
+  EXPECT_EQ(j["pod_status"], "drawn");
+  EXPECT_TRUE(j["pod"]["rendered"].get<bool>());
+  EXPECT_EQ(j["pod"]["title"], "POD from hits.csv");
+  for (const char* w : {"one_magnet POD", "one_magnet hit/miss", "f0 limit 370.00 Hz", "good (8)"})
+    EXPECT_NE(j["pod"]["desc"].get<std::string>().find(w), std::string::npos) << w;
+  EXPECT_EQ(j["gap_status"], "drawn");
+  EXPECT_TRUE(j["gap"]["rendered"].get<bool>());
+  EXPECT_EQ(j["gap"]["title"].get<std::string>().rfind("eol gap: channel_delay", 0), 0u)
+      << j["gap"]["title"];
+  EXPECT_NE(j["gap"]["title"].get<std::string>().find("meas.csv"), std::string::npos);
+
+  EXPECT_TRUE(j["axe_1920"].empty()) << j["axe_1920"];
+  EXPECT_TRUE(j["axe_1280"].empty()) << j["axe_1280"];
+  EXPECT_TRUE(j["outside_requests"].empty()) << j["outside_requests"];
+  EXPECT_TRUE(j["page_errors"].empty()) << j["page_errors"];
+  EXPECT_EQ(j["screenshots"].size(), 3u);
+  for (const auto& shot : j["screenshots"])
+    EXPECT_GT(std::filesystem::file_size(shot.get<std::string>()), 10000u) << shot;
+  station->Stop(SIGTERM, 20s);
 }
 
 }  // namespace

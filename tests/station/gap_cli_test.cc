@@ -13,6 +13,7 @@
 #include "drivers/io/frf_files.h"
 #include "drivers/io/recording_files.h"
 #include "tests/support/child_process.h"
+#include "tests/support/gap_units.h"
 
 namespace eol {
 namespace {
@@ -40,35 +41,17 @@ nlohmann::json ReadJson(const std::string& path) {
   return nlohmann::json::parse(in);
 }
 
-analysis::NominalNetwork Nominal() {
-  analysis::NominalNetwork n;
-  n.motional = {0.5, 2e-3, 0.51, 390.0, 50.0};
-  return n;
-}
-
-// Nominal + effects measured through the simulator (4 periods, DAQ noise).
-analysis::Frf Measured(const std::vector<analysis::AppliedEffect>& effects, std::uint64_t seed) {
-  const analysis::NominalNetwork n = Nominal();
-  const analysis::Excitation ex = analysis::DesignMultisine(analysis::MultisineOptions{});
-  analysis::SimulatedMeasurementOptions o;
-  o.seed = seed;
-  return analysis::SimulateImpedanceMeasurement(
-             [&](double f) { return analysis::EvaluateNetwork(n, effects, f); }, ex, o)
-      .frf;
-}
+using testing::GapMeasured;
 
 class GapCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::vector<double> f;
-    for (double x = 200.0; x <= 800.0; x += 1.0) f.push_back(x);
-    io::WriteFrfCsv(dir_ / "sim.csv", Nominal().motional.Evaluate(f));
-  }
+  void SetUp() override { io::WriteFrfCsv(dir_ / "sim.csv", testing::GapSimulation()); }
   TempDir dir_;
 };
 
 TEST_F(GapCli, JsonHasTheStableNames) {
-  io::WriteFrfCsv(dir_ / "meas.csv", Measured({{analysis::EffectKind::kChannelDelay, {6e-6}}}, 3));
+  io::WriteFrfCsv(dir_ / "meas.csv",
+                  GapMeasured({{analysis::EffectKind::kChannelDelay, {6e-6}}}, 3));
   const EolRun r = Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "meas.csv",
                         "--json-out", dir_ / "out.json"});
   ASSERT_EQ(r.code, 0) << r.output;
@@ -95,7 +78,7 @@ TEST_F(GapCli, JsonHasTheStableNames) {
 }
 
 TEST_F(GapCli, MissingSigmaIsEstimatedAndSaid) {
-  analysis::Frf m = Measured({{analysis::EffectKind::kStrayCapacitance, {2e-7}}}, 5);
+  analysis::Frf m = GapMeasured({{analysis::EffectKind::kStrayCapacitance, {2e-7}}}, 5);
   m.sigma.clear();
   io::WriteZma(dir_ / "meas.zma", m);
   const EolRun r = Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "meas.zma",
@@ -117,7 +100,7 @@ TEST_F(GapCli, SeveralUnitsAndAPlot) {
                                    dir_ / "gap.svg"};
   for (int u = 0; u < 3; ++u) {
     const std::string path = dir_ / ("unit" + std::to_string(u) + ".csv");
-    io::WriteFrfCsv(path, Measured(truth, 10 + u));
+    io::WriteFrfCsv(path, GapMeasured(truth, 10 + u));
     args.push_back("--measured");
     args.push_back(path);
   }
@@ -137,7 +120,7 @@ TEST_F(GapCli, SeveralUnitsAndAPlot) {
 }
 
 TEST_F(GapCli, PureNoiseIsNoneAndJsonToStdout) {
-  io::WriteFrfCsv(dir_ / "meas.csv", Measured({}, 8));
+  io::WriteFrfCsv(dir_ / "meas.csv", GapMeasured({}, 8));
   const EolRun r =
       Eol({"gap", "--sim", dir_ / "sim.csv", "--measured", dir_ / "meas.csv", "--json"});
   ASSERT_EQ(r.code, 0) << r.output;
@@ -146,7 +129,7 @@ TEST_F(GapCli, PureNoiseIsNoneAndJsonToStdout) {
 }
 
 TEST_F(GapCli, RawRecordingPeriodAndLinesAreDetected) {
-  const analysis::NominalNetwork n = Nominal();
+  const analysis::NominalNetwork n = testing::GapNominal();
   const std::vector<analysis::AppliedEffect> truth = {
       {analysis::EffectKind::kSeriesResistance, {0.02}}};
   const analysis::Excitation ex = analysis::DesignMultisine(analysis::MultisineOptions{});

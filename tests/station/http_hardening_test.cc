@@ -2,10 +2,7 @@
 // streams do not hold request workers, slow requests are cut off at their deadline, a request
 // that waited too long for a worker is refused unread, and bodies are bounded however they are
 // framed. Real servers on 127.0.0.1, real sockets.
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -20,6 +17,7 @@
 #include "db/store.h"
 #include "station/http_api.h"
 #include "tests/support/child_process.h"
+#include "tests/support/raw_client.h"
 #include "tests/support/station_ready.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
@@ -31,51 +29,7 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-// A client socket on 127.0.0.1:port, closed at the end of the scope.
-class RawClient {
- public:
-  explicit RawClient(int port) : fd_(::socket(AF_INET, SOCK_STREAM, 0)) {
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(static_cast<uint16_t>(port));
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  }
-  ~RawClient() { ::close(fd_); }
-  RawClient(const RawClient&) = delete;
-  RawClient& operator=(const RawClient&) = delete;
-
-  bool connected() const { return connected_; }
-  bool Send(const std::string& s) {
-    return ::send(fd_, s.data(), s.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(s.size());
-  }
-  // What arrives until `until` is in it, the peer closes, or the timeout passes.
-  std::string ReadUntil(const std::string& until, std::chrono::milliseconds timeout) {
-    const auto end = Clock::now() + timeout;
-    while (got_.find(until) == std::string::npos && !closed_) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - Clock::now());
-      if (left.count() <= 0) break;
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
-      char buf[4096];
-      const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
-      if (n <= 0) {
-        closed_ = true;
-        break;
-      }
-      got_.append(buf, static_cast<size_t>(n));
-    }
-    return got_;
-  }
-  bool closed() const { return closed_; }
-  int fd() const { return fd_; }
-
- private:
-  int fd_;
-  bool connected_ = false;
-  bool closed_ = false;
-  std::string got_;
-};
+using eol::testing::RawClient;
 
 // An API on a free port with a real (empty) SQLite store; counts the tests it was asked to
 // start.

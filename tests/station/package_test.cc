@@ -32,7 +32,8 @@ TEST(DebianPackage, HoldsProgramUnitConfigRecipesAndPage) {
   ASSERT_EQ(contents.Wait(60s).value_or(-1), 0);
   for (const char* f : {"./usr/bin/eol", "./lib/systemd/system/eol-station.service",
                         "./etc/eol/station.json", "./usr/share/eol/recipes/pmsm-10pole.json",
-                        "./usr/share/eol/web/index.html", "./usr/share/eol/web/app.js"})
+                        "./usr/share/eol/web/index.html", "./usr/share/eol/web/app.js",
+                        "./usr/share/eol/web/engineer.html", "./usr/share/eol/web/engineer.js"})
     EXPECT_NE(contents.output().find(f), std::string::npos) << f << " missing:\n"
                                                             << contents.output();
 

@@ -106,6 +106,14 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
          j["excitation"]["phase_pairs"] = nlohmann::json::array();
        },
        "/excitation/phase_pairs: must be a list of 1 to 3 phase pairs"},
+      // Issue 12: the bond index needs its definition, and a sane one.
+      {[](auto& j) { j.erase("bond_index"); },
+       "/bond_index: is required when a limit is declared on bond_index_pct"},
+      {[](auto& j) { j["bond_index"]["f0_exponent"] = -1; },
+       "/bond_index/f0_exponent: must be in [0, 1000]"},
+      {[](auto& j) { j["bond_index"]["residue_ref_ohm_per_s"] = 0; },
+       "/bond_index/residue_ref_ohm_per_s: must be positive"},
+      {[](auto& j) { j["bond_index"]["f0_ref"] = 390; }, "/bond_index/f0_ref: unknown field"},
   };
   for (const Case& c : cases) {
     nlohmann::json j = Good();

@@ -5,20 +5,13 @@
 // PASS and FAIL, measures whether the verdict overflows its box, and runs axe-core in the page.
 // Usage: node check_operator.mjs BASE_URL ARTIFACT_DIR LOCKED GOOD_MASTER LIMIT_MASTER GOOD BAD
 // Prints one JSON object; exit code 1 with {"error": ...} when a step does not happen.
-import { createRequire } from "node:module";
-import { chromium } from "playwright-core";
+import { runCheck, seriousViolations } from "./common.mjs";
 
 const [base, artifacts, lockedSerial, goodMaster, limitMaster, goodSerial, badSerial] = process.argv.slice(2);
-const axePath = createRequire(import.meta.url).resolve("axe-core/axe.min.js");
 const SIZES = [[1280, 800], [1920, 1080]];
 const FINAL = ["PASS", "FAIL", "ERROR", "ABORTED"];
 const out = { states: {}, screenshots: [] };
 
-const browser = await chromium.launch({
-  executablePath: "/usr/bin/chromium",
-  args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-});
 
 // The verdict box at this size: does the word fit, and how large is it.
 function verdictBox() {
@@ -45,16 +38,6 @@ function everyWord() {
   return result;
 }
 
-// axe-core in the page: the serious and critical violations, by rule, with their targets.
-async function accessibility(page) {
-  if (!(await page.evaluate(() => typeof window.axe === "object")))
-    await page.addScriptTag({ path: axePath });
-  const r = await page.evaluate(() => window.axe.run(document, { resultTypes: ["violations"] }));
-  return r.violations.filter(v => v.impact === "serious" || v.impact === "critical")
-      .map(v => ({ id: v.id, impact: v.impact, help: v.help,
-                   targets: v.nodes.map(n => n.target.join(" ")).slice(0, 5) }));
-}
-
 // Screenshots at both sizes (kept as test artifacts), the verdict box at each, and axe at each.
 async function capture(page, name, { axe = true } = {}) {
   const state = { sizes: {} };
@@ -64,7 +47,7 @@ async function capture(page, name, { axe = true } = {}) {
     const path = `${artifacts}/operator-${name}-${w}x${h}.png`;
     await page.screenshot({ path });
     out.screenshots.push(path);
-    if (axe) size.axe = await accessibility(page);
+    if (axe) size.axe = await seriousViolations(page);
     state.sizes[`${w}x${h}`] = size;
   }
   state.instruction = (await page.isVisible("#instruction")) ? await page.textContent("#instruction") : "";
@@ -105,7 +88,7 @@ async function waitForStored(page, serial) {
                                   document.getElementById("tested").textContent !== "", null, { timeout: 20000 });
 }
 
-try {
+await runCheck(out, async browser => {
   const context = await browser.newContext({ viewport: { width: SIZES[0][0], height: SIZES[0][1] },
                                              locale: "en-GB", timezoneId: "Asia/Kolkata" });
   const page = await context.newPage();
@@ -182,10 +165,4 @@ try {
   }
   out.outside_requests = outside;
   out.page_errors = errors;
-  console.log(JSON.stringify(out));
-} catch (e) {
-  console.log(JSON.stringify({ error: String(e), partial: out }));
-  process.exitCode = 1;
-} finally {
-  await browser.close();
-}
+});

@@ -3,16 +3,11 @@
 // shown, then starts a second test over the API and checks the page follows it live (SSE).
 // Usage: node check_page.mjs BASE_URL SCREENSHOT.png SERIAL1 SERIAL2
 // Prints one JSON object; exit code 1 with {"error": ...} when the page does not show it.
-import { chromium } from "playwright-core";
+import { runCheck } from "./common.mjs";
 
 const [base, shot, serial1, serial2] = process.argv.slice(2);
 const out = {};
-const browser = await chromium.launch({
-  executablePath: "/usr/bin/chromium",
-  args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-});
-try {
+await runCheck(out, async browser => {
   const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
   const errors = [];
   page.on("pageerror", e => errors.push(String(e)));
@@ -45,10 +40,4 @@ try {
                  connection: await page.textContent("#connection") };
   await page.screenshot({ path: shot });
   out.page_errors = errors;
-  console.log(JSON.stringify(out));
-} catch (e) {
-  console.log(JSON.stringify({ error: String(e), partial: out }));
-  process.exitCode = 1;
-} finally {
-  await browser.close();
-}
+});

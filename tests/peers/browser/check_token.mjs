@@ -3,17 +3,12 @@
 // same scan starts the test and the page shows its verdict.
 // Usage: node check_token.mjs BASE_URL TOKEN SERIAL
 // Prints one JSON object; exit code 1 with {"error": ...} when a step does not happen.
-import { chromium } from "playwright-core";
+import { runCheck } from "./common.mjs";
 
 const [base, token, serial] = process.argv.slice(2);
 const out = {};
-const browser = await chromium.launch({
-  executablePath: "/usr/bin/chromium",
-  args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-});
 const focused = page => page.evaluate(() => document.activeElement && document.activeElement.id);
-try {
+await runCheck(out, async browser => {
   const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
   await page.goto(base + "/", { timeout: 20000 });
   await page.waitForFunction(() => document.getElementById("connection").textContent === "live", null,
@@ -35,10 +30,4 @@ try {
                              serial, { timeout: 30000 });
   out.verdict = await page.textContent("#verdict");
   out.started = await page.textContent("#start-status");
-  console.log(JSON.stringify(out));
-} catch (e) {
-  console.log(JSON.stringify({ error: String(e), partial: out }));
-  process.exitCode = 1;
-} finally {
-  await browser.close();
-}
+});

@@ -1,11 +1,11 @@
-#include "station/cli/gap_report.h"
+#include "station/gap_report.h"
 
 #include <cmath>
 #include <cstdio>
 #include <locale>
 #include <sstream>
 
-namespace eol::station::cli {
+namespace eol::station {
 namespace {
 
 using nlohmann::json;
@@ -293,4 +293,4 @@ std::string GapReportText(const GapReport& r) {
   return os.str();
 }
 
-}  // namespace eol::station::cli
+}  // namespace eol::station

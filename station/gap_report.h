@@ -54,7 +54,7 @@
 #include "analysis/gap/prediction.h"
 #include "drivers/io/gap_inputs.h"
 
-namespace eol::station::cli {
+namespace eol::station {
 
 struct GapPrediction {
   io::GapInput simulation;
@@ -69,6 +69,7 @@ struct GapReport {
   std::vector<io::GapInput> measured;
   int sigma_pool = 0;
   double sigma_dof = 0.0;
+  double inertia_kg_m2 = 0.0;  // J_r the calibration used (0: unknown)
   analysis::GapSummary gap;
   std::vector<analysis::FeatureSummary> features;  // per measured unit
   std::optional<GapPrediction> prediction;
@@ -80,4 +81,4 @@ const analysis::RankedEffect* Winner(const analysis::GapSummary& gap);
 nlohmann::json GapReportJson(const GapReport& report);
 std::string GapReportText(const GapReport& report);
 
-}  // namespace eol::station::cli
+}  // namespace eol::station
