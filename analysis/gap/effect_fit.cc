@@ -146,6 +146,15 @@ struct Layout {
   }
 };
 
+Layout MakeLayout(const std::vector<AppliedEffect>& effects, const NominalNetwork& nominal,
+                  double f_lo, double f_hi) {
+  Layout layout;
+  layout.shape = effects;
+  for (const AppliedEffect& e : effects)
+    layout.specs.push_back(DescribeEffect(e.kind, nominal, f_lo, f_hi));
+  return layout;
+}
+
 // The weighted real residual of nominal + effects(theta) on the lines (effect_fit.h).
 void Residual(const NominalNetwork& n, const Lines& lines, const Layout& layout,
               const Eigen::VectorXd& theta, Eigen::VectorXd* r) {
@@ -494,9 +503,7 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   out.effects = start;
   const Lines lines = Collect(nominal_, units_, {}, mask);
   out.residuals = static_cast<int>(2 * lines.f.size());
-  Layout layout;
-  layout.shape = start;
-  for (const AppliedEffect& e : start) layout.specs.push_back(Spec(e.kind));
+  const Layout layout = MakeLayout(start, nominal_, f_lo_, f_hi_);
   out.n_params = layout.size();
   if (out.n_params == 0 || lines.f.empty()) {
     out.chi2 = Chi2(start, mask);
@@ -607,9 +614,7 @@ EffectFit EffectFitter::FitWithNominal(const NominalNetwork& nominal,
   *refitted = nominal;
   const Lines lines = Collect(nominal_, units_, {}, mask);
   out.residuals = static_cast<int>(2 * lines.f.size());
-  Layout layout;
-  layout.shape = start;
-  for (const AppliedEffect& e : start) layout.specs.push_back(Spec(e.kind));
+  const Layout layout = MakeLayout(start, nominal_, f_lo_, f_hi_);
   const int own = NominalParams(nominal);
   out.n_params = own + layout.size();
   if (lines.f.empty()) {
