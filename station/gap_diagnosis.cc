@@ -95,6 +95,7 @@ void ReadGapInputs(const std::string& simulation, const std::vector<std::string>
                    const GapRunOptions& o, GapReport* r) {
   r->quantity = o.io.quantity;
   r->sigma_pool = o.sigma_pool;
+  r->sigma_dof = o.sigma_dof;
   r->measured.clear();
   for (const std::string& path : measured) {
     io::GapInput m = io::ReadGapMeasurement(path, o.io);
@@ -122,6 +123,7 @@ void DiagnoseGapReport(const GapRunOptions& o, GapReport* r) {
     u.freq_hz = m.frf.freq_hz;
     u.value = m.frf.value;
     u.sigma = m.sigma_estimated ? m.frf.sigma : analysis::PoolLineSigma(m.frf, o.sigma_pool);
+    u.sigma_dof = m.sigma_estimated ? 0.0 : o.sigma_dof;
     units.push_back(std::move(u));
   }
   analysis::GapOptions go;

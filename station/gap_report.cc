@@ -84,6 +84,7 @@ json GapReportJson(const GapReport& r) {
   j["residuals"] = g.residuals;
   j["noise_z_before"] = Num(g.noise_z_before);
   j["noise_z_after"] = Num(g.noise_z_after);
+  j["sigma_scale"] = Num(g.sigma_scale);
   j["heldout"] = {{"gap_before", Num(g.heldout.gap_before)},
                   {"gap_after", Num(g.heldout.gap_after)},
                   {"method", g.heldout.method}};
@@ -95,6 +96,8 @@ json GapReportJson(const GapReport& r) {
                        {"params", ParamsValue(e.params)},
                        {"params_sigma", ParamsSigma(e.params)},
                        {"score", Num(e.score)},
+                       {"bic", Num(e.bic)},
+                       {"cost", Num(e.cost)},
                        {"gap_after", Num(e.gap_after)},
                        {"plausible", e.plausible},
                        {"rejected", e.rejected}});
@@ -119,6 +122,37 @@ json GapReportJson(const GapReport& r) {
   }
   j["features"] = features;
   j["refit"] = refit;
+  const analysis::GapSplit& sp = g.split;
+  if (sp.available) {
+    auto motional = [](const analysis::NominalNetwork& n) {
+      if (n.quantity == analysis::Quantity::kMobility)
+        return json{{"gain_rad_per_s2_per_a", Num(n.rigid.gain_rad_per_s2_per_a)},
+                    {"damping_per_s", Num(n.rigid.damping_per_s)}};
+      const analysis::MotionalImpedance& m = n.motional;
+      return json{{"R_ohm", Num(m.r_ohm)},
+                  {"L_h", Num(m.l_h)},
+                  {"Rp_ohm", Num(m.rp_ohm)},
+                  {"f0_hz", Num(m.f0_hz)},
+                  {"Q", Num(m.q)}};
+    };
+    json eff = json::array();
+    for (const auto& e : sp.effect)
+      eff.push_back({{"effect", analysis::ToString(e.kind)}, {"params", e.params}});
+    j["split"] = {{"g_nominal", Num(sp.g_nominal)},
+                  {"g_refit", Num(sp.g_refit)},
+                  {"g_refit_effect", Num(sp.g_refit_effect)},
+                  {"share_calibration", Num(sp.share_calibration)},
+                  {"share_structure", Num(sp.share_structure)},
+                  {"share_left", Num(sp.share_left)},
+                  {"heldout_g_nominal", Num(sp.heldout_g_nominal)},
+                  {"heldout_g_refit_effect", Num(sp.heldout_g_refit_effect)},
+                  {"heldout_method", sp.heldout_method},
+                  {"refit", motional(sp.refit)},
+                  {"refit_effect", motional(sp.refit_effect)},
+                  {"effect", eff}};
+  } else {
+    j["split"] = {{"message", sp.message}};
+  }
   j["calibration"] = {{"simulation", r.simulation.source},
                       {"kind", r.simulation.kind},
                       {"note", r.simulation.note},
@@ -141,6 +175,7 @@ json GapReportJson(const GapReport& r) {
   }
   j["measurements"] = meas;
   j["sigma_pool_lines"] = r.sigma_pool;
+  j["sigma_dof"] = Num(r.sigma_dof);
   if (r.prediction) {
     const auto& p = r.prediction->prediction;
     json effects = json::array();
@@ -156,8 +191,10 @@ json GapReportJson(const GapReport& r) {
                        {"message", p.message}};
   }
   j["score_rule"] =
-      "BIC = chi2 + p ln(2K), chi2 = 2 sum |H_meas - H_model|^2 / sigma^2; an effect is named "
-      "when it scores at least 10 below none";
+      "cost = -2 ln L of the normalised residual (chi2, or the Student t's for sigma on few "
+      "degrees of freedom); an effect is there when its BIC = cost + p ln(2K) is at least 10 "
+      "below none's; which one: the lowest score = cost + Laplace Occam penalty";
+  j["residual_form"] = g.residual_form;
   j["message"] = g.message;
   return j;
 }
@@ -184,7 +221,11 @@ std::string GapReportText(const GapReport& r) {
   if (r.sigma_pool > 0)
     os << "             sigma pooled over +-" << r.sigma_pool << " lines (relative variance)\n";
   os << "\nGAP          g = " << Fmt("%.3f", g.gap_before) << " over " << g.residuals / 2
-     << " lines (1 = within the noise; chi2 test z = " << Fmt("%.1f", g.noise_z_before) << ")\n";
+     << " lines (1 = within the noise; noise test z = " << Fmt("%.1f", g.noise_z_before)
+     << ", sigma scale " << Fmt("%.3f", g.sigma_scale) << ")\n";
+  if (r.sigma_dof > 0.0)
+    os << "             sigma^2 with " << Fmt("%.0f", r.sigma_dof)
+       << " degrees of freedom per line (F test)\n";
   os << "WHERE        ";
   if (g.where.empty()) os << "no band of the residual is significant";
   os << "\n";
@@ -211,18 +252,35 @@ std::string GapReportText(const GapReport& r) {
   if (const analysis::RankedEffect* w = Winner(g)) {
     for (const auto& p : w->params) os << "               " << ParamText(p) << "\n";
   }
-  os << "  ranking (score = BIC; an effect needs 10 below none):\n";
+  os << "  ranking (score = evidence: cost + Occam; an effect needs its BIC 10 below none's; "
+     << g.residual_form << " residual):\n";
   int rank = 0;
   for (const auto& e : g.ranking) {
     os << "  " << Fmt("%3.0f", ++rank) << ". " << e.effect;
     for (std::size_t pad = e.effect.size(); pad < 36; ++pad) os << ' ';
-    os << Fmt("%12.1f", e.score) << "   g " << Fmt("%.3f", e.gap_after);
+    os << Fmt("%12.1f", e.score) << "  BIC " << Fmt("%9.1f", e.bic) << "   g "
+       << Fmt("%.3f", e.gap_after);
     if (!e.plausible) os << "   rejected: " << e.rejected;
     os << "\n";
   }
   os << "HOW FAR      g " << Fmt("%.3f", g.gap_before) << " -> " << Fmt("%.3f", g.gap_after)
      << " overall; held out (" << g.heldout.method << ") " << Fmt("%.3f", g.heldout.gap_before)
      << " -> " << Fmt("%.3f", g.heldout.gap_after) << "\n";
+  if (g.split.available) {
+    const analysis::GapSplit& sp = g.split;
+    auto pct = [](double v) { return std::isfinite(v) ? Fmt("%.1f %%", 100.0 * v) : "n/a"; };
+    os << "CALIBRATION AND STRUCTURE (share of the excess g^2 - E|r|^2)\n"
+       << "  nominal (simulation)                g " << Fmt("%.3f", sp.g_nominal) << "\n"
+       << "  refit of the nominal's parameters   g " << Fmt("%.3f", sp.g_refit) << "   closes "
+       << pct(sp.share_calibration) << " (calibration)\n"
+       << "  + " << (g.winner.empty() ? std::string("no effect") : g.effect)
+       << " fitted together   g " << Fmt("%.3f", sp.g_refit_effect) << "   closes "
+       << pct(sp.share_structure) << " (structure); left " << pct(sp.share_left) << "\n"
+       << "  held out (" << sp.heldout_method << "): " << Fmt("%.3f", sp.heldout_g_nominal)
+       << " -> " << Fmt("%.3f", sp.heldout_g_refit_effect) << " (calibration + structure)\n";
+  } else if (!g.split.message.empty()) {
+    os << "CALIBRATION AND STRUCTURE  " << g.split.message << "\n";
+  }
   if (!g.where_after.empty())
     os << "  still significant after it: " << g.where_after.size() << " band(s), the first "
        << Fmt("%.1f", g.where_after.front().band.f_lo_hz) << " - "

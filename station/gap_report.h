@@ -7,7 +7,8 @@
 //   effects             the winner's effect names (empty for none / unexplained)
 //   params              the winner's parameters {name: value} (fitted, then derived)
 //   gap_before, gap_after        g = sqrt(mean |H_meas - H_model|^2 / sigma^2) over all lines
-//   chi2_before, chi2_after, residuals (2K), noise_z_before, noise_z_after (chi2 test z)
+//   chi2_before, chi2_after, residuals (2K), noise_z_before, noise_z_after (noise test z,
+//   residual.h), sigma_scale (sqrt(mean |r|^2 / E|r|^2) of the nominal)
 //   heldout             {gap_before, gap_after, method}: "interleaved-2fold",
 //                       "leave-one-unit-out" or "none"
 //   where               [{f_lo_hz, f_hi_hz, significance, gap_before, gap_after}] bands of the
@@ -15,7 +16,10 @@
 //                       is the Gaussian-equivalent z of the band's chi2 (residual.h)
 //   where_after         the bands that remain after the winner
 //   ranking             [{effect, params {name: value}, params_sigma {name: sigma}, score
-//                       (BIC), gap_after, plausible, rejected}], best first, "none" included
+//                       (cost + Laplace Occam penalty: which effect), bic (cost + p ln(2K):
+//                       whether an effect), cost (-2 ln L), gap_after, plausible, rejected}],
+//                       best first, "none" included
+//   residual_form       "impedance", "admittance" or "mixed" (effect_fit.h)
 //   features            [{measurement, name, simulated, measured, gap, sigma, significance}]
 //                       names f0_hz, q, peak_height_ohm, r_ohm, l_h (impedance) or
 //                       gain_rad_per_s2_per_a, damping_per_s (mobility)
@@ -23,8 +27,14 @@
 //                       misfit_rel_rms, inertia_kg_m2}: the nominal fitted to the simulation
 //   refit               [{measurement, params {name: {value, sigma}}, gap_after_refit}]: the
 //                       nominal refitted to each measurement (not an unmodelled effect)
+//   split               calibration and structure apart (diagnosis.h GapSplit): {g_nominal,
+//                       g_refit, g_refit_effect, share_calibration, share_structure,
+//                       share_left, heldout_g_nominal, heldout_g_refit_effect, heldout_method,
+//                       refit {R_ohm, L_h, Rp_ohm, f0_hz, Q | gain_rad_per_s2_per_a,
+//                       damping_per_s}, refit_effect {...}, effect [{effect, params}]}
 //   measurements        [{source, kind, note, lines, sigma_estimated, gap_before, gap_after}]
 //   sigma_pool_lines    the --sigma-pool half-width used (0: the files' sigma as given)
+//   sigma_dof           degrees of freedom of each line's sigma^2 after pooling (0: exact)
 //   prediction          (with --predict-sim) {simulation, f0_simulated_hz, f0_predicted_hz,
 //                       sigma_f0_hz, q_predicted, effects [{effect, params}], message}
 //   score_rule, message
@@ -58,6 +68,7 @@ struct GapReport {
   analysis::CalibrationSummary calibration;
   std::vector<io::GapInput> measured;
   int sigma_pool = 0;
+  double sigma_dof = 0.0;
   double inertia_kg_m2 = 0.0;  // J_r the calibration used (0: unknown)
   analysis::GapSummary gap;
   std::vector<analysis::FeatureSummary> features;  // per measured unit

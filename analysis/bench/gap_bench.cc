@@ -12,6 +12,11 @@
 namespace eol::analysis {
 namespace {
 
+// The hidden classes drawn: the first eight EffectKinds, the library as it was when the
+// README's figures were measured (coupled_inertia is benched by the independent generator,
+// tests/peers/independent_gap_cases.py), so a seed keeps drawing the same cases.
+constexpr int kBenchEffectKinds = 8;
+
 using Cplx = std::complex<double>;
 using Rng = std::mt19937_64;
 
@@ -71,6 +76,8 @@ AppliedEffect DrawEffect(EffectKind kind, const NominalNetwork& n, const std::ve
     }
     case EffectKind::kStrayCapacitance:
     case EffectKind::kSkinEffect:
+    case EffectKind::kCoupledInertia:  // not drawn: see kBenchEffectKinds
+    case EffectKind::kFractionalInductance:
     case EffectKind::kAdhesiveCreep:
       make = [](double x) { return std::vector<double>{x}; };
       log = kind == EffectKind::kStrayCapacitance;
@@ -158,7 +165,7 @@ GapBenchCase RunCase(const GapBenchOptions& o, const Excitation& ex, int index,
   const std::vector<double> sigma0 =
       ExpectedLineSigma([&](double x) { return truth_nominal.At(x); }, ex, mo);
 
-  const int cls = std::uniform_int_distribution<int>(0, kEffectKindCount)(rng);
+  const int cls = std::uniform_int_distribution<int>(0, kBenchEffectKinds)(rng);
   std::vector<AppliedEffect> hidden;
   c.truth = "none";
   if (cls > 0) {
@@ -208,14 +215,20 @@ GapBenchCase RunCase(const GapBenchOptions& o, const Excitation& ex, int index,
   c.heldout_after = s.heldout.gap_after;
 
   // Oracle.
-  const EffectFitter fitter(cal.nominal, {u});
+  // The oracle scores as the diagnosis does (diagnosis.h: the evidence, on the residual form
+  // the diagnosis chose for this unit).
+  GapUnit formed = u;
+  formed.admittance =
+      cal.nominal.quantity == Quantity::kImpedanceOhm &&
+      o.gap.residual_form != ResidualForm::kImpedance &&
+      (o.gap.residual_form == ResidualForm::kAdmittance || CurrentNoiseDominates(formed));
+  const EffectFitter fitter(cal.nominal, {formed});
   if (hidden.empty()) {
     c.oracle_separable = true;
   } else {
     const EffectFit truth_fit = fitter.Fit(hidden, {}, o.gap.max_iterations);
-    const double penalty = std::log(static_cast<double>(truth_fit.residuals));
-    double truth_score = truth_fit.chi2 + truth_fit.n_params * penalty;
-    double best_other = s.chi2_before;  // "none"
+    double truth_score = truth_fit.cost + truth_fit.occam;
+    double best_other = fitter.Cost({}, {});  // "none"
     for (const RankedEffect& r : s.ranking) {
       if (r.effects.size() != 1) continue;
       if (r.effect == c.truth)

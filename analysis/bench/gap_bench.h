@@ -23,7 +23,8 @@
 // Scores:
 //   top-1        diagnosed name == truth (a pair or "unexplained" is wrong);
 //   oracle       a case is separable when an oracle that knows the true family and starts
-//                its fit at the true parameters finds it scores (BIC) at least oracle_margin
+//                its fit at the true parameters finds it scores (the diagnosis' score: cost
+//                + Occam penalty, effect_fit.h; "none": its cost) at least oracle_margin
 //                below every other plausible single effect the diagnosis fitted and below
 //                "none". Every "none" case counts as separable (the diagnosis must never
 //                invent an effect from noise), so top-1 on separable cases is strict there;

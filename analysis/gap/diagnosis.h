@@ -4,21 +4,32 @@
 // Input: the nominal network calibrated to the simulation (calibration.h) and one or more
 // measured units (several units or rotor positions of one design), each line with sigma.
 // Metric: g = sqrt(mean |H_meas - H_model|^2 / sigma^2) over all lines of all units
-// (residual.h); chi2 = 2 K g^2 over 2K real residuals.
+// (residual.h); chi2 = 2 K g^2 over 2K real residuals. The noise test and the bands take
+// each unit's sigma_dof into account (residual.h: F-distributed lines when sigma is
+// estimated).
 //
 // Which (the nominal's parameters stay at the simulation's values):
 //   1. every effect of the library (effects.h) is fitted on top of the nominal, its
 //      parameters shared by all units (one fixture, one cable);
-//   2. score = BIC = chi2 + p ln(2K) (p fitted parameters; "none" scores chi2 of the
-//      nominal); a fit outside its plausibility bounds, or not converged, is rejected;
-//   3. the best plausible single effect is named when it lowers the score by at least
-//      min_score_gain below "none" (10: very strong evidence on the BIC scale). Otherwise the
-//      answer is "none" when the nominal's residual is consistent with the noise (chi2 test
-//      z <= noise_z_max and no significant band) and "unexplained" when it is not;
+//   2. cost = -2 ln L of the residual (effect_fit.h: chi2 for exact sigma, the Student t's
+//      for sigma on few degrees of freedom; "none" is the nominal's cost); whether an effect
+//      is there is judged by BIC = cost + p ln(2K) (p fitted parameters), which effect by the
+//      Laplace evidence score = cost + occam (effect_fit.h). A fit outside its plausibility
+//      bounds, or not converged, is rejected. The residual's form (impedance or admittance,
+//      effect_fit.h) is chosen per unit from its noise (options.residual_form);
+//   3. among the plausible singles whose BIC is at least min_score_gain below "none" (10:
+//      very strong evidence on the BIC scale), the best score is named. Otherwise the
+//      answer is "none" when the nominal's residual is consistent with the noise (no
+//      significant band, and noise test z <= noise_z_max or sigma_scale <= max_sigma_scale)
+//      and "unexplained" when it is not;
 //   4. when the winner still leaves a residual inconsistent with the noise, pairs are fitted
 //      (the pair_candidates best singles among themselves, and the winner with every other
-//      effect); a plausible pair wins when it lowers the score by min_score_gain more. Its
-//      name joins the two with "+" in EffectKind order ("second_mode+channel_delay").
+//      effect); a plausible pair with a better score wins when each member is significant on
+//      its own: the pair's BIC is min_score_gain below each member's single fit, and on
+//      held-out lines (below)
+//      its predictive cost is min_score_gain below the winner's (so a delay or a series
+//      resistance cannot ride along on a mis-modelled effect). Its name joins the two with "+"
+//      in EffectKind order ("second_mode+channel_delay").
 // Held out: one unit -> two-fold interleaved lines (fit the winner on the even lines, predict
 // the odd ones, and the reverse; every line is predicted by a fit that did not see it);
 // several units -> leave-one-unit-out. gap_before there is the nominal's g on the same lines.
@@ -35,16 +46,25 @@
 
 namespace eol::analysis {
 
+enum class ResidualForm { kAuto, kImpedance, kAdmittance };
+
 struct GapOptions {
   BandSearchOptions bands;
+  // kAuto: admittance for a unit whose noise is the current's (CurrentNoiseDominates,
+  // effect_fit.h), else impedance. Mobility is always fitted as measured.
+  ResidualForm residual_form = ResidualForm::kAuto;
   double min_score_gain = 10.0;  // BIC units
   // chi2 test of "consistent with the noise": z at most this. High (near the band threshold)
   // because sigma is itself estimated: from 4 periods pooled over 11 lines (periodic_frf.h)
   // it carries 66 degrees of freedom, which alone lifts g^2 by ~3 % (z ~ 0.8 over 601 lines)
   // and spreads it (z about +-1).
   double noise_z_max = 5.0;
+  // A residual with no significant band that is uniformly at most this factor above sigma is
+  // "none" (the sigma scale is reported) even when the noise test rejects: a sigma mis-scaled
+  // by a few percent (a calibration, a dof not given) is not a model gap.
+  double max_sigma_scale = 1.1;
   bool try_pairs = true;
-  int pair_candidates = 4;
+  int pair_candidates = 6;
   int max_iterations = 200;
   bool heldout = true;
   std::vector<EffectKind> effects;  // the library to try; empty: EffectsFor(quantity)
@@ -64,7 +84,9 @@ struct RankedEffect {
   std::vector<AppliedEffect> effects;
   std::vector<NamedValue> params;  // fitted, then derived (effects.h)
   double chi2 = 0.0;
-  double score = 0.0;  // BIC
+  double cost = 0.0;   // -2 ln L (effect_fit.h)
+  double bic = 0.0;    // cost + p ln(2K): whether there is an effect
+  double score = 0.0;  // cost + occam (effect_fit.h, Laplace evidence): which effect
   double gap_after = 0.0;
   bool plausible = true;
   bool converged = true;
@@ -80,7 +102,29 @@ struct BandGap {
 struct HeldOutGap {
   double gap_before = 0.0;
   double gap_after = 0.0;
-  std::string method;  // "interleaved-2fold", "leave-one-unit-out", "none"
+  std::string method;                          // "interleaved-2fold", "leave-one-unit-out", "none"
+  double cost_before = 0.0, cost_after = 0.0;  // predictive -2 ln L on the held-out lines
+};
+
+// Calibration and structure apart: the excess X(g) = g^2 - E|r|^2 over the
+// noise, split in the order a person would fix it:
+//   calibration  the nominal's own parameters (R, L, Rp, f0, Q; mobility g, a) refitted:
+//                share_calibration = (X(g_nominal) - X(g_refit)) / X(g_nominal)
+//   structure    the winner's effect on top, fitted together with the nominal's parameters:
+//                share_structure = (X(g_refit) - X(g_refit_effect)) / X(g_nominal)
+//   left         share_left = X(g_refit_effect) / X(g_nominal)
+// (shares NaN when the nominal's g is within the noise). heldout_g_refit_effect: the two
+// together on held-out lines (as HeldOutGap), against heldout_g_nominal on the same lines.
+struct GapSplit {
+  bool available = false;
+  std::string message;  // why not, when not
+  double g_nominal = 0.0, g_refit = 0.0, g_refit_effect = 0.0;
+  double share_calibration = 0.0, share_structure = 0.0, share_left = 0.0;
+  double heldout_g_nominal = 0.0, heldout_g_refit_effect = 0.0;
+  std::string heldout_method;
+  NominalNetwork refit;         // the nominal alone, refitted
+  NominalNetwork refit_effect;  // refitted together with the effect
+  std::vector<AppliedEffect> effect;
 };
 
 struct UnitGap {
@@ -98,12 +142,16 @@ struct GapSummary {
   double gap_before = 0.0, gap_after = 0.0;
   double chi2_before = 0.0, chi2_after = 0.0;
   int residuals = 0;                                 // 2K
-  double noise_z_before = 0.0, noise_z_after = 0.0;  // chi2 test z (residual.h)
+  double noise_z_before = 0.0, noise_z_after = 0.0;  // noise test z (residual.h), with
+                                                     // each unit's sigma_dof
+  double sigma_scale = 1.0;                 // sqrt(mean |r|^2 / E|r|^2) of the nominal (residual.h)
+  std::string residual_form = "impedance";  // "impedance", "admittance" or "mixed" (units)
   HeldOutGap heldout;
   std::vector<BandGap> where;
   std::vector<BandGap> where_after;
   std::vector<RankedEffect> ranking;  // best score first; rejected fits last
   std::vector<UnitGap> units;
+  GapSplit split;
 };
 
 // Never throws for bad data; usable == false with the reason (bad units, no lines, invalid

@@ -16,6 +16,7 @@ namespace {
 using Cplx = std::complex<double>;
 
 constexpr double kLmTol = 1e-10;
+constexpr double kSettledCost = 0.5;  // -2 ln L units, against min_score_gain 10
 
 double TwoPi() { return 2.0 * std::numbers::pi; }
 
@@ -23,8 +24,10 @@ double TwoPi() { return 2.0 * std::numbers::pi; }
 struct Lines {
   std::vector<double> f;
   std::vector<Cplx> meas, base;
-  std::vector<double> weight;  // 2 / sigma^2
-  double chi2 = 0.0;           // of the base
+  std::vector<double> weight;        // 2 / sigma^2
+  std::vector<const GapUnit*> unit;  // for the residual in the unit's form
+  std::vector<std::size_t> index;
+  double chi2 = 0.0;  // of the base
 };
 
 Lines Collect(const NominalNetwork& n, const std::vector<GapUnit>& units,
@@ -38,6 +41,8 @@ Lines Collect(const NominalNetwork& n, const std::vector<GapUnit>& units,
       l.meas.push_back(unit.value[k]);
       l.base.push_back(EvaluateNetwork(n, base, unit.freq_hz[k]));
       l.weight.push_back(2.0 / (unit.sigma[k] * unit.sigma[k]));
+      l.unit.push_back(&unit);
+      l.index.push_back(k);
       l.chi2 += l.weight.back() * std::norm(l.meas.back() - l.base.back());
     }
   }
@@ -79,6 +84,17 @@ std::vector<std::vector<double>> Best(std::vector<Candidate> c, std::size_t n) {
   return out;
 }
 
+// A bounded parameter's place in its bounds, 0 at lo and 1 at hi (in ln(value) when
+// log-scaled), and back.
+double BoundedShare(const EffectParamSpec& ps, double v) {
+  if (ps.log_scale) return std::log(std::max(v, ps.lo) / ps.lo) / std::log(ps.hi / ps.lo);
+  return (v - ps.lo) / (ps.hi - ps.lo);
+}
+double FromShare(const EffectParamSpec& ps, double u) {
+  if (ps.log_scale) return ps.lo * std::exp(u * std::log(ps.hi / ps.lo));
+  return ps.lo + u * (ps.hi - ps.lo);
+}
+
 // theta <-> natural parameters of a list of effects.
 struct Layout {
   std::vector<EffectSpec> specs;
@@ -96,7 +112,12 @@ struct Layout {
       for (std::size_t p = 0; p < effects[e].params.size(); ++p, ++i) {
         const EffectParamSpec& ps = specs[e].params[p];
         const double v = effects[e].params[p];
-        t(i) = ps.log_scale ? std::log(std::max(v, 1e-9 * ps.scale)) : v / ps.scale;
+        if (ps.bounded) {
+          const double u = std::clamp(BoundedShare(ps, v), 1e-6, 1.0 - 1e-6);
+          t(i) = std::log(u / (1.0 - u));
+        } else {
+          t(i) = ps.log_scale ? std::log(std::max(v, 1e-9 * ps.scale)) : v / ps.scale;
+        }
       }
     return t;
   }
@@ -106,16 +127,33 @@ struct Layout {
     for (std::size_t e = 0; e < out.size(); ++e)
       for (std::size_t p = 0; p < out[e].params.size(); ++p, ++i) {
         const EffectParamSpec& ps = specs[e].params[p];
-        out[e].params[p] = ps.log_scale ? std::exp(t(i)) : t(i) * ps.scale;
+        if (ps.bounded)
+          out[e].params[p] = FromShare(ps, 1.0 / (1.0 + std::exp(-t(i))));
+        else
+          out[e].params[p] = ps.log_scale ? std::exp(t(i)) : t(i) * ps.scale;
       }
     return out;
   }
   // d natural / d theta at the point.
   double Slope(const std::vector<AppliedEffect>& at, std::size_t e, std::size_t p) const {
     const EffectParamSpec& ps = specs[e].params[p];
+    if (ps.bounded) {
+      const double u = BoundedShare(ps, at[e].params[p]);
+      const double dv_du = ps.log_scale ? at[e].params[p] * std::log(ps.hi / ps.lo) : ps.hi - ps.lo;
+      return dv_du * u * (1.0 - u);
+    }
     return ps.log_scale ? at[e].params[p] : ps.scale;
   }
 };
+
+Layout MakeLayout(const std::vector<AppliedEffect>& effects, const NominalNetwork& nominal,
+                  double f_lo, double f_hi) {
+  Layout layout;
+  layout.shape = effects;
+  for (const AppliedEffect& e : effects)
+    layout.specs.push_back(DescribeEffect(e.kind, nominal, f_lo, f_hi));
+  return layout;
+}
 
 // The weighted real residual of nominal + effects(theta) on the lines (effect_fit.h).
 void Residual(const NominalNetwork& n, const Lines& lines, const Layout& layout,
@@ -123,29 +161,99 @@ void Residual(const NominalNetwork& n, const Lines& lines, const Layout& layout,
   r->resize(static_cast<long>(2 * lines.f.size()));
   const std::vector<AppliedEffect> e = layout.FromTheta(theta);
   for (std::size_t k = 0; k < lines.f.size(); ++k) {
-    const Cplx d = (EvaluateNetwork(n, e, lines.f[k]) - lines.meas[k]) * std::sqrt(lines.weight[k]);
-    (*r)(static_cast<long>(2 * k)) = d.real();
-    (*r)(static_cast<long>(2 * k + 1)) = d.imag();
+    const GapUnit& u = *lines.unit[k];
+    const Cplx res = LineResidual(u, lines.index[k], EvaluateNetwork(n, e, lines.f[k]));
+    const double r2 = std::norm(res);
+    // Scaled so that the squared norm is the line's cost rho(|r|^2).
+    const double gain = r2 > 1e-300 ? std::sqrt(LineCost(r2, u.sigma_dof) / r2)
+                                    : std::sqrt(LineCost(1.0, u.sigma_dof) / 1.0);
+    (*r)(static_cast<long>(2 * k)) = gain * res.real();
+    (*r)(static_cast<long>(2 * k + 1)) = gain * res.imag();
   }
 }
 
-// Central differences in theta (every theta is O(1): a logarithm or value / scale).
-void Jacobian(const NominalNetwork& n, const Lines& lines, const Layout& layout,
-              const Eigen::VectorXd& theta, Eigen::MatrixXd* jac) {
-  jac->resize(static_cast<long>(2 * lines.f.size()), theta.size());
+// Finite differences in theta (every theta is O(1): a logarithm or value / scale). Forward
+// (p + 1 residuals) for Levenberg-Marquardt's steps, whose optimum does not depend on them;
+// central (2 p) for the information at the optimum, which the covariance and the evidence use.
+void DifferenceJacobian(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>& res,
+                        const Eigen::VectorXd& theta, bool central, Eigen::MatrixXd* jac) {
   Eigen::VectorXd up, down;
+  if (!central) res(theta, &down);
   for (long i = 0; i < theta.size(); ++i) {
-    const double h = 1e-6 * std::max(1.0, std::abs(theta(i)));
+    const double h = (central ? 1e-6 : 1e-7) * std::max(1.0, std::abs(theta(i)));
     Eigen::VectorXd t = theta;
     t(i) = theta(i) + h;
-    Residual(n, lines, layout, t, &up);
-    t(i) = theta(i) - h;
-    Residual(n, lines, layout, t, &down);
-    jac->col(i) = (up - down) / (2.0 * h);
+    res(t, &up);
+    if (i == 0) jac->resize(up.size(), theta.size());
+    if (central) {
+      t(i) = theta(i) - h;
+      res(t, &down);
+      jac->col(i) = (up - down) / (2.0 * h);
+    } else {
+      jac->col(i) = (up - down) / h;
+    }
   }
+}
+
+// The prior width of each theta: uniform in ln(value) over [lo, hi] for a log-scaled
+// parameter (lo = 0 taken as 1e-6 hi), uniform in value otherwise (in theta units at the point
+// for a bounded one).
+double PriorWidth(const Layout& layout, const std::vector<AppliedEffect>& at, std::size_t e,
+                  std::size_t p) {
+  const EffectParamSpec& ps = layout.specs[e].params[p];
+  const double slope = std::max(layout.Slope(at, e, p), 1e-300);
+  if (ps.bounded && ps.log_scale)
+    return std::log(ps.hi / ps.lo) * std::max(at[e].params[p], 1e-300) / slope;
+  if (ps.bounded) return (ps.hi - ps.lo) / slope;
+  if (ps.log_scale) return std::log(ps.hi / std::max(ps.lo, 1e-6 * ps.hi));
+  return (ps.hi - ps.lo) / ps.scale;
+}
+
+// sum_i max(0, ln(lambda_i / 2 pi)) over the eigenvalues of W A W (effect_fit.h).
+double OccamPenalty(const Layout& layout, const std::vector<AppliedEffect>& at,
+                    const Eigen::MatrixXd& information) {
+  const long n = information.rows();
+  Eigen::VectorXd w(n);
+  long i = 0;
+  for (std::size_t e = 0; e < at.size(); ++e)
+    for (std::size_t p = 0; p < at[e].params.size(); ++p, ++i) w(i) = PriorWidth(layout, at, e, p);
+  const Eigen::MatrixXd scaled = w.asDiagonal() * information * w.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled, Eigen::EigenvaluesOnly);
+  double penalty = 0.0;
+  for (long k = 0; k < n; ++k)
+    penalty += std::max(0.0, std::log(eig.eigenvalues()(k) / (2.0 * std::numbers::pi)));
+  return std::isfinite(penalty) ? penalty : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace
+
+std::complex<double> LineResidual(const GapUnit& u, std::size_t k, std::complex<double> h) {
+  if (u.admittance)
+    return (Reciprocal(u.value[k]) - Reciprocal(h)) * (std::norm(u.value[k]) / u.sigma[k]);
+  return (u.value[k] - h) / u.sigma[k];
+}
+
+double LineCost(double r2, double sigma_dof) {
+  if (!(sigma_dof > 0.0) || !std::isfinite(sigma_dof)) return 2.0 * r2;
+  return (sigma_dof + 2.0) * std::log1p(2.0 * r2 / sigma_dof);
+}
+
+bool CurrentNoiseDominates(const GapUnit& u) {
+  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  const double n = static_cast<double>(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    const double x = std::log(std::abs(u.value[k]));
+    const double y = std::log(u.sigma[k]) - x;
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+  }
+  const double var = sxx - sx * sx / n;
+  // |H| flat over the band: no lever to tell the channels apart; keep the impedance form.
+  if (!(var > 1e-6 * n)) return false;
+  return (sxy - sx * sy / n) / var >= 0.5;
+}
 
 bool Selected(const LineMask& mask, std::size_t unit, std::size_t line) {
   return mask.empty() || (unit < mask.size() && line < mask[unit].size() && mask[unit][line]);
@@ -171,13 +279,26 @@ double EffectFitter::Chi2(std::span<const AppliedEffect> effects, const LineMask
     const GapUnit& unit = units_[u];
     for (std::size_t k = 0; k < unit.size(); ++k) {
       if (!Selected(mask, u, k)) continue;
-      const Cplx d = unit.value[k] - EvaluateNetwork(nominal_, effects, unit.freq_hz[k]);
-      chi2 += 2.0 * std::norm(d) / (unit.sigma[k] * unit.sigma[k]);
+      chi2 += 2.0 *
+              std::norm(LineResidual(unit, k, EvaluateNetwork(nominal_, effects, unit.freq_hz[k])));
       n += 2;
     }
   }
   if (residuals) *residuals = n;
   return chi2;
+}
+
+double EffectFitter::Cost(std::span<const AppliedEffect> effects, const LineMask& mask) const {
+  double cost = 0.0;
+  for (std::size_t u = 0; u < units_.size(); ++u) {
+    const GapUnit& unit = units_[u];
+    for (std::size_t k = 0; k < unit.size(); ++k) {
+      if (!Selected(mask, u, k)) continue;
+      const Cplx r = LineResidual(unit, k, EvaluateNetwork(nominal_, effects, unit.freq_hz[k]));
+      cost += LineCost(std::norm(r), unit.sigma_dof);
+    }
+  }
+  return cost;
 }
 
 std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
@@ -235,9 +356,99 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       for (double kappa : LogSpace(0.02, 30.0, 24)) kappas.push_back(kappa);
       for (double kappa : kappas) {
         trial.back().params = {kappa, FixtureLossKeepingQ(kappa, m.q)};
-        c.push_back({-Chi2(trial, mask), trial.back().params});
+        c.push_back({-Cost(trial, mask), trial.back().params});
       }
       return Best(c, 2);
+    }
+    case EffectKind::kFractionalInductance: {
+      // The share is linear for a given order and match frequency:
+      // B = L (w_m^(1-n) (j w)^n - s).
+      std::vector<Candidate> c;
+      for (double order : {0.4, 0.5, 0.6, 0.7, 0.8, 0.9})
+        for (double fm : LogSpace(0.2 * f_lo_, 5.0 * f_hi_, 8)) {
+          const double share = Amplitude(
+              l,
+              Shape(l, [&](double f,
+                           Cplx) { return m.l_h * (FractionalShape(order, f, fm) - s_of(f)); }),
+              &red);
+          if (share > 0.0) c.push_back({red, {std::min(share, 0.9), order, fm}});
+        }
+      if (c.empty()) c.push_back({0.0, {0.05, 0.7, std::sqrt(f_lo_ * f_hi_)}});
+      return Best(c, 3);
+    }
+    case EffectKind::kCoupledInertia: {
+      // The second inertia's own frequency on a log grid over and beyond the band (above f0
+      // it is the coupled mode's anti-resonance; far above, J2 acts as added inertia), times
+      // a few mass ratios and losses; every trial is the full network, so the first mode's
+      // shift, its Q and height and the coupled mode are all scored together.
+      // The node: at the rotor, or on the support between the rotor spring and the fixture
+      // (the shaft end); at a node the same J2 loads the first mode less, so the mass ratios
+      // reach higher there.
+      std::vector<Candidate> c;
+      std::vector<AppliedEffect> trial(base.begin(), base.end());
+      trial.push_back({kind, {0.1, 1.0, 30.0, 0.0}});
+      for (double x : {0.0, 0.3, 0.55, 0.8})
+        for (double f2 : LogSpace(0.6 * f_lo_, 15.0 * f_hi_, 44))
+          for (double mu : {0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0})
+            for (double q2 : {10.0, 40.0, 150.0}) {
+              trial.back().params = {mu, f2, q2, x};
+              c.push_back({-Cost(trial, mask), trial.back().params});
+            }
+      // The coupled mode is a few percent wide: a fine scan of f2 over the band's lines (at
+      // most 200) puts it where the data show it, which the coarse grid above cannot.
+      std::vector<double> fs = l.f;
+      std::sort(fs.begin(), fs.end());
+      fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+      const std::size_t stride = std::max<std::size_t>(1, fs.size() / 200);
+      // The mass ratio follows from the first mode's shift: J2 rigid on the rotor (f2 at the
+      // top) gives mu_rigid; below that, J2 on its spring loads the first mode as
+      // mu / (1 - (f0 / f2)^2), and at a node as (1 - x)^2 of that.
+      double mu_rigid = 0.1, best_cost = std::numeric_limits<double>::infinity();
+      for (double mu : LogSpace(1e-3, 3.0, 40)) {
+        trial.back().params = {mu, 19.0 * f_hi_, 30.0, 0.0};
+        const double cost = Cost(trial, mask);
+        if (cost < best_cost) {
+          best_cost = cost;
+          mu_rigid = mu;
+        }
+      }
+      for (std::size_t i = 0; i < fs.size(); i += stride) {
+        const double r = m.f0_hz / fs[i];
+        if (r > 0.9) continue;
+        for (double x : {0.0, 0.55})
+          for (double q2 : {15.0, 40.0, 100.0}) {
+            const double mu =
+                std::clamp(mu_rigid * (1.0 - r * r) / ((1.0 - x) * (1.0 - x)), 1e-3, 10.0);
+            trial.back().params = {mu, fs[i], q2, x};
+            c.push_back({-Cost(trial, mask), trial.back().params});
+          }
+      }
+      // The best start at the rotor and at each node, so LM sees every basin.
+      std::sort(c.begin(), c.end(),
+                [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
+      // Two per node, at clearly different f2 (the coupled mode's own basin and the added
+      // inertia's are far apart).
+      std::vector<std::vector<double>> out;
+      for (double x : {0.0, 0.3, 0.55, 0.8}) {
+        int taken = 0;
+        double f2_taken = 0.0;
+        for (const Candidate& cand : c) {
+          if (cand.params[3] != x) continue;
+          if (taken == 1 && std::abs(std::log(cand.params[1] / f2_taken)) < 0.2) continue;
+          out.push_back(cand.params);
+          f2_taken = cand.params[1];
+          if (++taken == 2) break;
+        }
+      }
+      std::sort(out.begin(), out.end(), [&](const auto& a, const auto& b) {
+        auto red = [&](const std::vector<double>& p) {
+          for (const Candidate& cand : c)
+            if (cand.params == p) return cand.reduction;
+          return -std::numeric_limits<double>::infinity();
+        };
+        return red(a) > red(b);
+      });
+      return out;
     }
     case EffectKind::kAdhesiveCreep: {
       std::vector<Candidate> c;
@@ -245,7 +456,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       trial.push_back({kind, {0.0}});
       for (double lambda : {0.003, 0.01, 0.03, 0.1, 0.25}) {
         trial.back().params[0] = lambda;
-        c.push_back({-Chi2(trial, mask), {lambda}});
+        c.push_back({-Cost(trial, mask), {lambda}});
       }
       return Best(c, 2);
     }
@@ -292,12 +503,11 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   out.effects = start;
   const Lines lines = Collect(nominal_, units_, {}, mask);
   out.residuals = static_cast<int>(2 * lines.f.size());
-  Layout layout;
-  layout.shape = start;
-  for (const AppliedEffect& e : start) layout.specs.push_back(Spec(e.kind));
+  const Layout layout = MakeLayout(start, nominal_, f_lo_, f_hi_);
   out.n_params = layout.size();
   if (out.n_params == 0 || lines.f.empty()) {
     out.chi2 = Chi2(start, mask);
+    out.cost = Cost(start, mask);
     out.converged = true;
     return out;
   }
@@ -308,32 +518,136 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
     Residual(nominal_, lines, layout, t, r);
   };
   problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* j) {
-    Jacobian(nominal_, lines, layout, t, j);
+    DifferenceJacobian(problem.residual, t, false, j);
   };
   LeastSquaresSettings settings;
   settings.max_iterations = max_iterations;
   settings.ftol = kLmTol;
   settings.xtol = kLmTol;
   Eigen::VectorXd theta = layout.ToTheta(start);
-  const LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, &theta, settings);
+  LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, &theta, settings);
   out.iterations = outcome.iterations;
   out.converged = outcome.converged;
+  if (!out.converged && outcome.termination == Termination::kMaxIterations) {
+    // A parameter that drifts along a flat direction (a bounded one towards its bound, where
+    // the logit's steps never meet xtol) keeps LM from stopping though the cost has settled:
+    // one more run, and a cost that moved by less than kSettledCost in it counts as converged
+    // (far below anything the model selection resolves).
+    Eigen::VectorXd r0;
+    problem.residual(theta, &r0);
+    outcome = MinimizeLeastSquares(problem, &theta, settings);
+    out.iterations += outcome.iterations;
+    Eigen::VectorXd r1;
+    problem.residual(theta, &r1);
+    out.converged = outcome.converged || r0.squaredNorm() - r1.squaredNorm() < kSettledCost;
+  }
   out.effects = layout.FromTheta(theta);
   Eigen::VectorXd r;
   problem.residual(theta, &r);
-  out.chi2 = r.squaredNorm();
+  out.cost = r.squaredNorm();
+  out.chi2 = Chi2(out.effects, mask);
   // Covariance in theta from the Jacobian at the optimum, then natural units.
   Eigen::MatrixXd jac;
-  problem.jacobian(theta, &jac);
+  DifferenceJacobian(problem.residual, theta, true, &jac);
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(problem.parameters, problem.parameters,
                                                   std::numeric_limits<double>::quiet_NaN());
   Eigen::MatrixXd inverse;
-  if (InvertInformation(jac.transpose() * jac, &inverse)) cov = inverse;
+  const Eigen::MatrixXd information = jac.transpose() * jac;
+  if (InvertInformation(information, &inverse)) cov = inverse;
+  out.occam = OccamPenalty(layout, out.effects, information);
   int i = 0;
   out.sigma.resize(out.effects.size());
   for (std::size_t e = 0; e < out.effects.size(); ++e)
     for (std::size_t p = 0; p < out.effects[e].params.size(); ++p, ++i)
       out.sigma[e].push_back(std::abs(layout.Slope(out.effects, e, p)) * std::sqrt(cov(i, i)));
+  return out;
+}
+
+namespace {
+
+// The nominal's own parameters as logarithms: impedance R, L, Rp, f0, Q; mobility g, a.
+int NominalParams(const NominalNetwork& n) { return n.quantity == Quantity::kMobility ? 2 : 5; }
+
+Eigen::VectorXd NominalTheta(const NominalNetwork& n) {
+  Eigen::VectorXd t(NominalParams(n));
+  if (n.quantity == Quantity::kMobility) {
+    t << std::log(n.rigid.gain_rad_per_s2_per_a), std::log(std::max(n.rigid.damping_per_s, 1e-9));
+  } else {
+    const MotionalImpedance& m = n.motional;
+    t << std::log(m.r_ohm), std::log(m.l_h), std::log(m.rp_ohm), std::log(m.f0_hz), std::log(m.q);
+  }
+  return t;
+}
+
+NominalNetwork WithMotional(NominalNetwork n, const Eigen::VectorXd& t) {
+  if (n.quantity == Quantity::kMobility)
+    n.rigid = {std::exp(t(0)), std::exp(t(1))};
+  else
+    n.motional = {std::exp(t(0)), std::exp(t(1)), std::exp(t(2)), std::exp(t(3)), std::exp(t(4))};
+  return n;
+}
+
+}  // namespace
+
+double EffectFitter::Chi2With(const NominalNetwork& nominal, std::span<const AppliedEffect> effects,
+                              const LineMask& mask, double* cost) const {
+  double chi2 = 0.0, c = 0.0;
+  for (std::size_t u = 0; u < units_.size(); ++u) {
+    const GapUnit& unit = units_[u];
+    for (std::size_t k = 0; k < unit.size(); ++k) {
+      if (!Selected(mask, u, k)) continue;
+      const Cplx r = LineResidual(unit, k, EvaluateNetwork(nominal, effects, unit.freq_hz[k]));
+      chi2 += 2.0 * std::norm(r);
+      c += LineCost(std::norm(r), unit.sigma_dof);
+    }
+  }
+  if (cost) *cost = c;
+  return chi2;
+}
+
+EffectFit EffectFitter::FitWithNominal(const NominalNetwork& nominal,
+                                       const std::vector<AppliedEffect>& start,
+                                       const LineMask& mask, int max_iterations,
+                                       NominalNetwork* refitted) const {
+  EffectFit out;
+  out.effects = start;
+  *refitted = nominal;
+  const Lines lines = Collect(nominal_, units_, {}, mask);
+  out.residuals = static_cast<int>(2 * lines.f.size());
+  const Layout layout = MakeLayout(start, nominal_, f_lo_, f_hi_);
+  const int own = NominalParams(nominal);
+  out.n_params = own + layout.size();
+  if (lines.f.empty()) {
+    out.chi2 = Chi2With(nominal, start, mask, &out.cost);
+    return out;
+  }
+  Eigen::VectorXd theta(out.n_params);
+  theta.head(own) = NominalTheta(nominal);
+  if (layout.size() > 0) theta.tail(layout.size()) = layout.ToTheta(start);
+  auto split = [&](const Eigen::VectorXd& t) {
+    return layout.size() > 0 ? layout.FromTheta(t.tail(layout.size()))
+                             : std::vector<AppliedEffect>{};
+  };
+  LeastSquaresProblem problem;
+  problem.parameters = out.n_params;
+  problem.residuals = out.residuals;
+  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
+    const Eigen::VectorXd effects = t.tail(layout.size());
+    Residual(WithMotional(nominal, t), lines, layout, effects, r);
+  };
+  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jac) {
+    DifferenceJacobian(problem.residual, t, false, jac);
+  };
+  LeastSquaresSettings settings;
+  settings.max_iterations = max_iterations;
+  settings.ftol = kLmTol;
+  settings.xtol = kLmTol;
+  const LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, &theta, settings);
+  out.iterations = outcome.iterations;
+  out.converged = outcome.converged;
+  *refitted = WithMotional(nominal, theta);
+  out.effects = split(theta);
+  out.chi2 = Chi2With(*refitted, out.effects, mask, &out.cost);
   return out;
 }
 
@@ -362,11 +676,26 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
       }
     }
   }
+  // A plausible, converged optimum beats a lower cost outside the bounds: a fit that runs off
+  // to a degenerate corner (a fixture spring of zero stiffness with a second inertia as the
+  // support) from one start is no answer when another start settles on a physical one.
+  auto admissible = [&](const EffectFit& f) {
+    std::string why;
+    for (const AppliedEffect& e : f.effects)
+      if (!IsPlausible(Spec(e.kind), e, &why)) return false;
+    return f.converged;
+  };
   EffectFit best;
-  best.chi2 = std::numeric_limits<double>::infinity();
+  best.chi2 = best.cost = std::numeric_limits<double>::infinity();
+  bool best_admissible = false;
   for (const auto& s : starts) {
     EffectFit f = Fit(s, mask, max_iterations);
-    if (std::isfinite(f.chi2) && f.chi2 < best.chi2) best = std::move(f);
+    if (!std::isfinite(f.cost)) continue;
+    const bool ok = admissible(f);
+    if ((ok && !best_admissible) || (ok == best_admissible && f.cost < best.cost)) {
+      best = std::move(f);
+      best_admissible = ok;
+    }
   }
   return best;
 }

@@ -1,12 +1,34 @@
 // Fitting unmodelled effects (analysis/model/effects.h) on top of a fixed nominal network.
 //
 // The nominal's parameters stay at the simulation's values; only the effects' parameters are
-// fitted, by weighted least squares on every (selected) line of every unit:
-//   chi2 = 2 sum_{u,k} |H_meas(u,k) - H_model(f_uk; effects)|^2 / sigma_uk^2
-// (the fit module's convention, resonance_fit.h: 2K real residuals of unit variance).
+// fitted, on every (selected) line of every unit, from the normalised residual
+//   r_uk = (H_meas(u,k) - H_model(f_uk)) / sigma_uk                 (impedance form)
+//   r_uk = (1/H_meas - 1/H_model) |H_meas|^2 / sigma_uk             (admittance form)
+// The admittance form is for a ratio Z = U / I whose current channel carries the noise: then
+// 1/Z is linear in that noise and its sigma, sigma / |Z|^2 = s_I / |U|, does not depend on the
+// noise draw, where sigma_Z (proportional to |Z_meas|^2) does and weights the lines whose
+// current came out high: a bias of -eps/2 sigma per line along Z (eps = sigma/|Z|), which
+// summed over hundreds of noisy lines looks like a lower inductance. Both forms agree to first
+// order when eps is small.
+//   chi2 = 2 sum |r_uk|^2   (the fit module's convention: 2K real residuals of unit variance)
+//   cost = sum rho(|r_uk|^2),  rho(u) = (nu + 2) ln(1 + 2 u / nu)   (-2 ln L + const)
+// With sigma^2 estimated on nu degrees of freedom (GapUnit::sigma_dof) r is a bivariate
+// Student t, not Gaussian: rho is its -2 ln L, which keeps a single heavy-tailed line from
+// buying a narrow mode; nu = 0 (exact sigma) gives rho = 2 u, the chi2. The fits minimise
+// the cost (Levenberg-Marquardt on the residual scaled by sqrt(rho(u) / u)), and the model
+// selection (diagnosis.h) scores it.
+// Evidence (Laplace): -2 ln p(data | effect) ~ cost + occam, with
+//   occam = sum_i max(0, ln(lambda_i / 2 pi)),  lambda_i the eigenvalues of W A W,
+// A = J^T J the information in theta at the optimum and W the prior widths of the thetas
+// (uniform in ln(value) over the plausibility bounds for log-scaled parameters, in value for
+// the others). A parameter the data pin down pays ln of (prior width / posterior width)^2; one
+// they leave as open as its prior pays nothing (where BIC charges every parameter ln(2K)):
+// an effect whose shape predicts a relation (a coupled inertia keeps the peak height while it
+// lowers f0 and raises Q) is not charged for parameters the data do not need.
 // Parameters are fitted as ln(value) (positive, wide-ranging ones) or value / scale, with
 // analysis::MinimizeLeastSquares (fit/least_squares.h: MINPACK Levenberg-Marquardt) on
-// central-difference Jacobians; the covariance (Jr^T Jr)^-1 at the optimum
+// forward-difference Jacobians; the covariance (Jr^T Jr)^-1 at the optimum, from a central-
+// difference Jacobian there,
 // (fit/least_squares.h InvertInformation) is mapped to natural units to first order.
 //
 // Starting values (Starts) come from the residual against a base model (the nominal plus any
@@ -33,9 +55,22 @@ struct GapUnit {
   std::vector<double> freq_hz;
   std::vector<std::complex<double>> value;
   std::vector<double> sigma;
+  // Degrees of freedom of each sigma^2 (residual.h NoiseLine): 2 (P - 1) from P periods,
+  // times the lines pooled; 0 when sigma is known exactly.
+  double sigma_dof = 0.0;
+  bool admittance = false;  // residual form (above); impedance quantity only
 
   std::size_t size() const { return freq_hz.size(); }
 };
+
+// The normalised complex residual r of line k against the model value h, in u's form.
+std::complex<double> LineResidual(const GapUnit& u, std::size_t k, std::complex<double> h);
+// rho(|r|^2) above for sigma^2 on sigma_dof degrees of freedom (0: exact).
+double LineCost(double r2, double sigma_dof);
+// True when the unit's noise is mostly the current's: the relative sigma eps_k = sigma/|H|
+// grows with |H| (least-squares slope of ln eps against ln |H| at least 0.5; a voltage
+// channel's noise gives eps flat in |H|, a current channel's eps proportional to |H|).
+bool CurrentNoiseDominates(const GapUnit& u);
 
 // mask[u][k] != 0: line k of unit u takes part. An empty mask selects every line.
 using LineMask = std::vector<std::vector<char>>;
@@ -45,6 +80,8 @@ struct EffectFit {
   std::vector<std::vector<double>> sigma;  // per effect, per parameter, natural units (NaN:
                                            // not determined)
   double chi2 = 0.0;                       // on the selected lines
+  double cost = 0.0;                       // sum rho (above), what the fit minimised
+  double occam = 0.0;                      // the Laplace evidence's penalty (above)
   int residuals = 0;                       // 2 x selected lines
   int n_params = 0;
   bool converged = false;
@@ -65,6 +102,8 @@ class EffectFitter {
   // chi2 of nominal + effects on the selected lines; *residuals gets 2 x lines when given.
   double Chi2(std::span<const AppliedEffect> effects, const LineMask& mask,
               int* residuals = nullptr) const;
+  // cost (above) of nominal + effects on the selected lines.
+  double Cost(std::span<const AppliedEffect> effects, const LineMask& mask) const;
 
   // Starting parameter vectors for `kind` on top of `base` (at most a few, best first).
   std::vector<std::vector<double>> Starts(EffectKind kind, std::span<const AppliedEffect> base,
@@ -74,9 +113,21 @@ class EffectFitter {
   EffectFit Fit(const std::vector<AppliedEffect>& start, const LineMask& mask,
                 int max_iterations) const;
 
+  // Calibration and structure together: as Fit, with the nominal's own parameters free too
+  // (impedance: ln R, ln L, ln Rp, ln f0, ln Q; mobility: ln g, ln a; started from
+  // `nominal`). The refitted nominal goes to *refitted; the effects' parameters to the
+  // result (start may be empty: a refit of the nominal alone). n_params counts both.
+  EffectFit FitWithNominal(const NominalNetwork& nominal, const std::vector<AppliedEffect>& start,
+                           const LineMask& mask, int max_iterations,
+                           NominalNetwork* refitted) const;
+  // chi2 / cost of another nominal + effects on the selected lines (as Chi2 and Cost).
+  double Chi2With(const NominalNetwork& nominal, std::span<const AppliedEffect> effects,
+                  const LineMask& mask, double* cost = nullptr) const;
+
   // The best of the fits started from Starts(kind) for each kind in `kinds`, the kinds
   // fitted jointly; for a pair the second kind's starts are taken on top of `seeds` (the
-  // kinds' single fits, same order as kinds) and vice versa.
+  // kinds' single fits, same order as kinds) and vice versa. Best: the lowest cost among the
+  // plausible (IsPlausible) converged fits; the lowest cost of all only when none is.
   EffectFit FitKinds(const std::vector<EffectKind>& kinds, const std::vector<AppliedEffect>& seeds,
                      const LineMask& mask, int max_iterations) const;
 

@@ -45,6 +45,19 @@ double ChiSquareZ(double chi2, double dof) {
   return (std::cbrt(chi2 / dof) - (1.0 - v)) / std::sqrt(v);
 }
 
+double ExpectedR2(double sigma_dof) {
+  if (!(sigma_dof > 0.0) || !std::isfinite(sigma_dof)) return 1.0;
+  return sigma_dof / (sigma_dof - 2.0);
+}
+
+NoiseLine NoiseTerms(double r2, double sigma_dof) {
+  if (!(sigma_dof > 0.0) || !std::isfinite(sigma_dof)) return {2.0 * r2, 2.0};
+  const double nu = sigma_dof;
+  const double m = nu / (nu - 2.0);
+  const double v = nu * nu * nu / ((nu - 2.0) * (nu - 2.0) * (nu - 4.0));
+  return {r2 * 2.0 * m / v, 2.0 * m * m / v};
+}
+
 bool BandSearchOptions::IsValid(std::string* why) const {
   if (!(std::isfinite(z_threshold) && z_threshold > 0.0)) {
     if (why) *why = "z_threshold must be positive";

@@ -8,6 +8,14 @@
 // Wilson-Hilferty transform z = ((chi2/d)^(1/3) - (1 - 2/(9d))) / sqrt(2/(9d)), accurate to
 // a few hundredths for d >= 6 and monotone far into the tail (no underflowing p-values).
 //
+// Estimated sigma: when sigma_k^2 itself rests on nu degrees of freedom (nu sigma_hat^2 /
+// sigma^2 ~ chi2(nu), independent of the residual), |r_k|^2 = (chi2(2) / 2) / (chi2(nu) / nu)
+// is F(2, nu)-distributed, not chi2(2) / 2: mean m = nu / (nu - 2), variance
+// v = nu^3 / ((nu - 2)^2 (nu - 4)) (nu > 4). A sum of such lines is matched in mean and
+// variance by a scaled chi-square a chi2(b), a = v / (2 m), b = 2 m^2 / v per line, so every
+// test below runs on (sum |r|^2 / a, sum b) with the same Wilson-Hilferty z; nu = infinity
+// (exact sigma) gives a = 1/2, b = 2, the plain chi2 (for 8 periods, nu = 14: m = 1.167,
+// b = 1.43). The sigma scale a residual implies is sqrt(mean |r|^2 / m).
 // Bands: the most significant interval [a, b] of consecutive lines (at least min_lines) is
 // the one maximising z(sum_{a..b} chi2_k, sum_{a..b} d_k); it is reported when z reaches
 // z_threshold, and the search repeats left and right of it. A narrow strong gap is found
@@ -32,6 +40,16 @@ namespace eol::analysis {
 
 // One-sided Gaussian-equivalent z of chi2 with dof degrees of freedom (Wilson-Hilferty).
 double ChiSquareZ(double chi2, double dof);
+
+// One line's contribution to the tests above: chi2 = |r|^2 / a, dof = b, for sigma^2 with
+// sigma_dof degrees of freedom (0 or infinity: exact). sigma_dof must exceed 4 otherwise.
+struct NoiseLine {
+  double chi2 = 0.0;
+  double dof = 0.0;
+};
+NoiseLine NoiseTerms(double r2, double sigma_dof);
+// E|r|^2 for sigma_dof (1 when exact).
+double ExpectedR2(double sigma_dof);
 
 struct BandSearchOptions {
   double z_threshold = 6.0;

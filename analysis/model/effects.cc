@@ -12,10 +12,12 @@ namespace {
 using Cplx = std::complex<double>;
 
 constexpr std::array<const char*, kEffectKindCount> kNames = {
-    "series_resistance", "channel_delay",      "stray_capacitance", "lossy_inductance",
-    "skin_effect",       "fixture_compliance", "second_mode",       "adhesive_creep"};
+    "series_resistance", "channel_delay",        "stray_capacitance", "lossy_inductance",
+    "skin_effect",       "fixture_compliance",   "second_mode",       "adhesive_creep",
+    "coupled_inertia",   "fractional_inductance"};
 
 constexpr double kSkinReferenceHz = 1000.0;
+constexpr double kFractionalReferenceHz = 1000.0;
 
 double TwoPi() { return 2.0 * std::numbers::pi; }
 
@@ -43,7 +45,7 @@ double MaxNominalMagnitude(const NominalNetwork& n, double f_lo, double f_hi) {
 
 // Motional impedance with the mechanical effects (creep, fixture) of the top of effects.h.
 Cplx MotionalWithEffects(const MotionalImpedance& m, const AppliedEffect* creep,
-                         const AppliedEffect* fixture, Cplx s) {
+                         const AppliedEffect* fixture, const AppliedEffect* coupled, Cplx s) {
   const double w0 = TwoPi() * m.f0_hz;
   const double cp = m.q / (w0 * m.rp_ohm);
   const double lp = m.rp_ohm / (m.q * w0);
@@ -52,20 +54,36 @@ Cplx MotionalWithEffects(const MotionalImpedance& m, const AppliedEffect* creep,
     const double n = Param(creep, 0) / std::numbers::ln10;
     compliance *= std::pow(s / w0, -n);
   }
-  Cplx support = 1.0 / m.rp_ohm + 1.0 / (s * compliance);
+  const Cplx inv_s = Reciprocal(s);
+  Cplx support = 1.0 / m.rp_ohm + inv_s * Reciprocal(compliance);
   if (fixture) {
     const double kappa = Param(fixture, 0);
     const double eta = Param(fixture, 1);
-    support = 1.0 / (1.0 / support + s * lp / (kappa * Cplx(1.0, eta)));
+    support = Reciprocal(Reciprocal(support) + s * lp * Reciprocal(kappa * Cplx(1.0, eta)));
   }
-  return 1.0 / (s * cp + support);
+  if (coupled) {
+    const double c2 = Param(coupled, 0) * cp;
+    const double w2 = TwoPi() * Param(coupled, 1);
+    const double x = std::clamp(Param(coupled, 3), 0.0, 0.999);
+    const Cplx spring2 = w2 * c2 / Param(coupled, 2) + w2 * w2 * c2 * inv_s;
+    const Cplx branch = Reciprocal(inv_s / c2 + Reciprocal(spring2));
+    support = x > 0.0
+                  ? Reciprocal(x * Reciprocal(support) + Reciprocal(support / (1.0 - x) + branch))
+                  : support + branch;
+  }
+  return Reciprocal(s * cp + support);
 }
 
 }  // namespace
 
+std::complex<double> FractionalShape(double order, double f_hz, double ref_hz) {
+  const double w_r = TwoPi() * ref_hz;
+  return w_r * std::pow(f_hz / ref_hz, order) * std::polar(1.0, order * std::numbers::pi / 2.0);
+}
+
 std::complex<double> RigidShaftMobility::At(double f_hz) const {
   const Cplx s(0.0, TwoPi() * f_hz);
-  return gain_rad_per_s2_per_a / (s + damping_per_s);
+  return gain_rad_per_s2_per_a * Reciprocal(s + damping_per_s);
 }
 
 std::complex<double> NominalNetwork::At(double f_hz) const {
@@ -161,6 +179,22 @@ EffectSpec DescribeEffect(EffectKind kind, const NominalNetwork& n, double f_lo,
                   {height, unit, 0.0, h_max, true, 1e-3 * h_max}};
       break;
     }
+    case EffectKind::kFractionalInductance:
+      s.equation =
+          "Z = Z0 + inductance_share L (w_m^(1 - order) (j w)^order - s), w_m = 2 pi match_hz";
+      s.params = {{"inductance_share", "1", 0.0, 0.95, true, 0.1},
+                  {"order", "1", 0.3, 0.98, false, 0.1},
+                  {"match_hz", "Hz", 0.1 * f_lo, 10.0 * f_hi, true, std::sqrt(f_lo * f_hi), true}};
+      break;
+    case EffectKind::kCoupledInertia:
+      s.equation =
+          "Ym' = Ym + 1 / (1 / (s mass_ratio Cp) + 1 / (w2 mass_ratio Cp / q2 + w2^2 mass_ratio "
+          "Cp / s)), w2 = 2 pi f2_hz, on the support node node_compliance_share";
+      s.params = {{"mass_ratio", "1", 1e-3, 10.0, true, 0.1, true},
+                  {"f2_hz", "Hz", 0.5 * f_lo, 20.0 * f_hi, true, std::sqrt(f_lo * f_hi), true},
+                  {"q2", "1", 0.5, 3000.0, true, 30.0, true},
+                  {"node_compliance_share", "1", 0.0, 0.95, false, 0.3, true}};
+      break;
     case EffectKind::kAdhesiveCreep:
       s.equation = "C(f) = C0 (1 - creep_lambda log10(f / f0)) (causal power law)";
       s.params = {{"creep_lambda", "1", 0.0, 0.3, true, 0.02}};
@@ -220,23 +254,30 @@ std::complex<double> EvaluateNetwork(const NominalNetwork& n,
     }
     if (eddy) {
       const double l2 = Param(eddy, 0);
-      winding -= s * s * l2 * l2 / (s * l2 + Param(eddy, 1));
+      winding -= s * s * l2 * l2 * Reciprocal(s * l2 + Param(eddy, 1));
     }
+    if (const AppliedEffect* frac = FindEffect(effects, EffectKind::kFractionalInductance))
+      winding += m.l_h * Param(frac, 0) *
+                 (FractionalShape(Param(frac, 1), f_hz,
+                                  Param(frac, 2) > 0.0 ? Param(frac, 2) : kFractionalReferenceHz) -
+                  s);
     const AppliedEffect* creep = FindEffect(effects, EffectKind::kAdhesiveCreep);
     const AppliedEffect* fixture = FindEffect(effects, EffectKind::kFixtureCompliance);
+    const AppliedEffect* coupled = FindEffect(effects, EffectKind::kCoupledInertia);
     const Cplx motional =
-        creep || fixture
-            ? MotionalWithEffects(m, creep, fixture, s)
-            : m.rp_ohm / (1.0 + m.q * (s / (TwoPi() * m.f0_hz) + TwoPi() * m.f0_hz / s));
+        creep || fixture || coupled
+            ? MotionalWithEffects(m, creep, fixture, coupled, s)
+            : m.rp_ohm * Reciprocal(1.0 + m.q * (s / (TwoPi() * m.f0_hz) +
+                                                 TwoPi() * m.f0_hz * Reciprocal(s)));
     inside = winding + motional;
   }
   if (mode) {
     const double w2 = TwoPi() * Param(mode, 0);
-    inside += Param(mode, 2) / (1.0 + Param(mode, 1) * (s / w2 + w2 / s));
+    inside += Param(mode, 2) * Reciprocal(1.0 + Param(mode, 1) * (s / w2 + w2 * Reciprocal(s)));
   }
   if (n.quantity == Quantity::kImpedanceOhm) {
     if (const AppliedEffect* stray = FindEffect(effects, EffectKind::kStrayCapacitance))
-      inside = inside / (1.0 + s * Param(stray, 0) * inside);
+      inside = inside * Reciprocal(1.0 + s * Param(stray, 0) * inside);
   }
   if (const AppliedEffect* delay = FindEffect(effects, EffectKind::kChannelDelay))
     inside *= std::exp(-s * Param(delay, 0));
@@ -265,6 +306,11 @@ std::vector<DerivedParam> DeriveEffectParams(const NominalNetwork& n, const Appl
     const double k_nominal = n.NominalStiffnessNmPerRad();
     if (k_nominal > 0.0) out.push_back({"k_fixture_nm_per_rad", "N m/rad", kappa * k_nominal});
     out.push_back({"f_loaded_hz", "Hz", n.motional.f0_hz * std::sqrt(kappa / (1.0 + kappa))});
+  } else if (e.kind == EffectKind::kCoupledInertia && n.inertia_kg_m2 > 0.0) {
+    const double j2 = Param(&e, 0) * n.inertia_kg_m2;
+    const double w2 = TwoPi() * Param(&e, 1);
+    out.push_back({"j2_kg_m2", "kg m^2", j2});
+    out.push_back({"k2_nm_per_rad", "N m/rad", j2 * w2 * w2});
   } else if (e.kind == EffectKind::kLossyInductance) {
     const double l2 = Param(&e, 0);
     if (l2 > 0.0) out.push_back({"corner_hz", "Hz", Param(&e, 1) / (TwoPi() * l2)});

@@ -4,6 +4,7 @@
 // would land in the measured set-up (--predict-sim). Inputs: drivers/io/gap_inputs.h;
 // reading, diagnosis and plot: station/gap_diagnosis.h (shared with POST /api/gap.svg); report:
 // station/gap_report.h.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -34,6 +35,8 @@ struct GapArgs {
   double f_lo_hz = 0.0;
   double f_hi_hz = 0.0;
   int sigma_pool = 0;
+  double sigma_dof = 0.0;
+  int sigma_periods = 0;
   double period_s = 0.0;
   std::string input_column, output_column, lines_file;
   std::vector<std::string> effects;
@@ -59,6 +62,10 @@ int RunGap(const GapArgs& a) {
   o.f_lo_hz = a.f_lo_hz;
   o.f_hi_hz = a.f_hi_hz;
   o.sigma_pool = a.sigma_pool;
+  // P periods give sigma^2 with 2 (P - 1) degrees of freedom per line; pooling over 2 N + 1
+  // lines multiplies them.
+  const double dof = a.sigma_dof > 0.0 ? a.sigma_dof : 2.0 * std::max(a.sigma_periods - 1, 0);
+  o.sigma_dof = dof * (2 * a.sigma_pool + 1);
   o.inertia_kg_m2 = a.inertia_kg_m2;
   o.try_pairs = !a.no_pairs;
   for (const std::string& name : a.effects) {
@@ -158,6 +165,15 @@ void AddGapCommand(CLI::App& app) {
                   "on few periods and was not pooled (the periodic estimator already pools: 0)")
       ->capture_default_str()
       ->check(CLI::Range(0, 50));
+  cmd->add_option("--sigma-periods", a->sigma_periods,
+                  "The measured files' sigma comes from this many periods: each sigma^2 has "
+                  "2 (P - 1) degrees of freedom and the residual is tested as F, not chi2 "
+                  "(default: sigma exact)")
+      ->check(CLI::Range(4, 100000));
+  cmd->add_option("--sigma-dof", a->sigma_dof,
+                  "Degrees of freedom of each line's sigma^2 in the measured files (above 4; "
+                  "overrides --sigma-periods)")
+      ->check(CLI::Range(4.000001, 1e12));
   cmd->add_option("--period-s", a->period_s,
                   "Raw recordings: the excitation period (default: detect)")
       ->check(CLI::NonNegativeNumber);

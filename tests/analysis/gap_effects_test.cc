@@ -147,5 +147,55 @@ TEST(GapEffects, PlausibilityBoundsNameTheParameter) {
   EXPECT_EQ(mode.params[2].name, "height_rad_per_s_per_a");
 }
 
+// coupled_inertia at a node of the support against the mechanics written out (torque / angular
+// velocity, NOTES.md 1): J on the rotor spring k_r (c_r) to a node that holds J2 on k2 (c2) and
+// sits on the fixture spring k_f (c_f) to ground, damping stiffness-proportional, so that
+// k = k_r k_f / (k_r + k_f) and x = k / k_r. Z = R + s L + T^2 / Zm.
+TEST(GapEffects, CoupledInertiaAtANodeIsTheThreeSpringChain) {
+  const NominalNetwork n = PaperNominal();
+  const MotionalImpedance& m = n.motional;
+  const double t2 = 1.0;  // T^2 only scales the mechanics: Cp = J / T^2 etc.
+  const double w0 = 2.0 * std::numbers::pi * m.f0_hz;
+  const double j = m.q / (w0 * m.rp_ohm) * t2, k = w0 * w0 * j, c = t2 / m.rp_ohm;
+  for (double x : {0.0, 0.4, 0.8}) {
+    const double mu = 0.3, f2 = 2.2 * m.f0_hz, q2 = 25.0;
+    const double j2 = mu * j, w2 = 2.0 * std::numbers::pi * f2, k2 = j2 * w2 * w2;
+    const double c2 = std::sqrt(k2 * j2) / q2;
+    const std::vector<AppliedEffect> e = {{EffectKind::kCoupledInertia, {mu, f2, q2, x}}};
+    for (double f : {100.0, 0.8 * m.f0_hz, m.f0_hz, 1.7 * m.f0_hz, f2, 3000.0}) {
+      const Cplx s(0.0, 2.0 * std::numbers::pi * f);
+      const Cplx branch = 1.0 / (1.0 / (k2 / s + c2) + 1.0 / (s * j2));
+      Cplx zm;
+      if (x == 0.0) {
+        zm = s * j + k / s + c + branch;
+      } else {
+        const Cplx rotor_spring = (k / s + c) / x, fixture_spring = (k / s + c) / (1.0 - x);
+        zm = s * j + 1.0 / (1.0 / rotor_spring + 1.0 / (fixture_spring + branch));
+      }
+      const Cplx expected = m.r_ohm + s * m.l_h + t2 / zm;
+      EXPECT_NEAR(std::abs(EvaluateNetwork(n, e, f) - expected), 0.0, 1e-9 * std::abs(expected))
+          << "x " << x << " f " << f;
+    }
+  }
+}
+
+// fractional_inductance: Z_L = s L (1 - b) + b L w_m^(1 - n) (j w)^n, the same |Z| as b s L at
+// w_m; the match frequency free.
+TEST(GapEffects, FractionalInductanceMatchesItsShareAtTheMatchFrequency) {
+  const NominalNetwork n = PaperNominal();
+  const double b = 0.2, order = 0.6, fm = 316.0;
+  const std::vector<AppliedEffect> e = {{EffectKind::kFractionalInductance, {b, order, fm}}};
+  for (double f : {50.0, fm, 1500.0}) {
+    const double w = 2.0 * std::numbers::pi * f, wm = 2.0 * std::numbers::pi * fm;
+    const Cplx frac = b * n.motional.l_h * std::pow(wm, 1.0 - order) * std::pow(w, order) *
+                      std::polar(1.0, order * std::numbers::pi / 2.0);
+    const Cplx expected = n.At(f) - Cplx(0.0, w * b * n.motional.l_h) + frac;
+    EXPECT_NEAR(std::abs(EvaluateNetwork(n, e, f) - expected), 0.0, 1e-9 * std::abs(expected));
+    if (f == fm) {
+      EXPECT_NEAR(std::abs(frac), b * w * n.motional.l_h, 1e-9 * std::abs(frac));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace eol::analysis

@@ -33,7 +33,12 @@ noise (what white noise gives on the lines of a whole period). Z = mean U / mean
 with the sample (co)variances of the P periods: sigma^2 then has 2 (P - 1) degrees of freedom.
 The channel noise is scaled so that the effect's strength
   S = sqrt(sum_k 2 |Z_meas_true - Z_nominal|^2 / sigma_true_k^2)
-is log-uniform in [s_lo, s_hi]; a case is "separable" when it has no effect or S >= 20.
+is log-uniform in [s_lo, s_hi]; a case is "separable" when it has no effect or S >= 20, and
+for a coupled inertia also when the data can tell it from a fixture spring: --score fits the
+best massless fixture spring (`eol gap --effects fixture_compliance`) and counts the case only
+when the true model's chi2 = sum 2 |Z_meas - Z_true|^2 / sigma^2 is at least 10 (the
+diagnosis' min_score_gain) below that fit's. A coupled mode at 1.3-3.5 f0 can be so weak that
+the fixture spring fits as well as the truth: no rule can name it then.
 
 Usage:
   independent_gap_cases.py --out DIR [--cases 70] [--seed 1]
@@ -248,6 +253,20 @@ def generate(out_dir, cases, seed, s_lo, s_hi, plan=None):
     return truth
 
 
+def truth_beats_fixture(base, t, eol, extra):
+    """chi2 of the best fixture spring minus chi2 of the true model (both sum 2 |r|^2)."""
+    data = np.loadtxt(base + "-meas.csv", delimiter=",", skiprows=2)
+    f, z, sigma = data[:, 0], data[:, 1] + 1j * data[:, 2], data[:, 3]
+    chi2_true = np.sum(2 * np.abs(z - impedance(t["motor"], f, t["effect"], t["params"])) ** 2 /
+                       sigma ** 2)
+    cmd = [eol, "gap", "--sim", base + "-sim.csv", "--measured", base + "-meas.csv", "--json",
+           "--effects", "fixture_compliance", "--no-pairs"] + extra
+    p = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    fits = [r for r in json.loads(p.stdout)["ranking"] if r["effect"] == "fixture_compliance"]
+    chi2_fixture = 2 * len(f) * fits[0]["gap_after"] ** 2
+    return chi2_fixture - chi2_true
+
+
 def score(out_dir, eol, extra):
     with open(os.path.join(out_dir, "truth.json")) as f:
         truth = json.load(f)
@@ -256,7 +275,7 @@ def score(out_dir, eol, extra):
     for t in truth:
         base = os.path.join(out_dir, t["case"])
         cmd = [eol, "gap", "--sim", base + "-sim.csv", "--measured", base + "-meas.csv",
-               "--json", "-"] + extra
+               "--json"] + extra
         p = subprocess.run(cmd, capture_output=True, text=True)
         if p.returncode != 0:
             answer = "error: " + p.stderr.strip().splitlines()[-1] if p.stderr else "error"
@@ -264,7 +283,10 @@ def score(out_dir, eol, extra):
             answer = json.loads(p.stdout)["effect"]
         ok = answer in EXPECTED[t["effect"]]
         sub = t["effect"] + ("(" + t["params"]["at"] + ")" if "at" in t["params"] else "")
-        rows.append((t["case"], sub, t["effect"], t["separable"], t["strength"], answer, ok))
+        separable = t["separable"]
+        if t["effect"] == "coupled_inertia" and separable:
+            separable = bool(truth_beats_fixture(base, t, eol, extra) >= 10.0)
+        rows.append((t["case"], sub, t["effect"], separable, t["strength"], answer, ok))
     elapsed = time.time() - t0
     print("%-9s %-24s %5s %8s  %-40s %s" % ("case", "hidden", "sep", "S", "answer", "ok"))
     for r in rows:

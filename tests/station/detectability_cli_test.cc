@@ -38,8 +38,13 @@ TEST(DetectabilityCli, FixtureFromTheGapDiagnosis) {
   r = Eol({"simulate", "--motor", kMotors + "pmsm-10pole.json", "--out", dir / "meas.csv",
            "--model", "steady_state"});
   ASSERT_EQ(r.code, 0) << r.out;
+  // The chain's fixture is a spring (887.9 N m/rad) with the clamp's inertia on its node. The
+  // full diagnosis names both (fixture_compliance+coupled_inertia), and with the inertia free
+  // the stiffness alone is not identifiable from Z (the spring, the node and the inertia trade
+  // off at the same g); detectability's fixture is a massless spring, so it takes the
+  // massless-spring equivalent, the diagnosis with the fixture alone.
   r = Eol({"gap", "--sim", dir / "sim.csv", "--measured", dir / "meas.csv", "--json-out",
-           dir / "gap.json"});
+           dir / "gap.json", "--effects", "fixture_compliance"});
   ASSERT_EQ(r.code, 0) << r.out;
   r = Eol({"detectability", "--gap", dir / "gap.json", "--json"}, false);
   ASSERT_EQ(r.code, 0) << r.out;
