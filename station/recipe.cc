@@ -333,6 +333,10 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
       retest->RejectUnknown();
     }
     ParseLimits(root.Raw("limits"), "/limits", r);
+    r.analysis.fit.second_mode_test =
+        std::any_of(r.limits.begin(), r.limits.end(), [](const analysis::MeasurementSpec& s) {
+          return s.name == analysis::names::kSecondModeChi2Drop;
+        });
     if (root.Has("masks")) ParseMasks(root.Raw("masks"), "/masks", r);
     if (auto c = root.OptionalObject("conditions")) ParseConditions(*c, r);
     if (auto i = root.OptionalObject("instructions")) ParseInstructions(*i, r);

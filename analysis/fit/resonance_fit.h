@@ -51,6 +51,10 @@ struct ResonanceFitOptions {
   // The motional peak must stand this many standard deviations above zero (Rp / sigma_Rp);
   // below it the fit reports "no resonance found".
   double min_rp_significance = 5.0;
+  // AnalyzeImpedance (impedance_analysis.h) also tests for a second motional mode and reports
+  // second_mode_chi2_drop; set by a recipe that declares a limit on it (costs a two-mode fit,
+  // modes_fit.h: about 35 ms on 601 lines).
+  bool second_mode_test = false;
 
   bool IsValid(std::string* why) const;
 };

@@ -18,10 +18,20 @@ inline constexpr std::string_view kFitChi2PerDof = "fit_chi2_per_dof";  // 1: go
 // %: 100 [ln(A/A_ref) - m ln(f0/f0_ref)], f0 and residue weighed by the good units' spread
 // (bond_index.h); only where the recipe defines it ("bond_index" block, set by teaching)
 inline constexpr std::string_view kBondIndexPct = "bond_index_pct";
+// 1: chi2 of the one-mode fit minus chi2 with a second motional mode added anywhere in the
+// search range (impedance_analysis.h): the likelihood-ratio test for a soft magnet's local mode
+// (only where the recipe declares it)
+inline constexpr std::string_view kSecondModeChi2Drop = "second_mode_chi2_drop";
 
 // In the export schema's column order (db/export_schema.h): append only.
-inline constexpr std::array<std::string_view, 8> kAll = {
-    kResonanceFHz,           kResonanceQ,  kWindingROhm, kWindingLH, kMotionalRpOhm, kFitChi2PerDof,
-    kMotionalResidueOhmPerS, kBondIndexPct};
+inline constexpr std::array<std::string_view, 9> kAll = {kResonanceFHz,
+                                                         kResonanceQ,
+                                                         kWindingROhm,
+                                                         kWindingLH,
+                                                         kMotionalRpOhm,
+                                                         kFitChi2PerDof,
+                                                         kMotionalResidueOhmPerS,
+                                                         kBondIndexPct,
+                                                         kSecondModeChi2Drop};
 
 }  // namespace eol::analysis::names

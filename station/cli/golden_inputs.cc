@@ -74,6 +74,13 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
   }
   if (j.contains("fit") && j.at("fit").contains("chi2_per_dof"))
     u.values[std::string(names::kFitChi2PerDof)] = j.at("fit").at("chi2_per_dof").get<double>();
+  // What only a recipe's analysis computes (second_mode_chi2_drop): from the verdict's
+  // measurements of `eol analyze --recipe R --json`.
+  if (j.contains("verdict") && j.at("verdict").contains("measurements"))
+    for (const auto& m : j.at("verdict").at("measurements"))
+      if (m.contains("name") && m.contains("value") && m.at("value").is_number() &&
+          !u.values.count(m.at("name").get<std::string>()))
+        u.values[m.at("name").get<std::string>()] = m.at("value").get<double>();
   return u;
 }
 

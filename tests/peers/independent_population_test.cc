@@ -136,8 +136,10 @@ TEST_F(IndependentPopulation, AllMagnetsA9095FromHitMiss) {
 }
 
 // Teaching by physics (the default) against the even split on the same transition sweep: the
-// budget given to f0 and chi2 must find more soft rotors, never fewer (a default that fell
-// back to the even split fails here).
+// budget given to f0, the residue and the bond index must find more all-ten-soft rotors, and
+// never fewer single soft magnets (a default that fell back to the even split fails here).
+// Since the second-mode test, single soft magnets are found alike by both (42 / 42 of 200):
+// its chi2 drop is far beyond either bound when it shows at all.
 TEST_F(IndependentPopulation, PhysicsAllocationFindsMoreThanEvenSplit) {
   const nlohmann::json phys = PodSweep(*this, "phys", {});
   const nlohmann::json even = PodSweep(*this, "even", {"--allocation", "even"});
@@ -148,8 +150,8 @@ TEST_F(IndependentPopulation, PhysicsAllocationFindsMoreThanEvenSplit) {
   std::cout << "rejected by physics / even: all_soft " << rejected(phys, "all_soft") << " / "
             << rejected(even, "all_soft") << ", one_soft " << rejected(phys, "one_soft") << " / "
             << rejected(even, "one_soft") << "\n";
-  EXPECT_GE(rejected(phys, "all_soft"), rejected(even, "all_soft"));
-  EXPECT_GT(rejected(phys, "one_soft"), rejected(even, "one_soft"));
+  EXPECT_GT(rejected(phys, "all_soft"), rejected(even, "all_soft"));
+  EXPECT_GE(rejected(phys, "one_soft"), rejected(even, "one_soft"));
 }
 
 // Part 4: the same teaching and judging with and without the residue's limits (the residue

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "../support/child_process.h"
@@ -32,6 +33,13 @@ TEST(Recipe, ShippedRecipeLoads) {
   EXPECT_EQ(r.hash.size(), 64u);
   EXPECT_FALSE(r.limits.empty());
   EXPECT_DOUBLE_EQ(r.analysis.fit.f0_min_hz, 250.0);
+  EXPECT_TRUE(r.analysis.fit.second_mode_test) << "declared: second_mode_chi2_drop";
+  nlohmann::json j = Good();
+  auto& limits = j["limits"];
+  limits.erase(std::remove_if(limits.begin(), limits.end(),
+                              [](const auto& l) { return l["name"] == "second_mode_chi2_drop"; }),
+               limits.end());
+  EXPECT_FALSE(ParseRecipe(j, "test.json").analysis.fit.second_mode_test);
 }
 
 TEST(Recipe, ErrorsNameTheJsonPathAndRule) {

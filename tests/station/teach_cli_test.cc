@@ -112,7 +112,8 @@ TEST_F(TeachCli, ReadsAnalyzeJsonAndReportsJson) {
       "teach",  "--recipe",          kRecipe,   "--out", dir_ / "j.json",
       "--json", "--allow-few-units", "--golden"};
   for (std::size_t i = 0; i < 6; ++i) {
-    const CliRun a = Eol({"analyze", "--measured", golden_[i], "--json"}, false);
+    const CliRun a =
+        Eol({"analyze", "--measured", golden_[i], "--recipe", kRecipe, "--json"}, false);
     ASSERT_EQ(a.code, 0) << a.out;
     const std::string path = dir_ / ("a" + std::to_string(i) + ".json");
     std::ofstream(path) << a.out;
