@@ -35,6 +35,10 @@
 //                                           (10000 units): one soft magnet 156 escapes
 //                                           against 157, weak bonds 202 against 203, good
 //                                           false rejects 1 against 3
+//   second_mode_chi2   hi           0.30    a soft magnet's own mode beside the rotor's: the
+//     _drop                                 likelihood-ratio drop of a second fitted mode;
+//                                           taught on ln(1 + x), its tail is long (line model:
+//                                           one soft magnet 0 of 64 escape against 30 without)
 //   fit_chi2_per_dof   hi           0.35    a soft magnet's local mode is a peak the one-mode
 //                                           model cannot follow; it only raises chi2
 //   Re Z mask max      hi           0.20    (all segments together) an extra motional peak
