@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 namespace eol::analysis {
 
@@ -40,6 +41,28 @@ bool Frf::Validate(std::string* why) const {
       return fail(where.str() + ": sigma must be finite and positive");
   }
   return true;
+}
+
+Frf CombineIndependent(const Frf& a, const Frf& b) {
+  std::string why;
+  if (!a.Validate(&why)) throw std::invalid_argument("first estimate: " + why);
+  if (!b.Validate(&why)) throw std::invalid_argument("second estimate: " + why);
+  if (!a.has_sigma() || !b.has_sigma())
+    throw std::invalid_argument("both estimates need a sigma per line to be combined");
+  if (a.quantity != b.quantity)
+    throw std::invalid_argument("the estimates are of other quantities");
+  if (a.freq_hz != b.freq_hz)
+    throw std::invalid_argument("the estimates are on other lines (" + std::to_string(a.size()) +
+                                " and " + std::to_string(b.size()) + " lines)");
+  Frf c = a;
+  c.method = a.method + "+" + b.method;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const double wa = 1.0 / (a.sigma[k] * a.sigma[k]);
+    const double wb = 1.0 / (b.sigma[k] * b.sigma[k]);
+    c.value[k] = (a.value[k] * wa + b.value[k] * wb) / (wa + wb);
+    c.sigma[k] = 1.0 / std::sqrt(wa + wb);
+  }
+  return c;
 }
 
 }  // namespace eol::analysis

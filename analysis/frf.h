@@ -34,4 +34,11 @@ struct Frf {
   bool Validate(std::string* why) const;
 };
 
+// Two independent estimates of one response on the same lines (the looks of a sequential
+// test) as one, line by line weighted by inverse variance:
+//   Z = (Z_a / s_a^2 + Z_b / s_b^2) / (1 / s_a^2 + 1 / s_b^2),   s^-2 = s_a^-2 + s_b^-2.
+// Throws std::invalid_argument naming the cause when the lines, quantities or sigmas differ
+// or are missing (an estimate without sigma cannot be weighed).
+Frf CombineIndependent(const Frf& a, const Frf& b);
+
 }  // namespace eol::analysis

@@ -3,6 +3,7 @@
 #include <openssl/evp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -248,6 +249,72 @@ void ParseBondIndex(const JsonObject& o, Recipe& r) {
   r.bond_index = d;
 }
 
+// After the excitation and the analysis: the recipe's own excitation must meet the requirement
+// it states.
+void ParseExcitationDesign(const JsonObject& o, Recipe& r, bool check_excitation) {
+  analysis::ExcitationRequirement d;
+  d.sigma_f0_hz = o.RequiredNumber("sigma_f0_hz");
+  d.verdict_margin_hz = o.Number("verdict_margin_hz", d.verdict_margin_hz);
+  d.margin_z = o.Number("margin_z", d.margin_z);
+  d.noise_v_rms = o.RequiredNumber("noise_v_rms");
+  d.noise_a_rms = o.RequiredNumber("noise_a_rms");
+  d.max_peak_v = o.RequiredNumber("max_peak_v");
+  d.current_full_scale_a = o.Number("current_full_scale_a", d.current_full_scale_a);
+  d.max_v_rms = o.Number("max_v_rms", d.max_v_rms);
+  d.max_a_rms = o.Number("max_a_rms", d.max_a_rms);
+  d.lines_per_half_power_band = o.Number("lines_per_half_power_band", d.lines_per_half_power_band);
+  d.min_periods = static_cast<std::size_t>(
+      std::clamp(o.Integer("min_periods", static_cast<int>(d.min_periods)), 0, 100000));
+  const JsonObject n = o.Object("nominal");
+  d.nominal.r_ohm = n.RequiredNumber("r_ohm");
+  d.nominal.l_h = n.RequiredNumber("l_h");
+  d.nominal.rp_ohm = n.RequiredNumber("rp_ohm");
+  d.nominal.f0_hz = n.RequiredNumber("f0_hz");
+  d.nominal.q = n.RequiredNumber("q");
+  n.RejectUnknown();
+  o.Require(d.max_peak_v <= 50.0, "max_peak_v", "must be at most 50 V (as peak_v)");
+  o.Require(d.nominal.f0_hz > r.excitation.f_lo_hz && d.nominal.f0_hz < r.excitation.f_hi_hz,
+            "nominal", "f0_hz must lie inside the excitation band");
+  std::string why;
+  o.Require(d.IsValid(&why), "sigma_f0_hz", why);
+  o.Require(r.excitation.peak_v <= d.max_peak_v * (1.0 + 1e-9), "max_peak_v",
+            "is below the excitation's peak_v " + Fixed(r.excitation.peak_v, 3) + " V");
+  o.RejectUnknown();
+  r.excitation_design = d;
+  if (!check_excitation) return;
+  const std::size_t periods = r.analysis.frf_method == analysis::FrfMethod::kTransientLpm
+                                  ? r.periods + r.transient_periods
+                                  : r.periods;
+  const double predicted = analysis::PredictedSigmaF0Hz(r.excitation, periods, d);
+  o.Require(predicted <= d.RequiredSigmaF0Hz() * (1.0 + 1e-6), "sigma_f0_hz",
+            "the excitation reaches std(f0) " + Fixed(predicted, 5) +
+                " Hz at the nominal motor (Cramer-Rao bound), more than the " +
+                Fixed(d.RequiredSigmaF0Hz(), 5) +
+                " Hz required: eol design-excitation designs one that meets it");
+}
+
+void ParseSequential(const JsonObject& o, Recipe& r) {
+  SequentialPolicy p;
+  const int extend = o.Integer("extend_periods", static_cast<int>(p.extend_periods));
+  p.max_extensions = o.Integer("max_extensions", p.max_extensions);
+  p.confidence_z = o.Number("confidence_z", p.confidence_z);
+  o.Require(extend >= 2 && extend <= 1000, "extend_periods", "must be in [2, 1000]");
+  o.Require(extend > static_cast<int>(r.transient_periods), "extend_periods",
+            "must exceed the excitation's transient_periods (they are played and dropped)");
+  o.Require(p.max_extensions >= 1 && p.max_extensions <= 5, "max_extensions", "must be in [1, 5]");
+  o.Require(p.confidence_z > 0.0 && p.confidence_z <= 10.0, "confidence_z", "must be in (0, 10]");
+  p.extend_periods = static_cast<std::size_t>(extend);
+  const double worst_s =
+      static_cast<double>(r.periods + r.transient_periods +
+                          p.extend_periods * static_cast<std::size_t>(p.max_extensions)) /
+      r.excitation.line_spacing_hz;
+  o.Require(worst_s <= kMaxExcitationS, "extend_periods",
+            "the longest sequential test excites a phase pair for " + Fixed(worst_s, 1) +
+                " s; at most " + Fixed(kMaxExcitationS, 0) + " s are allowed");
+  o.RejectUnknown();
+  r.sequential = p;
+}
+
 void ParseApproval(const JsonObject& o, Recipe& r) {
   RecipeApproval a;
   a.state = o.String("state", "");
@@ -303,7 +370,8 @@ std::string Sha256Hex(const std::string& data) {
 
 std::string CanonicalHash(const nlohmann::json& j) { return Sha256Hex(j.dump()); }
 
-Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
+Recipe ParseRecipe(const nlohmann::json& j, const std::string& source,
+                   const RecipeParseOptions& options) {
   try {
     const JsonObject root(j, "");
     Recipe r;
@@ -342,6 +410,9 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source) {
     if (auto i = root.OptionalObject("instructions")) ParseInstructions(*i, r);
     if (auto a = root.OptionalObject("approval")) ParseApproval(*a, r);
     if (auto b = root.OptionalObject("bond_index")) ParseBondIndex(*b, r);
+    if (auto q = root.OptionalObject("sequential")) ParseSequential(*q, r);
+    if (auto d = root.OptionalObject("excitation_design"))
+      ParseExcitationDesign(*d, r, options.check_excitation_design);
     const bool index_declared =
         std::any_of(r.limits.begin(), r.limits.end(), [](const analysis::MeasurementSpec& s) {
           return s.name == analysis::names::kBondIndexPct;
@@ -406,6 +477,25 @@ nlohmann::json ConditionsJson(const ConditionWindows& w) {
 }
 
 }  // namespace
+
+nlohmann::json ExcitationDesignJson(const analysis::ExcitationRequirement& d) {
+  const analysis::MotionalImpedance& n = d.nominal;
+  nlohmann::json j = {
+      {"sigma_f0_hz", d.sigma_f0_hz},
+      {"verdict_margin_hz", d.verdict_margin_hz},
+      {"margin_z", d.margin_z},
+      {"noise_v_rms", d.noise_v_rms},
+      {"noise_a_rms", d.noise_a_rms},
+      {"max_peak_v", d.max_peak_v},
+      {"lines_per_half_power_band", d.lines_per_half_power_band},
+      {"min_periods", d.min_periods},
+      {"nominal",
+       {{"r_ohm", n.r_ohm}, {"l_h", n.l_h}, {"rp_ohm", n.rp_ohm}, {"f0_hz", n.f0_hz}, {"q", n.q}}}};
+  if (std::isfinite(d.current_full_scale_a)) j["current_full_scale_a"] = d.current_full_scale_a;
+  if (std::isfinite(d.max_v_rms)) j["max_v_rms"] = d.max_v_rms;
+  if (std::isfinite(d.max_a_rms)) j["max_a_rms"] = d.max_a_rms;
+  return j;
+}
 
 nlohmann::json InstructionsJson(const OperatorInstructions& i) {
   return {{"fail", i.fail}, {"error", i.error}, {"aborted", i.aborted}};
@@ -474,6 +564,11 @@ nlohmann::json RecipeToJson(const Recipe& r) {
     j["bond_index"] = {{"f0_exponent", r.bond_index->f0_exponent},
                        {"f0_ref_hz", r.bond_index->f0_ref_hz},
                        {"residue_ref_ohm_per_s", r.bond_index->residue_ref_ohm_per_s}};
+  if (r.sequential)
+    j["sequential"] = {{"extend_periods", r.sequential->extend_periods},
+                       {"max_extensions", r.sequential->max_extensions},
+                       {"confidence_z", r.sequential->confidence_z}};
+  if (r.excitation_design) j["excitation_design"] = ExcitationDesignJson(*r.excitation_design);
   if (r.approval) {
     j["approval"] = {{"state", r.approval->state}, {"by", r.approval->by}, {"at", r.approval->at}};
     if (!r.approval->note.empty()) j["approval"]["note"] = r.approval->note;

@@ -25,6 +25,19 @@
 //   "bond_index": {"f0_exponent": 5.3, "f0_ref_hz": 390, "residue_ref_ohm_per_s": 25.6}
 //                  optional; required by a limit on bond_index_pct (analysis/qc/bond_index.h;
 //                  eol teach writes it from the golden units)
+//   "sequential": {"extend_periods": 8, "max_extensions": 1, "confidence_z": 3}   optional
+//                  (SequentialPolicy below)
+//   "excitation_design": {"sigma_f0_hz": 0.009, "verdict_margin_hz": 0, "margin_z": 3,
+//                  "noise_v_rms": 0.002, "noise_a_rms": 0.001, "max_peak_v": 10,
+//                  "current_full_scale_a": 2, "max_v_rms": 8, "max_a_rms": 3,
+//                  "lines_per_half_power_band": 2, "min_periods": 2,
+//                  "nominal": {"r_ohm": 0.5, "l_h": 0.002, "rp_ohm": 0.53, "f0_hz": 390, "q": 50}}
+//                  optional (analysis/signal/excitation_design.h): the std(f0) the excitation
+//                  must reach at the nominal motor (the Cramer-Rao bound with the DAQ's noise);
+//                  a recipe whose excitation does not is refused. The amplitude limits are
+//                  max_peak_v, max_v_rms and max_a_rms (heating; optional) and 0.8 of the
+//                  current channel's full scale (optional).
+//                  `eol design-excitation` writes the shortest excitation that meets it.
 // }
 // Validated on load: every message names the JSON path and the rule broken, and a recipe
 // that fails validation is never used. The hash is the SHA-256 of the canonical JSON (keys
@@ -41,6 +54,7 @@
 #include "analysis/qc/bond_index.h"
 #include "analysis/qc/curve_mask.h"
 #include "analysis/qc/measurement.h"
+#include "analysis/signal/excitation_design.h"
 #include "analysis/signal/multisine.h"
 #include "drivers/fixture/fixture.h"
 #include "station/conditions.h"
@@ -86,6 +100,20 @@ struct RecipeApproval {
   bool operator==(const RecipeApproval&) const = default;
 };
 
+// Sequential decision (issue 16): after each phase pair's first look (the excitation's periods),
+// while a measurement is undecided at confidence_z (analysis/qc/measurement.h
+// UndecidedMeasurements: within z sigma, or its marginal band, of a bound) the pair is excited
+// again for extend_periods periods from rest, and the looks are combined line by line by
+// inverse variance (analysis/frf.h CombineIndependent) and analysed again; at most
+// max_extensions times. Units far from every limit stop after the first look.
+//   "sequential": {"extend_periods": 8, "max_extensions": 1, "confidence_z": 3}
+struct SequentialPolicy {
+  std::size_t extend_periods = 8;
+  int max_extensions = 1;
+  double confidence_z = 3.0;
+  bool operator==(const SequentialPolicy&) const = default;
+};
+
 struct Recipe {
   std::string id;
   int version = 0;
@@ -121,6 +149,10 @@ struct Recipe {
   OperatorInstructions instructions;
   std::optional<RecipeApproval> approval;
   std::optional<analysis::BondIndexDefinition> bond_index;
+  // The precision the excitation is designed for (issue 16); the recipe's own excitation must
+  // reach it at the nominal motor, or the recipe is refused.
+  std::optional<analysis::ExcitationRequirement> excitation_design;
+  std::optional<SequentialPolicy> sequential;
 
   bool Approved() const { return !approval || approval->state == "approved"; }
   // Empty when Approved(); else why the station refuses it, naming how to approve it.
@@ -132,8 +164,14 @@ struct Recipe {
   nlohmann::json source;  // the recipe as loaded
 };
 
+struct RecipeParseOptions {
+  // false only for `eol design-excitation`, which reads a recipe whose excitation does not yet
+  // meet its stated requirement in order to design one that does.
+  bool check_excitation_design = true;
+};
 // Throws io::ConfigError with "<source>: <json path>: <rule>".
-Recipe ParseRecipe(const nlohmann::json& j, const std::string& source);
+Recipe ParseRecipe(const nlohmann::json& j, const std::string& source,
+                   const RecipeParseOptions& options = {});
 Recipe LoadRecipe(const std::string& path);
 // Writes a recipe's JSON (2-space indent) to `path` through `path`.tmp and a rename, so a
 // reader never sees half a file (atomic on one file system). Throws std::runtime_error naming
@@ -147,6 +185,8 @@ void WriteRecipeFile(const std::string& path, const nlohmann::json& j);
 nlohmann::json RecipeToJson(const Recipe& r);
 // One curve mask in the recipe's "masks" schema.
 nlohmann::json MaskJson(const analysis::CurveMask& mask);
+// The recipe's "excitation_design" schema, every key written out.
+nlohmann::json ExcitationDesignJson(const analysis::ExcitationRequirement& d);
 // The recipe's "instructions" schema, every key written out (the page reads it from
 // GET /api/recipe).
 nlohmann::json InstructionsJson(const OperatorInstructions& instructions);

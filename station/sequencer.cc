@@ -302,7 +302,7 @@ void Sequencer::ClampAndConfirm(db::TestRecord& record) {
   record.conditions["phase_pair"] = static_cast<int>(recipe_->phase_pair);
 }
 
-analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
+analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size_t periods) {
   // Re-check right before closing the relay: nothing may have changed since confirmation.
   // (Still in the clamp's state: the excite state, and the cycle's excitation step, begin
   // when the stator is about to be excited.)
@@ -311,13 +311,13 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record) {
     throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock before excitation: " + why}};
   ThrowIfAborted();
   Enter(record, SeqState::kExcite,
-        std::to_string(recipe_->transient_periods + recipe_->periods) + " periods of " +
-            Fixed(1.0 / excitation_.line_spacing_hz, 3) + " s");
+        std::to_string(periods) + " periods of " + Fixed(1.0 / excitation_.line_spacing_hz, 3) +
+            " s");
 
   drivers::AcquisitionRequest req;
   req.sample_rate_hz = excitation_.sample_rate_hz;
   req.period_samples = excitation_.period_samples;
-  req.excitation_v = excitation_.Repeat(recipe_->transient_periods + recipe_->periods);
+  req.excitation_v = excitation_.Repeat(periods);
   record.conditions["excitation_peak_v"] = recipe_->excitation.peak_v;
   record.conditions["crest_factor"] = excitation_.crest_factor;
   record.conditions["line_spacing_hz"] = excitation_.line_spacing_hz;
@@ -379,10 +379,12 @@ void Sequencer::MeasurePair(db::TestRecord& record, std::size_t k,
           Outcome::kError,
           {ReasonCode::kFixture, "phase pair " + std::string(PairName(pair)) + ": " + s.message()}};
   }
-  analysis::Recording recording = ExciteAndRecord(record);
+  analysis::Recording recording =
+      ExciteAndRecord(record, recipe_->transient_periods + recipe_->periods);
   Enter(record, SeqState::kAnalyse);
   analysis::ImpedanceAnalysis a =
       analysis::AnalyzeRecording(recording, excitation_.lines, recipe_->analysis);
+  if (recipe_->sequential) ExtendWhileUndecided(record, pair, suffix, recording, a);
   if (a.frf.frf.size() > 0) record.curves.push_back(ToCurve(a.frf.frf, "impedance" + suffix));
   record.conditions["periods_used"] = a.frf.periods_used;
   if (!a.fit.params.empty()) {
@@ -390,6 +392,45 @@ void Sequencer::MeasurePair(db::TestRecord& record, std::size_t k,
     record.curves.push_back(ToCurve(a.fit.Model().Evaluate(a.frf.frf.freq_hz), "model" + suffix));
   }
   measured.push_back({pair, std::move(recording), std::move(a)});
+}
+
+void Sequencer::ExtendWhileUndecided(db::TestRecord& record, drivers::PhasePair pair,
+                                     const std::string& suffix, analysis::Recording& recording,
+                                     analysis::ImpedanceAnalysis& a) {
+  const SequentialPolicy& policy = *recipe_->sequential;
+  int looks = 1;
+  nlohmann::json undecided_seen = nlohmann::json::array();
+  for (int extension = 0; extension < policy.max_extensions && a.usable; ++extension) {
+    // The one judge on this pair alone; its conditions are not kept (the verdict's are).
+    nlohmann::json scratch = record.conditions;
+    const PairMeasurement m{pair, &a, &recording};
+    const Judgement j = JudgeUnit(*recipe_, std::span<const PairMeasurement>(&m, 1), scratch);
+    const std::vector<std::string> undecided =
+        analysis::UndecidedMeasurements(j.measurements, policy.confidence_z);
+    if (undecided.empty()) break;
+    for (const std::string& name : undecided) undecided_seen.push_back(name + suffix);
+    Enter(
+        record, SeqState::kAnalyse,
+        "undecided at z " + Fixed(policy.confidence_z, 1) + ": " + undecided.front() +
+            (undecided.size() > 1 ? " and " + std::to_string(undecided.size() - 1) + " more" : "") +
+            "; extending");
+    analysis::Recording more = ExciteAndRecord(record, policy.extend_periods);
+    Enter(record, SeqState::kAnalyse, "look " + std::to_string(looks + 1));
+    analysis::ImpedanceAnalysis b =
+        analysis::AnalyzeRecording(more, excitation_.lines, recipe_->analysis);
+    recording = std::move(more);  // the conditions are judged on the newest look
+    ++looks;
+    if (!b.usable) {  // the verdict is then the extension's ERROR, never the first look's
+      a = std::move(b);
+      break;
+    }
+    analysis::FrfSummary frf = b.frf;
+    frf.frf = analysis::CombineIndependent(a.frf.frf, b.frf.frf);
+    a = analysis::AnalyzeImpedance(frf.frf, recipe_->analysis.fit);
+    a.frf = std::move(frf);
+  }
+  record.conditions["looks" + suffix] = looks;
+  if (!undecided_seen.empty()) record.conditions["undecided" + suffix] = undecided_seen;
 }
 
 void Sequencer::Judge(db::TestRecord& record, const std::vector<MeasuredPair>& measured) {

@@ -113,12 +113,19 @@ class Sequencer {
   drivers::FixtureInputs ReadInputs(const char* purpose);
   void CheckInterlocks(db::TestRecord& record);
   void ClampAndConfirm(db::TestRecord& record);
-  analysis::Recording ExciteAndRecord(db::TestRecord& record);
+  // Plays `periods` periods of the excitation (the first look: transient + averaged periods).
+  analysis::Recording ExciteAndRecord(db::TestRecord& record, std::size_t periods);
   // The recipe's phase pair k in the same clamping (k > 0: relay off, switch the pair first):
   // excite, analyse, record the curves ("impedance", "model"; "<name>@<pair>" for k > 0) and,
   // for the first pair, the fit summary. Appends the recording and analysis to `measured`.
+  // With a "sequential" recipe, a pair whose measurements are undecided after a look is
+  // excited again and the looks combined (station/recipe.h SequentialPolicy); the record's
+  // conditions keep the looks ("looks", "looks@<pair>") and what was undecided.
   struct MeasuredPair;
   void MeasurePair(db::TestRecord& record, std::size_t k, std::vector<MeasuredPair>& measured);
+  void ExtendWhileUndecided(db::TestRecord& record, drivers::PhasePair pair,
+                            const std::string& suffix, analysis::Recording& recording,
+                            analysis::ImpedanceAnalysis& a);
   // The verdict of every pair measured, by the one judge (station/judge.h): the sequencer
   // decides nothing about the motor itself.
   void Judge(db::TestRecord& record, const std::vector<MeasuredPair>& measured);

@@ -15,7 +15,8 @@ namespace eol::analysis {
 namespace {
 
 constexpr std::uint64_t kGoldenIndexBase = 1000000000ULL;
-constexpr std::uint64_t kPodIndexBase = 2000000000ULL;  // + sweep x 1e8 + unit
+constexpr std::uint64_t kPodIndexBase = 2000000000ULL;           // + sweep x 1e8 + unit
+constexpr std::uint64_t kExtensionSeed = 0xA5A5A5A55A5A5A5AULL;  // a sequential look's noise
 
 std::size_t ClassIndex(DefectClass c) {
   for (std::size_t i = 0; i < kAllDefectClasses.size(); ++i)
@@ -43,8 +44,8 @@ Measured MeasureUnit(const ProductionBenchOptions& o, const LineMeasurementSetup
   return m;
 }
 
-Outcome JudgeWith(const std::vector<MeasurementSpec>& limits, const std::vector<CurveMask>& masks,
-                  const std::optional<BondIndexDefinition>& bond_index, const Measured& m) {
+Verdict VerdictWith(const std::vector<MeasurementSpec>& limits, const std::vector<CurveMask>& masks,
+                    const std::optional<BondIndexDefinition>& bond_index, const Measured& m) {
   std::vector<MeasurementSpec> specs = limits;
   std::map<std::string, Estimate> values = m.analysis.values;
   if (bond_index) AddBondIndex(values, *bond_index);
@@ -54,7 +55,32 @@ Outcome JudgeWith(const std::vector<MeasurementSpec>& limits, const std::vector<
       values[mask.MeasurementName()] =
           Estimate{static_cast<double>(CheckMask(m.frf, mask).lines_outside), 0.0};
   }
-  return Judge(specs, values).outcome;
+  return Judge(specs, values);
+}
+
+Outcome JudgeWith(const std::vector<MeasurementSpec>& limits, const std::vector<CurveMask>& masks,
+                  const std::optional<BondIndexDefinition>& bond_index, const Measured& m) {
+  return VerdictWith(limits, masks, bond_index, m).outcome;
+}
+
+// The station's sequential decision (station/recipe.h SequentialPolicy) under the limits in
+// force (the taught ones): while a measurement is undecided, a further look of
+// o.extend_periods periods with its own noise, combined by inverse variance and analysed
+// again. Returns the looks taken.
+int ExtendWhileUndecided(const ProductionBenchOptions& o, const LineMeasurementSetup& extension,
+                         const TeachSummary& teach, const LineUnit& unit, std::uint64_t index,
+                         Measured& m) {
+  int looks = 1;
+  for (int e = 0; e < o.max_extensions && m.analysis.usable; ++e) {
+    const Verdict v = VerdictWith(teach.limits, teach.masks, teach.bond_index, m);
+    if (UndecidedMeasurements(v.measurements, o.confidence_z).empty()) break;
+    const Frf more = MeasureLineUnit(extension, ModalImpedance(unit.motor, extension.freq_hz),
+                                     NoiseSeed(o.seed ^ kExtensionSeed * (e + 1), index));
+    m.frf = CombineIndependent(m.frf, more);
+    m.analysis = AnalyzeImpedance(m.frf, o.fit);
+    ++looks;
+  }
+  return looks;
 }
 
 double ResonanceHz(const Measured& m) {
@@ -83,7 +109,8 @@ void ParallelFor(const ProductionBenchOptions& o, std::string_view phase, int n,
 }
 
 void RunPodSweep(const ProductionBenchOptions& o, const LineMeasurementSetup& setup,
-                 const TeachSummary& teach, std::uint64_t sweep, PodSweep& w) {
+                 const LineMeasurementSetup& extension, const TeachSummary& teach,
+                 std::uint64_t sweep, PodSweep& w) {
   const auto n = static_cast<std::size_t>(o.pod_units);
   w.data.assign(n, HitMiss{});
   w.f0_hz.assign(n, std::nan(""));
@@ -96,7 +123,8 @@ void RunPodSweep(const ProductionBenchOptions& o, const LineMeasurementSetup& se
     nominal.bond_poor = {o.rotor.bond.stiffness_nm_per_rad * (1.0 - loss),
                          o.rotor.bond.damping_nms_per_rad * (1.0 - loss)};
     const LineUnit unit = DrawLineUnit(nominal, o.spread, w.defect, o.seed, index);
-    const Measured m = MeasureUnit(o, setup, unit, index);
+    Measured m = MeasureUnit(o, setup, unit, index);
+    if (o.max_extensions > 0) ExtendWhileUndecided(o, extension, teach, unit, index, m);
     const auto k = static_cast<std::size_t>(i);
     w.data[k] = {loss, JudgeWith(teach.limits, teach.masks, teach.bond_index, m) != Outcome::kPass};
     w.f0_hz[k] = ResonanceHz(m);
@@ -137,6 +165,9 @@ bool ProductionBenchOptions::IsValid(std::string* why) const {
   if (golden_units < 3 || golden_units > 100000) return fail("golden_units must be in [3, 100000]");
   if (threads < 1 || threads > 64) return fail("threads must be in [1, 64]");
   if (periods < 1) return fail("periods must be at least 1");
+  if (max_extensions < 0 || max_extensions > 5) return fail("max_extensions must be in [0, 5]");
+  if (max_extensions > 0 && (extend_periods < 1 || !(confidence_z > 0.0)))
+    return fail("a sequential bench needs extend_periods >= 1 and confidence_z > 0");
   if (!(voltage_noise_v > 0.0 && current_noise_a > 0.0))
     return fail("the channel noise must be positive (the sigma of every line comes from it)");
   std::string w;
@@ -181,6 +212,10 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
   const LineMeasurementSetup setup =
       MakeLineMeasurement(o.excitation, o.periods, o.voltage_noise_v, o.current_noise_a);
   const int threads = o.threads;
+  const LineMeasurementSetup extension =
+      o.max_extensions > 0 ? MakeLineMeasurement(o.excitation, o.extend_periods, o.voltage_noise_v,
+                                                 o.current_noise_a)
+                           : setup;
 
   // 1. Golden units and teaching.
   std::vector<GoldenUnit> golden(static_cast<std::size_t>(o.golden_units));
@@ -216,8 +251,10 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
     for (int i = next++; i < o.units; i = next++) {
       const auto index = static_cast<std::uint64_t>(i);
       const LineUnit unit = DrawLineUnit(o.rotor, o.spread, o.rates, o.seed, index);
-      const Measured m = MeasureUnit(o, setup, unit, index);
+      Measured m = MeasureUnit(o, setup, unit, index);
       const std::size_t c = ClassIndex(unit.defect);
+      if (o.max_extensions > 0 && ExtendWhileUndecided(o, extension, s.teach, unit, index, m) > 1)
+        ++local.extended[c];
       Count(local.counts[0][c], JudgeWith(s.teach.limits, s.teach.masks, s.teach.bond_index, m));
       Count(local.counts[1][c], JudgeWith(o.declared, o.recipe_masks, o.recipe_bond_index, m));
       Count(local.counts[2][c], NaivePass(m.frf, o.naive) ? Outcome::kPass : Outcome::kFail);
@@ -234,6 +271,7 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
         s.counts[r][c].fail += local.counts[r][c].fail;
         s.counts[r][c].error += local.counts[r][c].error;
       }
+    for (std::size_t c = 0; c < kAllDefectClasses.size(); ++c) s.extended[c] += local.extended[c];
     for (std::size_t c = 0; c < kAllDefectClasses.size(); ++c)
       s.f0_hz[c].insert(s.f0_hz[c].end(), local.f0_hz[c].begin(), local.f0_hz[c].end());
   };
@@ -248,7 +286,8 @@ ProductionBenchSummary RunProductionBench(const ProductionBenchOptions& o) {
     s.pod[0].defect = DefectClass::kOneSoftMagnet;
     s.pod[1].name = "all_magnets";
     s.pod[1].defect = DefectClass::kAllSoft;
-    for (std::size_t k = 0; k < s.pod.size(); ++k) RunPodSweep(o, setup, s.teach, k, s.pod[k]);
+    for (std::size_t k = 0; k < s.pod.size(); ++k)
+      RunPodSweep(o, setup, extension, s.teach, k, s.pod[k]);
   }
 
   s.units = o.units;

@@ -47,6 +47,12 @@ struct ProductionBenchOptions {
   std::size_t periods = 4;
   double voltage_noise_v = 2.0e-3;  // the simulated DAQ's, rms per sample
   double current_noise_a = 1.0e-3;
+  // The recipe's sequential decision (station/recipe.h SequentialPolicy; max_extensions 0:
+  // none), judged against the taught limits: production units and POD sweeps take further looks
+  // of extend_periods periods while a measurement is undecided at confidence_z.
+  int max_extensions = 0;
+  std::size_t extend_periods = 8;
+  double confidence_z = 3.0;
   ResonanceFitOptions fit;                               // the recipe's analysis options
   std::vector<MeasurementSpec> declared;                 // the recipe's scalar limits
   std::vector<CurveMask> recipe_masks;                   // the recipe's masks (the "recipe" rule)
@@ -100,6 +106,8 @@ struct ProductionBenchSummary {
   std::vector<PodSweep> pod;
   // Fitted f0 of every production unit per class (kAllDefectClasses order; usable fits only).
   std::array<std::vector<double>, kAllDefectClasses.size()> f0_hz{};
+  // Production units that took more than one look, per class (sequential recipes only).
+  std::array<int, kAllDefectClasses.size()> extended{};
   int units = 0;
   double seconds = 0.0;  // wall time of the whole benchmark
   double golden_seconds = 0.0;

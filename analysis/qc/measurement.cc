@@ -1,5 +1,6 @@
 #include "analysis/qc/measurement.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -136,6 +137,21 @@ Verdict Judge(const std::vector<MeasurementSpec>& specs,
   }
   v.outcome = missing ? Outcome::kError : failed ? Outcome::kFail : Outcome::kPass;
   return v;
+}
+
+std::vector<std::string> UndecidedMeasurements(const std::vector<Measurement>& measurements,
+                                               double z) {
+  std::vector<std::string> out;
+  for (const Measurement& m : measurements) {
+    if (!std::isfinite(m.value)) continue;
+    double band = m.limit.marginal;
+    if (std::isfinite(m.sigma) && m.sigma > 0.0) band = std::max(band, z * m.sigma);
+    if (!(band > 0.0)) continue;
+    const bool near_lo = m.limit.lo && std::abs(m.value - *m.limit.lo) < band;
+    const bool near_hi = m.limit.hi && std::abs(m.value - *m.limit.hi) < band;
+    if (near_lo || near_hi) out.push_back(m.name);
+  }
+  return out;
 }
 
 }  // namespace eol::analysis

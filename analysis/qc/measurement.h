@@ -110,4 +110,13 @@ Verdict Judge(const std::vector<MeasurementSpec>& specs,
               const std::map<std::string, Estimate>& values,
               ReasonCode out_of_limits = ReasonCode::kLimit);
 
+// Sequential decision (issue 16): the measurements whose outcome the data do not yet decide at
+// confidence z. A measurement is undecided when it lies closer to a bound it declares, on
+// either side, than max(z sigma, marginal): its own uncertainty (where it has one) or the
+// recipe's marginal band (statistics without a sigma, e.g. chi2 and mask counts with a band)
+// could put it on the other side. A value that is not finite is never undecided (it is
+// ERROR, and more data of a broken measurement does not help). Returns their names in order.
+std::vector<std::string> UndecidedMeasurements(const std::vector<Measurement>& measurements,
+                                               double z);
+
 }  // namespace eol::analysis

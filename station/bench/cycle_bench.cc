@@ -61,6 +61,7 @@ std::map<std::string, UnitResult> RunRecipe(const CycleBenchOptions& o,
     } else {
       summary.false_rejects += r.outcome == analysis::Outcome::kFail;
     }
+    summary.extended += r.conditions.value("looks", 1) > 1;
     excitation.push_back(CycleStepS(r.cycle_s, "excitation"));
     cycle.push_back(CycleStepS(r.cycle_s, "total"));
     overhead.push_back(StationOverheadS(r.cycle_s));
@@ -145,6 +146,7 @@ nlohmann::json ToJson(const CycleBenchResult& r) {
                           {"defective", c.defective},
                           {"caught", c.caught},
                           {"false_rejects", c.false_rejects},
+                          {"extended", c.extended},
                           {"excitation_s", c.excitation_s},
                           {"cycle_s", c.cycle_s},
                           {"overhead_s", c.overhead_s},

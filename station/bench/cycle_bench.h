@@ -38,6 +38,7 @@ struct CycleBenchRecipe {
   std::string excitation;  // "4 Hz lines, 0 + 2 periods, transient_lpm"
   int units = 0, pass = 0, fail = 0, error = 0;
   int defective = 0, caught = 0, false_rejects = 0;
+  int extended = 0;  // units that took more than one look (a sequential recipe)
   double excitation_s = 0, cycle_s = 0, overhead_s = 0;  // medians per unit
   double f0_sigma_hz = 0;                                // median reported sigma of f0
 };

@@ -28,5 +28,6 @@ void AddCycleBenchCommand(CLI::App& app);
 void AddPodCommand(CLI::App& app);
 void AddRecipeApproveCommand(CLI::App& app);
 void AddPlantBenchCommand(CLI::App& app);
+void AddDesignExcitationCommand(CLI::App& app);
 
 }  // namespace eol::station::cli

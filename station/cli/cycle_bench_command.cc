@@ -22,8 +22,8 @@ void PrintRecipe(const char* label, const CycleBenchRecipe& c) {
       c.excitation_s, c.cycle_s, c.overhead_s, c.f0_sigma_hz);
   std::printf(
       "          %d units: %d PASS, %d FAIL, %d ERROR; %d of %d defective caught, %d good "
-      "rejected\n",
-      c.units, c.pass, c.fail, c.error, c.caught, c.defective, c.false_rejects);
+      "rejected; %d extended (sequential)\n",
+      c.units, c.pass, c.fail, c.error, c.caught, c.defective, c.false_rejects, c.extended);
 }
 
 }  // namespace

@@ -33,6 +33,13 @@ std::string Percent(double v) {
   return buf;
 }
 
+// Units of class c that took more than one look (a sequential recipe).
+int ExtendedOf(const analysis::ProductionBenchSummary& s, analysis::DefectClass c) {
+  for (std::size_t i = 0; i < analysis::kAllDefectClasses.size(); ++i)
+    if (analysis::kAllDefectClasses[i] == c) return s.extended[i];
+  return 0;
+}
+
 json SummaryJson(const analysis::ProductionBenchSummary& s, const BenchArgs& a) {
   json classes = json::array();
   for (analysis::DefectClass c : analysis::kAllDefectClasses) {
@@ -43,6 +50,7 @@ json SummaryJson(const analysis::ProductionBenchSummary& s, const BenchArgs& a) 
     }
     classes.push_back({{"class", analysis::ToString(c)},
                        {"units", s.Counts(analysis::BenchRule::kTaught, c).units},
+                       {"extended", ExtendedOf(s, c)},
                        {"rules", rules}});
   }
   json rates = json::object();
@@ -88,6 +96,11 @@ int RunBench(BenchArgs a) {
   analysis::ProductionBenchOptions& o = a.options;
   o.excitation = r.excitation;
   o.periods = r.periods;
+  if (r.sequential) {
+    o.max_extensions = r.sequential->max_extensions;
+    o.extend_periods = r.sequential->extend_periods;
+    o.confidence_z = r.sequential->confidence_z;
+  }
   o.fit = r.analysis.fit;
   o.declared = r.limits;
   o.recipe_masks = r.masks;
@@ -143,6 +156,17 @@ int RunBench(BenchArgs a) {
     std::snprintf(hb, sizeof hb, "%d/%d/%d", h.pass, h.fail, h.error);
     std::snprintf(nb, sizeof nb, "%d/%d", n.pass, n.fail);
     std::printf("%-18s %6d | %-22s | %-22s | %-22s\n", analysis::ToString(c), t.units, tb, hb, nb);
+  }
+  if (a.options.max_extensions > 0) {
+    std::cout << "sequential (up to " << a.options.max_extensions << " x "
+              << a.options.extend_periods << " more periods while undecided at z "
+              << a.options.confidence_z << "): extended";
+    int all = 0;
+    for (analysis::DefectClass c : analysis::kAllDefectClasses) {
+      std::cout << " " << analysis::ToString(c) << " " << ExtendedOf(s, c);
+      all += ExtendedOf(s, c);
+    }
+    std::cout << "; " << Percent(static_cast<double>(all) / std::max(1, s.units)) << " of all\n";
   }
   for (analysis::BenchRule rule : analysis::kBenchRules) {
     std::cout << analysis::ToString(rule) << ": false rejects " << Percent(s.FalseRejectRate(rule))

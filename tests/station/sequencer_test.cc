@@ -156,6 +156,58 @@ TEST_F(SequencerTest, EveryPhasePairOfTheRecipeIsMeasuredInOneClamping) {
   ExpectStored(bad);
 }
 
+// Issue 16's sequential decision: a unit whose measurements are decided stops after its first
+// look; one that sits near a limit (here: a marginal band wider than the window) is excited
+// again and judged on both looks combined, with a smaller sigma.
+TEST_F(SequencerTest, SequentialRecipeExtendsOnlyUndecidedUnits) {
+  Build(0.0);
+  recipe_.sequential =
+      SequentialPolicy{.extend_periods = 8, .max_extensions = 1, .confidence_z = 3.0};
+  auto rebuild = [&] {
+    SequencerOptions o;
+    o.station_id = "test";
+    sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
+                                             std::make_shared<const Recipe>(recipe_), *board_, o);
+  };
+  auto f0_of = [](const db::TestRecord& r) {
+    for (const auto& m : r.measurements)
+      if (m.name == analysis::names::kResonanceFHz) return m;
+    return analysis::Measurement{};
+  };
+  auto excitations = [](const db::TestRecord& r) {
+    return std::count_if(r.trace.begin(), r.trace.end(),
+                         [](const auto& t) { return t.state == "excite"; });
+  };
+  rebuild();
+  const db::TestRecord far = Test("SEQ-1", false);
+  EXPECT_EQ(far.outcome, Outcome::kPass) << (far.reasons.empty() ? "" : far.reasons[0].text);
+  EXPECT_EQ(far.conditions.value("looks", 0), 1);
+  EXPECT_FALSE(far.conditions.contains("undecided"));
+  EXPECT_EQ(excitations(far), 1);
+
+  for (auto& spec : recipe_.limits)
+    if (spec.name == analysis::names::kResonanceFHz) spec.limit.marginal = 100.0;
+  rebuild();
+  const db::TestRecord near = Test("SEQ-1", false);
+  EXPECT_EQ(near.outcome, Outcome::kPass) << (near.reasons.empty() ? "" : near.reasons[0].text);
+  EXPECT_EQ(near.conditions.value("looks", 0), 2);
+  ASSERT_TRUE(near.conditions.contains("undecided"));
+  EXPECT_EQ(near.conditions["undecided"][0], analysis::names::kResonanceFHz);
+  EXPECT_EQ(excitations(near), 2);
+  // 4 + 7 averaged periods against 4: sigma(f0) about sqrt(4 / 11) = 0.6 of the first look's.
+  EXPECT_LT(f0_of(near).sigma, 0.8 * f0_of(far).sigma);
+  EXPECT_NEAR(f0_of(near).value, f0_of(far).value, 5 * f0_of(far).sigma);
+  // The stored curve is the combination of both looks: its sigma is smaller on every line.
+  const auto stored_far = store_->Test(far.id), stored_near = store_->Test(near.id);
+  ASSERT_TRUE(stored_far.has_value() && stored_near.has_value());
+  const auto& a = stored_far->curves.front().sigma;
+  const auto& b = stored_near->curves.front().sigma;
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_FALSE(a.empty());
+  for (std::size_t k = 0; k < a.size(); k += 50) EXPECT_LT(b[k], a[k]) << "line " << k;
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+}
+
 TEST_F(SequencerTest, PoorlyCementedRotorFailsOnResonance) {
   Build(0.0);
   const db::TestRecord r = Test("BAD-1", true);

@@ -1,0 +1,116 @@
+// The recipe's "excitation_design" requirement (station/recipe.h) and `eol design-excitation`:
+// a recipe whose excitation misses the precision it states is refused, naming the field; the
+// command writes the shortest excitation that meets it as a proposal that loads.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "drivers/io/json_config.h"
+#include "station/recipe.h"
+#include "tests/support/child_process.h"
+
+namespace eol::station {
+namespace {
+
+using testing::ChildProcess;
+using testing::TempDir;
+
+const std::string kFast = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json";
+
+std::string ErrorOf(const nlohmann::json& j) {
+  try {
+    ParseRecipe(j, "test.json");
+  } catch (const io::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ExcitationDesignRecipe, FastRecipeStatesItsRequirementAndMeetsIt) {
+  const Recipe r = LoadRecipe(kFast);
+  ASSERT_TRUE(r.excitation_design.has_value());
+  const double predicted = analysis::PredictedSigmaF0Hz(
+      r.excitation, r.periods + r.transient_periods, *r.excitation_design);
+  EXPECT_LE(predicted, r.excitation_design->RequiredSigmaF0Hz() * (1 + 1e-6));
+  EXPECT_LE(static_cast<double>(r.periods + r.transient_periods) / r.excitation.line_spacing_hz,
+            0.5);
+  const nlohmann::json written = RecipeToJson(r);
+  EXPECT_EQ(RecipeToJson(ParseRecipe(written, "written")), written);
+}
+
+TEST(ExcitationDesignRecipe, ExcitationThatMissesItsRequirementIsRefused) {
+  nlohmann::json j = io::ReadJsonFile(kFast);
+  j["excitation"]["peak_v"] = j["excitation"]["peak_v"].get<double>() / 2;
+  const std::string e = ErrorOf(j);
+  EXPECT_NE(e.find("/excitation_design/sigma_f0_hz: the excitation reaches std(f0)"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("eol design-excitation"), std::string::npos) << e;
+  j = io::ReadJsonFile(kFast);
+  j["excitation_design"]["nominal"].erase("q");
+  EXPECT_NE(ErrorOf(j).find("/excitation_design/nominal/q: missing"), std::string::npos)
+      << ErrorOf(j);
+  j = io::ReadJsonFile(kFast);
+  j["excitation_design"]["max_peak_v"] = 1.0;  // below the excitation's own peak
+  EXPECT_NE(ErrorOf(j).find("/excitation_design/max_peak_v"), std::string::npos) << ErrorOf(j);
+}
+
+TEST(ExcitationDesignCli, WritesTheShortestExcitationAsAProposal) {
+  TempDir dir;
+  // The usual case: a recipe whose excitation does not (yet) meet what it states. It does not
+  // load, but the designer reads it.
+  nlohmann::json weak = io::ReadJsonFile(kFast);
+  weak["excitation"]["peak_v"] = weak["excitation"]["peak_v"].get<double>() / 2;
+  ASSERT_NE(ErrorOf(weak), "");
+  const std::string input = dir / "weak.json";
+  std::ofstream(input) << weak.dump(2);
+  const std::string out = dir / "designed.json";
+  ChildProcess p({EOL_BINARY, "design-excitation", "--recipe", input, "--sigma-f0-hz", "0.004",
+                  "--out", out, "--json"},
+                 /*merge_stderr=*/false);
+  ASSERT_EQ(p.Wait(std::chrono::seconds(60)), 0) << p.output();
+  const nlohmann::json j = nlohmann::json::parse(p.output());
+  ASSERT_TRUE(j["usable"].get<bool>()) << j.dump(2);
+  const nlohmann::json& c = j["chosen"];
+  EXPECT_LE(c["sigma_f0_hz"].get<double>(), 0.004 * (1 + 1e-6));
+  for (const auto& other : j["candidates"]) {
+    if (other["meets"].get<bool>()) {
+      EXPECT_GE(other["record_s"].get<double>(), c["record_s"].get<double>() - 1e-9);
+    }
+  }
+
+  const Recipe fast = LoadRecipe(kFast);
+  const Recipe designed = LoadRecipe(out);  // loads: its bound was checked on load
+  EXPECT_EQ(designed.version, fast.version + 1);
+  ASSERT_TRUE(designed.approval.has_value());
+  EXPECT_EQ(designed.approval->state, "proposed");
+  EXPECT_FALSE(designed.Approved());
+  EXPECT_DOUBLE_EQ(designed.excitation.peak_v, c["peak_v"].get<double>());
+  EXPECT_DOUBLE_EQ(designed.excitation.line_spacing_hz, c["line_spacing_hz"].get<double>());
+  EXPECT_EQ(designed.periods, c["periods"].get<std::size_t>());
+  EXPECT_EQ(designed.analysis.frf_method, analysis::FrfMethod::kTransientLpm);
+  ASSERT_TRUE(designed.excitation_design.has_value());
+  EXPECT_DOUBLE_EQ(designed.excitation_design->sigma_f0_hz, 0.004);
+  // Twice the precision costs four times the information: more periods or more amplitude.
+  EXPECT_GT(static_cast<double>(designed.periods) * designed.excitation.peak_v *
+                designed.excitation.peak_v,
+            3.0 * static_cast<double>(fast.periods) * fast.excitation.peak_v *
+                fast.excitation.peak_v * designed.excitation.line_spacing_hz /
+                fast.excitation.line_spacing_hz);
+
+  // Never overwrites without --force.
+  ChildProcess again({EOL_BINARY, "design-excitation", "--recipe", kFast, "--out", out});
+  EXPECT_EQ(again.Wait(std::chrono::seconds(60)), 2);
+  EXPECT_NE(again.output().find("refusing to overwrite"), std::string::npos) << again.output();
+}
+
+TEST(ExcitationDesignCli, RecipeWithoutRequirementNamesTheBlock) {
+  ChildProcess p({EOL_BINARY, "design-excitation", "--recipe",
+                  std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"});
+  EXPECT_EQ(p.Wait(std::chrono::seconds(60)), 2);
+  EXPECT_NE(p.output().find("has no \"excitation_design\" block"), std::string::npos) << p.output();
+}
+
+}  // namespace
+}  // namespace eol::station
