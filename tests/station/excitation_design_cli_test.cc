@@ -9,6 +9,7 @@
 #include "drivers/io/json_config.h"
 #include "station/recipe.h"
 #include "tests/support/child_process.h"
+#include "tests/support/recipe_error.h"
 
 namespace eol::station {
 namespace {
@@ -18,14 +19,7 @@ using testing::TempDir;
 
 const std::string kFast = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json";
 
-std::string ErrorOf(const nlohmann::json& j) {
-  try {
-    ParseRecipe(j, "test.json");
-  } catch (const io::ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string ErrorOf(const nlohmann::json& j) { return testing::RecipeErrorOf(j); }
 
 TEST(ExcitationDesignRecipe, FastRecipeStatesItsRequirementAndMeetsIt) {
   const Recipe r = LoadRecipe(kFast);

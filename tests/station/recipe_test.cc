@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "../support/child_process.h"
+#include "../support/recipe_error.h"
 #include "drivers/io/json_config.h"
 
 namespace eol::station {
@@ -17,14 +18,7 @@ const std::string kRecipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.
 
 nlohmann::json Good() { return io::ReadJsonFile(kRecipe); }
 
-std::string ErrorOf(const nlohmann::json& j) {
-  try {
-    ParseRecipe(j, "test.json");
-  } catch (const io::ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string ErrorOf(const nlohmann::json& j) { return testing::RecipeErrorOf(j); }
 
 TEST(Recipe, ShippedRecipeLoads) {
   const Recipe r = LoadRecipe(kRecipe);
