@@ -516,7 +516,10 @@ TEST(EngineerPage, ShowsChartsCapabilityDetectabilityAndFiguresFromFiles) {
   for (const auto& m : stats["recipes"][0]["measurements"])
     if (m["name"] == "resonance_f_hz") f0 = m;
   ASSERT_FALSE(f0.is_null()) << stats;
-  const auto detect = nlohmann::json::parse(http.Get("/api/detectability")->body);
+  const auto detect_reply = http.Get("/api/detectability");
+  ASSERT_TRUE(detect_reply) << "GET /api/detectability: "
+                            << httplib::to_string(detect_reply.error());
+  const auto detect = nlohmann::json::parse(detect_reply->body);
 
   // Files to upload: a hits table and the gap inputs (a nominal simulation, a unit measured
   // with a channel delay).
