@@ -119,7 +119,8 @@ analysis::Frf ReadZma(const std::string& path) {
       throw FileError(path, ln, words[0].second, "frequencies must increase strictly");
     if (v[1] < 0.0) throw FileError(path, ln, words[1].second, "|Z| must not be negative");
     z.freq_hz.push_back(v[0]);
-    z.value.push_back(std::polar(v[1], v[2] * std::numbers::pi / 180.0));
+    // Reduced to one turn first: a phase such as 1e308 degrees is finite but overflows in radians.
+    z.value.push_back(std::polar(v[1], std::fmod(v[2], 360.0) * std::numbers::pi / 180.0));
   }
   if (z.size() == 0) throw FileError(path, 0, 0, "no data lines (an empty ZMA file)");
   return z;

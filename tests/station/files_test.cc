@@ -128,6 +128,18 @@ TEST(ZmaTest, ReadsMagnitudePhaseSkippingStars) {
   EXPECT_EQ(ErrorOf([&] { ReadZma(p); }), p + ": no data lines (an empty ZMA file)");
 }
 
+TEST(ZmaTest, AHugePhaseIsReducedToOneTurnNotANan) {
+  // Found by the zma fuzzer: 1e308 degrees overflows when turned into radians.
+  testing::TempDir dir;
+  const std::string p = dir / "m.zma";
+  Write(p, "300 2 1e308\n400 2 -720.5\n");
+  const analysis::Frf z = ReadZma(p);
+  std::string why;
+  EXPECT_TRUE(z.Validate(&why)) << why;
+  EXPECT_NEAR(std::abs(z.value[0]), 2.0, 1e-12);
+  EXPECT_NEAR(std::arg(z.value[1]) * 180.0 / std::numbers::pi, -0.5, 1e-9);
+}
+
 analysis::Recording SomeRecording() {
   analysis::Recording r;
   r.sample_rate_hz = 8000.0;
