@@ -27,6 +27,10 @@ void ParseExcitation(const JsonObject& e, Recipe& r) {
   r.excitation.sample_rate_hz = e.RequiredNumber("sample_rate_hz");
   r.excitation.peak_v = e.RequiredNumber("peak_v");
   r.excitation.crest_iterations = e.Integer("crest_iterations", r.excitation.crest_iterations);
+  const std::string crest_for = e.String("crest_for", "voltage");
+  e.Require(crest_for == "voltage" || crest_for == "current", "crest_for",
+            "must be \"voltage\" or \"current\"");
+  r.crest_for_current = crest_for == "current";
   const int periods = e.Integer("periods", 4);
   const int transient = e.Integer("transient_periods", 1);
   std::vector<int> pairs;
@@ -281,6 +285,15 @@ void ParseExcitationDesign(const JsonObject& o, Recipe& r, bool check_excitation
             "is below the excitation's peak_v " + Fixed(r.excitation.peak_v, 3) + " V");
   o.RejectUnknown();
   r.excitation_design = d;
+  if (r.crest_for_current) {
+    // The phases keep both peaks within the design's limits: the voltage's and 0.8 of the
+    // current's full scale (multisine.h, crest_current_weight_ohm).
+    r.excitation.crest_load_ohm = [motor = d.nominal](double f_hz) { return motor.At(f_hz); };
+    r.excitation.crest_current_weight_ohm =
+        std::isfinite(d.current_full_scale_a)
+            ? d.max_peak_v / (analysis::kCurrentHeadroom * d.current_full_scale_a)
+            : 0.0;
+  }
   if (!check_excitation) return;
   const std::size_t periods = r.analysis.frf_method == analysis::FrfMethod::kTransientLpm
                                   ? r.periods + r.transient_periods
@@ -413,6 +426,9 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source,
     if (auto q = root.OptionalObject("sequential")) ParseSequential(*q, r);
     if (auto d = root.OptionalObject("excitation_design"))
       ParseExcitationDesign(*d, r, options.check_excitation_design);
+    root.Require(!r.crest_for_current || r.excitation_design.has_value(), "excitation",
+                 "crest_for \"current\" needs the \"excitation_design\" block: its nominal "
+                 "motor is the load the phases are designed for");
     const bool index_declared =
         std::any_of(r.limits.begin(), r.limits.end(), [](const analysis::MeasurementSpec& s) {
           return s.name == analysis::names::kBondIndexPct;
@@ -560,6 +576,7 @@ nlohmann::json RecipeToJson(const Recipe& r) {
       {"masks", masks},
       {"instructions", InstructionsJson(r.instructions)}};
   if (r.conditions.enabled) j["conditions"] = ConditionsJson(r.conditions);
+  if (r.crest_for_current) j["excitation"]["crest_for"] = "current";
   if (r.bond_index)
     j["bond_index"] = {{"f0_exponent", r.bond_index->f0_exponent},
                        {"f0_ref_hz", r.bond_index->f0_ref_hz},

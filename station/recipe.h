@@ -5,7 +5,10 @@
 //   "motor":      {"poles": 10, "rotor_inertia_kg_m2": 1.0e-4},
 //   "excitation": {"f_lo_hz": 200, "f_hi_hz": 800, "line_spacing_hz": 1, "sample_rate_hz": 8000,
 //                  "peak_v": 2.0, "periods": 4, "transient_periods": 1, "phase_pair": 0 |
-//                  "phase_pairs": [0, 1, 2]},
+//                  "phase_pairs": [0, 1, 2], "crest_for": "voltage" (default) | "current"},
+//                  crest_for "current": the phases minimise the crest factor of the current
+//                  through the excitation_design block's nominal motor (required then), for a
+//                  motor whose current range limits the amplitude (analysis/signal/multisine.h)
 //   "fixture":    {"clamp_pressure_bar": {"lo": 4.5, "hi": 6.5}, "clamp_timeout_s": 2.0,
 //                  "release_timeout_s": 2.0},
 //   "analysis":   {"f0_min_hz": 250, "f0_max_hz": 700, "q_min": 5, "q_max": 500,
@@ -123,7 +126,10 @@ struct Recipe {
   int poles = 10;
   double rotor_inertia_kg_m2 = 0.0;  // the given J_r of the paper's eq. 24-30
 
+  // excitation.crest_load_ohm is the excitation_design's nominal motor when "crest_for" is
+  // "current" (set by ParseRecipe), empty otherwise.
   analysis::MultisineOptions excitation;
+  bool crest_for_current = false;
   std::size_t periods = 4;                                  // averaged
   std::size_t transient_periods = 1;                        // played first and dropped
   drivers::PhasePair phase_pair = drivers::PhasePair::kUV;  // the first of phase_pairs

@@ -19,20 +19,14 @@ double Rms(const std::vector<double>& x) {
   return std::sqrt(s / static_cast<double>(x.size()));
 }
 
-// Rms voltage, rms current and peak current of the nominal motor driven by `ex` (as designed,
-// at its own peak).
-struct Drive {
-  double v_rms = 0.0, a_rms = 0.0, a_peak = 0.0;
-};
-
-Drive DriveOf(const Excitation& ex, const MotionalImpedance& motor) {
+ExcitationDrive DriveOf(const Excitation& ex, const MotionalImpedance& motor) {
   const RealFft fft(ex.period_samples);
   std::vector<std::complex<double>> u = fft.Forward(ex.period_v.data());
   std::vector<std::complex<double>> i(u.size(), 0.0);
   for (std::size_t k : ex.lines)
     i[k] = u[k] / motor.At(static_cast<double>(k) * ex.line_spacing_hz);
   const std::vector<double> current = fft.Inverse(i);
-  Drive d;
+  ExcitationDrive d;
   d.v_rms = Rms(ex.period_v);
   d.a_rms = Rms(current);
   for (double a : current) d.a_peak = std::max(d.a_peak, std::abs(a));
@@ -46,7 +40,7 @@ ExcitationCandidate Evaluate(MultisineOptions o, const ExcitationRequirement& r)
   o.peak_v = 1.0;
   const Excitation unit = DesignMultisine(o);
   c.lines = unit.lines.size();
-  const Drive d = DriveOf(unit, r.nominal);
+  const ExcitationDrive d = DriveOf(unit, r.nominal);
   struct Bound {
     double peak_v;
     const char* name;
@@ -121,6 +115,10 @@ bool ExcitationRequirement::IsValid(std::string* why) const {
   if (min_periods < 1 || min_periods > 1000) return fail("min_periods must be 1 to 1000");
   if (!Positive(max_record_s)) return fail("max_record_s must be positive");
   return true;
+}
+
+ExcitationDrive DriveThrough(const MultisineOptions& excitation, const MotionalImpedance& motor) {
+  return DriveOf(DesignMultisine(excitation), motor);
 }
 
 double PredictedSigmaF0Hz(const MultisineOptions& excitation, std::size_t periods,

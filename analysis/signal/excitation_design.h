@@ -93,6 +93,13 @@ struct ExcitationDesign {
 ExcitationDesign DesignExcitationForTime(const MultisineOptions& base,
                                          const ExcitationRequirement& requirement);
 
+// What an excitation drives through a motor: rms voltage, rms current and peak current (the
+// period as designed, at its peak_v).
+struct ExcitationDrive {
+  double v_rms = 0.0, a_rms = 0.0, a_peak = 0.0;
+};
+ExcitationDrive DriveThrough(const MultisineOptions& excitation, const MotionalImpedance& motor);
+
 // The bound on f0 (Hz) at the nominal motor for an excitation played for `periods` periods and
 // analysed whole (NaN when the bound does not exist, e.g. too few lines).
 double PredictedSigmaF0Hz(const MultisineOptions& excitation, std::size_t periods,

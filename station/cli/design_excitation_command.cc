@@ -27,6 +27,7 @@ using nlohmann::json;
 struct DesignArgs {
   std::string recipe;
   double sigma_f0_hz = 0.0;  // 0: the recipe's
+  std::string crest_for;     // empty: the recipe's
   std::string out;
   bool force = false;
   bool json = false;
@@ -52,17 +53,19 @@ void Scale(analysis::Limit& window, double factor) {
 }
 
 // The recipe with the designed excitation, as a proposal.
+// The rms windows follow the rms the new excitation drives against what the recipe's own
+// (`own`) drove: the crest factor may differ, so the peak ratio would not do.
 Recipe Designed(const Recipe& recipe, const analysis::ExcitationDesign& d,
-                const analysis::ExcitationRequirement& requirement) {
+                const analysis::ExcitationRequirement& requirement,
+                const analysis::ExcitationDrive& own) {
   Recipe next = recipe;
-  const double ratio = d.chosen.peak_v / recipe.excitation.peak_v;
   next.excitation = d.excitation;
   next.periods = d.chosen.periods;
   next.transient_periods = 0;
   next.analysis.frf_method = analysis::FrfMethod::kTransientLpm;
   next.analysis.frf.transient_periods = 0;
-  Scale(next.conditions.excitation_v_rms, ratio);
-  Scale(next.conditions.excitation_a_rms, ratio);
+  Scale(next.conditions.excitation_v_rms, d.chosen.v_rms / own.v_rms);
+  Scale(next.conditions.excitation_a_rms, d.chosen.a_rms / own.a_rms);
   next.excitation_design = requirement;
   next.version = recipe.version + 1;
   next.description = recipe.description + " [eol design-excitation: std(f0) " +
@@ -74,8 +77,13 @@ Recipe Designed(const Recipe& recipe, const analysis::ExcitationDesign& d,
 }
 
 int RunDesign(const DesignArgs& a) {
-  const Recipe recipe =
-      ParseRecipe(io::ReadJsonFile(a.recipe), a.recipe, {.check_excitation_design = false});
+  // The recipe as it is (its own excitation, for comparison), and as designed (--crest-for).
+  const nlohmann::json original = io::ReadJsonFile(a.recipe);
+  const Recipe as_is = ParseRecipe(original, a.recipe, {.check_excitation_design = false});
+  nlohmann::json source = original;
+  if (!a.crest_for.empty() && source.contains("excitation") && source["excitation"].is_object())
+    source["excitation"]["crest_for"] = a.crest_for;
+  const Recipe recipe = ParseRecipe(source, a.recipe, {.check_excitation_design = false});
   if (!recipe.excitation_design)
     throw std::runtime_error(a.recipe +
                              ": has no \"excitation_design\" block (the required std(f0), the "
@@ -86,15 +94,18 @@ int RunDesign(const DesignArgs& a) {
   const analysis::ExcitationDesign d =
       analysis::DesignExcitationForTime(recipe.excitation, requirement);
   // What the recipe's own excitation reaches, for comparison.
-  const std::size_t analysed = recipe.analysis.frf_method == analysis::FrfMethod::kTransientLpm
-                                   ? recipe.periods + recipe.transient_periods
-                                   : recipe.periods;
+  const std::size_t analysed = as_is.analysis.frf_method == analysis::FrfMethod::kTransientLpm
+                                   ? as_is.periods + as_is.transient_periods
+                                   : as_is.periods;
+  const analysis::ExcitationDrive own =
+      analysis::DriveThrough(as_is.excitation, requirement.nominal);
   const json current = {
-      {"sigma_f0_hz", analysis::PredictedSigmaF0Hz(recipe.excitation, analysed, requirement)},
-      {"record_s", static_cast<double>(recipe.periods + recipe.transient_periods) /
-                       recipe.excitation.line_spacing_hz},
-      {"peak_v", recipe.excitation.peak_v},
-      {"line_spacing_hz", recipe.excitation.line_spacing_hz}};
+      {"sigma_f0_hz", analysis::PredictedSigmaF0Hz(as_is.excitation, analysed, requirement)},
+      {"record_s", static_cast<double>(as_is.periods + as_is.transient_periods) /
+                       as_is.excitation.line_spacing_hz},
+      {"peak_v", as_is.excitation.peak_v},
+      {"current_peak_a", own.a_peak},
+      {"line_spacing_hz", as_is.excitation.line_spacing_hz}};
   json out = {{"usable", d.usable},
               {"recipe_excitation", current},
               {"message", d.message},
@@ -107,7 +118,7 @@ int RunDesign(const DesignArgs& a) {
       throw std::runtime_error(a.out +
                                " exists: refusing to overwrite it (choose another --out, "
                                "or --force)");
-    const json j = RecipeToJson(Designed(recipe, d, requirement));
+    const json j = RecipeToJson(Designed(recipe, d, requirement, own));
     const Recipe checked = ParseRecipe(j, a.out);  // validated (and its bound re-checked) first
     WriteRecipeFile(a.out, j);
     out["written"] = {{"path", a.out}, {"version", checked.version}, {"hash", checked.hash}};
@@ -119,9 +130,10 @@ int RunDesign(const DesignArgs& a) {
   std::printf("required std(f0) %.5f Hz at the nominal motor (f0 %.1f Hz, Q %.1f)\n",
               d.required_sigma_f0_hz, requirement.nominal.f0_hz, requirement.nominal.q);
   std::printf(
-      "the recipe's own excitation: std(f0) %.5f Hz in %.3f s (%.4f Hz lines, %.3f V peak)\n",
+      "the recipe's own excitation: std(f0) %.5f Hz in %.3f s (%.4f Hz lines, %.3f V peak, "
+      "%.3f A peak)\n",
       current["sigma_f0_hz"].get<double>(), current["record_s"].get<double>(),
-      recipe.excitation.line_spacing_hz, recipe.excitation.peak_v);
+      as_is.excitation.line_spacing_hz, as_is.excitation.peak_v, own.a_peak);
   std::printf("%10s %6s %8s %-19s %7s %7s %8s %8s %9s %10s\n", "lines Hz", "lines", "peak V",
               "limited by", "V rms", "A rms", "A peak", "periods", "record s", "std(f0) Hz");
   for (const auto& c : d.candidates)
@@ -151,8 +163,10 @@ void AddDesignExcitationCommand(CLI::App& app) {
       "Design the shortest multisine that meets the recipe's \"excitation_design\" requirement:\n"
       "std(f0) at the nominal motor (Cramer-Rao bound with the DAQ's noise), the amplitude as\n"
       "high as max_peak_v, max_v_rms / max_a_rms and 0.8 of the current full scale allow, the\n"
-      "line grid just fine enough to resolve the mode. Prints every candidate; --out writes the\n"
-      "recipe with that excitation (played from rest, transient_lpm) as a proposal.\n"
+      "line grid just fine enough to resolve the mode (--crest-for current: the phases keep\n"
+      "the current's crest factor low where the current range limits). Prints every\n"
+      "candidate; --out writes the recipe with that excitation (played from rest,\n"
+      "transient_lpm) as a proposal.\n"
       "Exit: 0 designed, 1 no excitation meets the requirement, 2 usage or file error.");
   cmd->add_option("--recipe", args->recipe, "Recipe with an excitation_design block")
       ->required()
@@ -160,6 +174,10 @@ void AddDesignExcitationCommand(CLI::App& app) {
   cmd->add_option("--sigma-f0-hz", args->sigma_f0_hz,
                   "Required std(f0) in Hz (default: the recipe's)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--crest-for", args->crest_for,
+                  "Phases that keep the voltage's or the current's crest factor low (default: "
+                  "the recipe's excitation.crest_for)")
+      ->check(CLI::IsMember({"voltage", "current"}));
   cmd->add_option("--out", args->out, "Write the designed recipe (version + 1) here");
   cmd->add_flag("--force", args->force, "Overwrite --out if it exists");
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");

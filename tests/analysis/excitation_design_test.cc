@@ -103,6 +103,35 @@ TEST(ExcitationDesign, AmplitudeStopsAtTheFirstLimit) {
   EXPECT_NEAR(d.chosen.v_rms, 1.0, 1e-9);
 }
 
+TEST(ExcitationDesign, PhasesForTheCurrentCarryMoreInformationThroughTheSameCurrentRange) {
+  // The fast recipe's case: the current channel limits the amplitude. Phases that keep the
+  // current compact let the voltage rise until the current's peak is the same again.
+  ExcitationRequirement r = Requirement();
+  r.sigma_f0_hz = 1e-4;  // far beyond reach: no candidate lowers its amplitude
+  r.max_peak_v = 10;
+  r.lines_per_half_power_band = 1.85;
+  r.max_record_s = 1e6;
+  MultisineOptions base = Band();
+  base.crest_iterations = 300;
+  const ExcitationDesign voltage = DesignExcitationForTime(base, r);
+  base.crest_load_ohm = [m = r.nominal](double f_hz) { return m.At(f_hz); };
+  base.crest_current_weight_ohm = r.max_peak_v / (kCurrentHeadroom * r.current_full_scale_a);
+  const ExcitationDesign current = DesignExcitationForTime(base, r);
+  ASSERT_TRUE(voltage.usable && current.usable);
+  const ExcitationCandidate& v = voltage.candidates.front();
+  const ExcitationCandidate& c = current.candidates.front();
+  ASSERT_DOUBLE_EQ(v.line_spacing_hz, c.line_spacing_hz);
+  EXPECT_EQ(v.amplitude_limited_by, "current_full_scale");
+  EXPECT_LE(c.current_peak_a, kCurrentHeadroom * r.current_full_scale_a * (1 + 1e-9));
+  const double information = std::pow(v.sigma_f0_one_period_hz / c.sigma_f0_one_period_hz, 2);
+  std::printf(
+      "%.4f Hz lines: voltage-crest phases %.2f V peak (%s), current-crest %.2f V (%s); "
+      "information x %.2f\n",
+      v.line_spacing_hz, v.peak_v, v.amplitude_limited_by.c_str(), c.peak_v,
+      c.amplitude_limited_by.c_str(), information);
+  EXPECT_GT(information, 2.0);
+}
+
 TEST(ExcitationDesign, AmplitudeBuysTimeAsOneOverUSquared) {
   ExcitationRequirement r = Requirement();
   r.current_full_scale_a = 1e9;

@@ -3,6 +3,7 @@
 // command writes the shortest excitation that meets it as a proposal that loads.
 #include <gtest/gtest.h>
 
+#include <complex>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -48,6 +49,35 @@ TEST(ExcitationDesignRecipe, ExcitationThatMissesItsRequirementIsRefused) {
   j = io::ReadJsonFile(kFast);
   j["excitation_design"]["max_peak_v"] = 1.0;  // below the excitation's own peak
   EXPECT_NE(ErrorOf(j).find("/excitation_design/max_peak_v"), std::string::npos) << ErrorOf(j);
+}
+
+TEST(ExcitationDesignRecipe, CrestForCurrentDesignsThroughTheNominalMotorAndRoundTrips) {
+  nlohmann::json j = io::ReadJsonFile(kFast);
+  j["excitation"]["crest_for"] = "current";
+  const Recipe r = ParseRecipe(j, "current", {.check_excitation_design = false});
+  EXPECT_TRUE(r.crest_for_current);
+  ASSERT_TRUE(static_cast<bool>(r.excitation.crest_load_ohm));
+  const std::complex<double> z = r.excitation.crest_load_ohm(390.0);
+  EXPECT_NEAR(std::abs(z - r.excitation_design->nominal.At(390.0)), 0.0, 1e-12);
+  const nlohmann::json written = RecipeToJson(r);
+  EXPECT_EQ(written["excitation"]["crest_for"], "current");
+  EXPECT_EQ(RecipeToJson(ParseRecipe(written, "written", {.check_excitation_design = false})),
+            written);
+  EXPECT_FALSE(RecipeToJson(LoadRecipe(std::string(EOL_SOURCE_DIR) +
+                                       "/recipes/pmsm-10pole.json"))["excitation"]
+                   .contains("crest_for"));
+
+  nlohmann::json bad = j;
+  bad.erase("excitation_design");
+  EXPECT_NE(ErrorOf(bad).find("/excitation: crest_for \"current\" needs the "
+                              "\"excitation_design\" block"),
+            std::string::npos)
+      << ErrorOf(bad);
+  bad = j;
+  bad["excitation"]["crest_for"] = "both";
+  EXPECT_NE(ErrorOf(bad).find("/excitation/crest_for: must be \"voltage\" or \"current\""),
+            std::string::npos)
+      << ErrorOf(bad);
 }
 
 TEST(ExcitationDesignCli, WritesTheShortestExcitationAsAProposal) {
@@ -97,6 +127,33 @@ TEST(ExcitationDesignCli, WritesTheShortestExcitationAsAProposal) {
   ChildProcess again({EOL_BINARY, "design-excitation", "--recipe", kFast, "--out", out});
   EXPECT_EQ(again.Wait(std::chrono::seconds(60)), 2);
   EXPECT_NE(again.output().find("refusing to overwrite"), std::string::npos) << again.output();
+}
+
+TEST(ExcitationDesignCli, CrestForCurrentKeepsTheRmsWindowsAroundWhatItDrives) {
+  TempDir dir;
+  const std::string out = dir / "current.json";
+  ChildProcess p({EOL_BINARY, "design-excitation", "--recipe", kFast, "--crest-for", "current",
+                  "--sigma-f0-hz", "0.0085", "--out", out, "--json"},
+                 /*merge_stderr=*/false);
+  ASSERT_EQ(p.Wait(std::chrono::seconds(60)), 0) << p.output();
+  const Recipe fast = LoadRecipe(kFast);
+  const Recipe designed = LoadRecipe(out);
+  EXPECT_TRUE(designed.crest_for_current);
+  ASSERT_TRUE(designed.conditions.excitation_v_rms.lo && designed.conditions.excitation_v_rms.hi);
+  const analysis::MotionalImpedance& nominal = designed.excitation_design->nominal;
+  const analysis::ExcitationDrive was = analysis::DriveThrough(fast.excitation, nominal);
+  const analysis::ExcitationDrive now = analysis::DriveThrough(designed.excitation, nominal);
+  // Each window is the old one times the rms ratio, so it sits where it sat around the drive.
+  EXPECT_NEAR(*designed.conditions.excitation_v_rms.lo / now.v_rms,
+              *fast.conditions.excitation_v_rms.lo / was.v_rms, 1e-6);
+  EXPECT_NEAR(*designed.conditions.excitation_v_rms.hi / now.v_rms,
+              *fast.conditions.excitation_v_rms.hi / was.v_rms, 1e-6);
+  EXPECT_NEAR(*designed.conditions.excitation_a_rms.hi / now.a_rms,
+              *fast.conditions.excitation_a_rms.hi / was.a_rms, 1e-6);
+  EXPECT_LE(now.a_peak, analysis::kCurrentHeadroom *
+                            designed.excitation_design->current_full_scale_a * (1 + 1e-6));
+  const nlohmann::json j = nlohmann::json::parse(p.output());
+  EXPECT_NEAR(j["recipe_excitation"]["current_peak_a"].get<double>(), was.a_peak, 1e-9);
 }
 
 TEST(ExcitationDesignCli, RecipeWithoutRequirementNamesTheBlock) {
