@@ -24,7 +24,8 @@ namespace {
 struct DemoArgs {
   int units = 20;
   std::string db = "eol-demo.sqlite";
-  std::string recipe = DefaultRecipePath();
+  // The recipe designed for time (issue 16): the 5 s recipe's information in 0.474 s.
+  std::string recipe = DefaultRecipePath("pmsm-10pole-fast.json");
   bool json = false;
   int port = 8080;
   std::string listen = "127.0.0.1";
