@@ -295,10 +295,7 @@ void ParseExcitationDesign(const JsonObject& o, Recipe& r, bool check_excitation
             : 0.0;
   }
   if (!check_excitation) return;
-  const std::size_t periods = r.analysis.frf_method == analysis::FrfMethod::kTransientLpm
-                                  ? r.periods + r.transient_periods
-                                  : r.periods;
-  const double predicted = analysis::PredictedSigmaF0Hz(r.excitation, periods, d);
+  const double predicted = analysis::PredictedSigmaF0Hz(r.excitation, r.AnalysedPeriods(), d);
   o.Require(predicted <= d.RequiredSigmaF0Hz() * (1.0 + 1e-6), "sigma_f0_hz",
             "the excitation reaches std(f0) " + Fixed(predicted, 5) +
                 " Hz at the nominal motor (Cramer-Rao bound), more than the " +
@@ -457,6 +454,11 @@ void WriteRecipeFile(const std::string& path, const nlohmann::json& j) {
     if (!out) throw std::runtime_error(tmp + ": writing failed");
   }
   std::filesystem::rename(tmp, path);
+}
+
+std::size_t Recipe::AnalysedPeriods() const {
+  return analysis.frf_method == analysis::FrfMethod::kTransientLpm ? periods + transient_periods
+                                                                   : periods;
 }
 
 std::string Recipe::WhyNotApproved() const {

@@ -160,6 +160,10 @@ struct Recipe {
   std::optional<analysis::ExcitationRequirement> excitation_design;
   std::optional<SequentialPolicy> sequential;
 
+  // Periods the estimator uses of one look: every period played for "transient_lpm" (it
+  // removes the start transient), the averaged ones after the dropped transient otherwise.
+  std::size_t AnalysedPeriods() const;
+
   bool Approved() const { return !approval || approval->state == "approved"; }
   // Empty when Approved(); else why the station refuses it, naming how to approve it.
   std::string WhyNotApproved() const;

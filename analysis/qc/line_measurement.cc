@@ -10,7 +10,12 @@ namespace eol::analysis {
 
 LineMeasurementSetup MakeLineMeasurement(const MultisineOptions& excitation, std::size_t periods,
                                          double voltage_noise_v, double current_noise_a) {
-  const Excitation ex = DesignMultisine(excitation);
+  return MakeLineMeasurement(DesignMultisine(excitation), periods, voltage_noise_v,
+                             current_noise_a);
+}
+
+LineMeasurementSetup MakeLineMeasurement(const Excitation& ex, std::size_t periods,
+                                         double voltage_noise_v, double current_noise_a) {
   const std::size_t n = ex.period_samples;
   const RealFft fft(n);
   const std::vector<std::complex<double>> u = fft.Forward(ex.period_v.data());

@@ -37,6 +37,9 @@ struct LineMeasurementSetup {
 // Designs the multisine (throws std::invalid_argument when the options are invalid).
 LineMeasurementSetup MakeLineMeasurement(const MultisineOptions& excitation, std::size_t periods,
                                          double voltage_noise_v, double current_noise_a);
+// The same for an excitation already designed.
+LineMeasurementSetup MakeLineMeasurement(const Excitation& excitation, std::size_t periods,
+                                         double voltage_noise_v, double current_noise_a);
 
 // sigma_k for the true impedance z on setup.freq_hz.
 std::vector<double> LineSigma(const LineMeasurementSetup& setup,

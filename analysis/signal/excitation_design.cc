@@ -60,8 +60,10 @@ ExcitationCandidate Evaluate(MultisineOptions o, const ExcitationRequirement& r)
   c.v_rms = d.v_rms * c.peak_v;
   c.a_rms = d.a_rms * c.peak_v;
   c.current_peak_a = d.a_peak * c.peak_v;
-  o.peak_v = c.peak_v;
-  c.sigma_f0_one_period_hz = PredictedSigmaF0Hz(o, 1, r);
+  // The bound at this peak, from the unit period scaled (the shape does not depend on the peak).
+  Excitation scaled = unit;
+  for (double& v : scaled.period_v) v *= c.peak_v;
+  c.sigma_f0_one_period_hz = PredictedSigmaF0Hz(scaled, 1, r);
   if (!std::isfinite(c.sigma_f0_one_period_hz)) return c;
   // sigma_k^2 is proportional to 1/P, so the bound to 1/sqrt(P).
   const double needed = std::pow(c.sigma_f0_one_period_hz / r.RequiredSigmaF0Hz(), 2.0);
@@ -121,7 +123,7 @@ ExcitationDrive DriveThrough(const MultisineOptions& excitation, const MotionalI
   return DriveOf(DesignMultisine(excitation), motor);
 }
 
-double PredictedSigmaF0Hz(const MultisineOptions& excitation, std::size_t periods,
+double PredictedSigmaF0Hz(const Excitation& excitation, std::size_t periods,
                           const ExcitationRequirement& r) {
   const LineMeasurementSetup setup =
       MakeLineMeasurement(excitation, periods, r.noise_v_rms, r.noise_a_rms);
@@ -129,6 +131,11 @@ double PredictedSigmaF0Hz(const MultisineOptions& excitation, std::size_t period
   const CramerRaoBound b =
       ComputeCramerRaoBound(r.nominal, setup.freq_hz, LineSigma(setup, nominal.value));
   return b.valid ? b.Std(kParamF0) : std::nan("");
+}
+
+double PredictedSigmaF0Hz(const MultisineOptions& excitation, std::size_t periods,
+                          const ExcitationRequirement& r) {
+  return PredictedSigmaF0Hz(DesignMultisine(excitation), periods, r);
 }
 
 ExcitationDesign DesignExcitationForTime(const MultisineOptions& base,

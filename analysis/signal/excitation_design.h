@@ -104,5 +104,8 @@ ExcitationDrive DriveThrough(const MultisineOptions& excitation, const MotionalI
 // analysed whole (NaN when the bound does not exist, e.g. too few lines).
 double PredictedSigmaF0Hz(const MultisineOptions& excitation, std::size_t periods,
                           const ExcitationRequirement& requirement);
+// The same for an excitation already designed (at its own peak).
+double PredictedSigmaF0Hz(const Excitation& excitation, std::size_t periods,
+                          const ExcitationRequirement& requirement);
 
 }  // namespace eol::analysis

@@ -94,13 +94,11 @@ int RunDesign(const DesignArgs& a) {
   const analysis::ExcitationDesign d =
       analysis::DesignExcitationForTime(recipe.excitation, requirement);
   // What the recipe's own excitation reaches, for comparison.
-  const std::size_t analysed = as_is.analysis.frf_method == analysis::FrfMethod::kTransientLpm
-                                   ? as_is.periods + as_is.transient_periods
-                                   : as_is.periods;
   const analysis::ExcitationDrive own =
       analysis::DriveThrough(as_is.excitation, requirement.nominal);
   const json current = {
-      {"sigma_f0_hz", analysis::PredictedSigmaF0Hz(as_is.excitation, analysed, requirement)},
+      {"sigma_f0_hz",
+       analysis::PredictedSigmaF0Hz(as_is.excitation, as_is.AnalysedPeriods(), requirement)},
       {"record_s", static_cast<double>(as_is.periods + as_is.transient_periods) /
                        as_is.excitation.line_spacing_hz},
       {"peak_v", as_is.excitation.peak_v},
