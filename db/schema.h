@@ -148,4 +148,13 @@ CREATE TABLE outbox_cursors (
 );
 )sql";
 
+// Version 5 -> 6: curves in a compact binary form (db/curve_codec.h). encoding says how `data`
+// is stored: 'json-zlib' (every row written before v6: the zlib stream of the curve's JSON,
+// raw_size its size) or 'binary-v1' (EncodeCurve's bytes, raw_size their size). Old rows stay
+// as they are; new rows are binary.
+inline constexpr const char kSchemaV6[] = R"sql(
+ALTER TABLE curves ADD COLUMN encoding TEXT NOT NULL DEFAULT 'json-zlib'
+  CHECK (encoding IN ('json-zlib', 'binary-v1'));
+)sql";
+
 }  // namespace eol::db::schema

@@ -19,6 +19,7 @@
 #include <utility>
 
 #include "db/clock.h"
+#include "db/curve_codec.h"
 #include "db/schema.h"
 
 namespace eol::db {
@@ -187,8 +188,12 @@ void MigrateTo5(sqlite3* db, const std::string& path) {
   Exec(db, path, schema::kSchemaV5, "migrate the schema to version 5");
 }
 
+void MigrateTo6(sqlite3* db, const std::string& path) {
+  Exec(db, path, schema::kSchemaV6, "migrate the schema to version 6");
+}
+
 constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {
-    &MigrateTo1, &MigrateTo2, &MigrateTo3, &MigrateTo4, &MigrateTo5};
+    &MigrateTo1, &MigrateTo2, &MigrateTo3, &MigrateTo4, &MigrateTo5, &MigrateTo6};
 
 std::int64_t PragmaInt(sqlite3* db, const std::string& path, const char* sql,
                        const std::string& op) {
@@ -287,17 +292,6 @@ int AbortUnfinished(sqlite3* db, const std::string& path) {
 // Invalid UTF-8 in a string (a garbled barcode, a device's reply) must not lose the record.
 std::string Dump(const nlohmann::json& j) {
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
-std::string Compress(const std::string& raw, const std::string& path, const std::string& op) {
-  uLongf size = compressBound(static_cast<uLong>(raw.size()));
-  std::string out(size, '\0');
-  const int rc = compress2(reinterpret_cast<Bytef*>(out.data()), &size,
-                           reinterpret_cast<const Bytef*>(raw.data()),
-                           static_cast<uLong>(raw.size()), Z_DEFAULT_COMPRESSION);
-  if (rc != Z_OK) throw StoreError(Message(path, op, std::string("zlib: ") + zError(rc)));
-  out.resize(size);
-  return out;
 }
 
 void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record) {
@@ -408,15 +402,20 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
 
   const std::string curves_op = op + " (write curves)";
   Statement c(db, path,
-              "INSERT INTO curves (test_id, name, raw_size, data) VALUES (?1, ?2, ?3, ?4)",
+              "INSERT INTO curves (test_id, name, raw_size, data, encoding) "
+              "VALUES (?1, ?2, ?3, ?4, 'binary-v1')",
               curves_op);
   for (const Curve& curve : record.curves) {
-    const std::string raw = Dump(nlohmann::json(curve));
-    const std::string packed = Compress(raw, path, curves_op);
+    std::string packed;
+    try {
+      packed = EncodeCurve(curve);
+    } catch (const std::invalid_argument& e) {
+      throw StoreError(Message(path, curves_op, e.what()));
+    }
     c.Reset();
     c.BindInt(1, record.id);
     c.BindText(2, curve.name);
-    c.BindInt(3, static_cast<std::int64_t>(raw.size()));
+    c.BindInt(3, static_cast<std::int64_t>(packed.size()));
     c.BindBlob(4, packed.data(), packed.size());
     c.Run();
   }
@@ -492,6 +491,14 @@ void LoadCurves(Statement& c, const std::string& path, TestRecord& r) {
   c.BindInt(1, r.id);
   while (c.Step()) {
     const std::string op = "read curve '" + c.Text(0) + "' of test " + std::to_string(r.id);
+    if (c.Text(3) == "binary-v1") {
+      try {
+        r.curves.push_back(DecodeCurve(c.Blob(2), c.Text(0)));
+      } catch (const std::invalid_argument& e) {
+        throw StoreError(Message(path, op, std::string("corrupt curve data: ") + e.what()));
+      }
+      continue;
+    }
     const std::string raw = Decompress(c.Blob(2), c.Int(1), path, op);
     try {
       r.curves.push_back(nlohmann::json::parse(raw).get<Curve>());
@@ -507,7 +514,8 @@ std::vector<TestRecord> ReadTests(sqlite3* db, const std::string& path, Statemen
   std::vector<TestRecord> out;
   while (s.Step()) out.push_back(RowToRecord(s, path));
   if (with_curves && !out.empty()) {
-    Statement c(db, path, "SELECT name, raw_size, data FROM curves WHERE test_id = ?1 ORDER BY id",
+    Statement c(db, path,
+                "SELECT name, raw_size, data, encoding FROM curves WHERE test_id = ?1 ORDER BY id",
                 "read curves");
     for (TestRecord& r : out) LoadCurves(c, path, r);
   }

@@ -106,7 +106,7 @@ struct OutboxEntry {
 
 class Store {
  public:
-  static constexpr int kSchemaVersion = 5;
+  static constexpr int kSchemaVersion = 6;
 
   // kWriter: the station's one connection; recovers unfinished tests as ABORTED. It holds an
   // exclusive flock on "<path>.lock" (created 0600 beside the file) for as long as it is open:

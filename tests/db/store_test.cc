@@ -127,6 +127,23 @@ TestRecord MakeFullRecord(const std::string& serial, const std::string& started_
   return r;
 }
 
+// What a stored curve keeps (db/curve_codec.h): each value to a thousandth of its line's sigma,
+// to 1e-6 of itself without a sigma, exactly where float32 cannot (a NaN stays NaN).
+void ExpectKept(const std::vector<double>& got, const std::vector<double>& want,
+                const std::vector<double>& sigma, const char* what) {
+  ASSERT_EQ(got.size(), want.size()) << what;
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    if (std::isnan(want[i])) {
+      EXPECT_TRUE(std::isnan(got[i])) << what << "[" << i << "]";
+      continue;
+    }
+    const double tol = sigma.empty()             ? 1e-6 * std::abs(want[i])
+                       : std::isfinite(sigma[i]) ? 1e-3 * sigma[i]
+                                                 : 0.0;
+    EXPECT_NEAR(got[i], want[i], tol) << what << "[" << i << "]";
+  }
+}
+
 // NaN-aware element-wise equality.
 void ExpectSame(const std::vector<double>& a, const std::vector<double>& b, const char* what) {
   ASSERT_EQ(a.size(), b.size()) << what;
@@ -232,8 +249,8 @@ TEST_F(StoreTest, FullRecordRoundTrips) {
     EXPECT_EQ(out->curves[i].name, in.curves[i].name);
     EXPECT_EQ(out->curves[i].unit, in.curves[i].unit);
     ExpectSame(out->curves[i].freq_hz, in.curves[i].freq_hz, "freq_hz");
-    ExpectSame(out->curves[i].re, in.curves[i].re, "re");
-    ExpectSame(out->curves[i].im, in.curves[i].im, "im");
+    ExpectKept(out->curves[i].re, in.curves[i].re, in.curves[i].sigma, "re");
+    ExpectKept(out->curves[i].im, in.curves[i].im, in.curves[i].sigma, "im");
     ExpectSame(out->curves[i].sigma, in.curves[i].sigma, "sigma");
   }
 
