@@ -9,7 +9,7 @@
 #   --seconds N   fuzzing time per target (default 20: the CI-sized run of the test suite)
 #   --fork N      N fuzzing processes per target that go on after a finding, so a long run
 #                 collects every finding instead of stopping at the first (libFuzzer -fork)
-#   TARGET        recipe config frf_csv zma recording_csv wav http_body (default: all)
+#   TARGET        recipe config frf_csv zma recording_csv wav http_body curve_codec (default: all)
 #
 # Each run's new inputs, findings and log stay in DIR/runs/<target>/ until the next run.
 set -euo pipefail
@@ -27,7 +27,7 @@ while (($#)); do
     *) targets+=("$1"); shift ;;
   esac
 done
-((${#targets[@]})) || targets=(recipe config frf_csv zma recording_csv wav http_body)
+((${#targets[@]})) || targets=(recipe config frf_csv zma recording_csv wav http_body curve_codec)
 
 if ! command -v clang++-14 >/dev/null 2>&1; then
   echo "run_fuzzers: clang++-14 not found (install clang-14 and libclang-rt-14-dev:" \
