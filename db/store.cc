@@ -16,6 +16,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string_view>
+#include <tuple>
 #include <utility>
 
 #include "db/clock.h"
@@ -633,6 +634,24 @@ void Store::Insert(TestRecord& record) {
     // Rolled back: the record must not carry an id that is not in the file.
     record.id = id;
     record.retest_of = retest_of;
+    throw;
+  }
+}
+
+void Store::InsertAll(std::vector<TestRecord>& records) {
+  Transaction tx(db_, path_, "insert " + std::to_string(records.size()) + " tests");
+  std::vector<std::pair<std::int64_t, std::optional<std::int64_t>>> before;
+  before.reserve(records.size());
+  for (const TestRecord& r : records) before.emplace_back(r.id, r.retest_of);
+  try {
+    for (TestRecord& r : records) {
+      InsertTestRow(db_, path_, r);
+      WriteFinish(db_, path_, r);
+    }
+    tx.Commit();
+  } catch (...) {
+    for (std::size_t i = 0; i < records.size(); ++i)
+      std::tie(records[i].id, records[i].retest_of) = before[i];
     throw;
   }
 }

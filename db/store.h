@@ -134,6 +134,9 @@ class Store {
   void FinishTest(const TestRecord& record);
   // BeginTest + FinishTest, for records made elsewhere (imports, tests).
   void Insert(TestRecord& record);
+  // Insert for many records in one transaction (bulk imports, generated benchmark stores):
+  // all are there or none; each record's id and retest_of are set.
+  void InsertAll(std::vector<TestRecord>& records);
 
   // Finished (and aborted) tests of a serial, newest first.
   std::vector<TestRecord> TestsOfSerial(const std::string& serial, bool with_curves = false);

@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   eol::station::cli::AddProductionBenchCommand(app);
   eol::station::cli::AddHttpBenchCommand(app);
   eol::station::cli::AddCycleBenchCommand(app);
+  eol::station::cli::AddDbBenchCommand(app);
   eol::station::cli::AddDesignExcitationCommand(app);
   eol::station::cli::AddPodCommand(app);
   eol::station::cli::AddRecipeApproveCommand(app);

@@ -331,6 +331,23 @@ TEST_F(StoreTest, TestsOfSerialAreNewestFirstAndRetestsLinkToTheFirst) {
   EXPECT_TRUE(store->TestsOfSerial("M-9").empty());
 }
 
+TEST_F(StoreTest, InsertAllIsOneTransactionAllOrNothing) {
+  auto store = Open();
+  std::vector<TestRecord> batch = {MakeRecord("B-1", "2024-05-01T10:00:00.000Z"),
+                                   MakeRecord("B-1", "2024-05-01T10:01:00.000Z"),
+                                   MakeRecord("B-2", "2024-05-01T10:02:00.000Z")};
+  store->InsertAll(batch);
+  EXPECT_GT(batch[0].id, 0);
+  EXPECT_EQ(batch[1].retest_of, batch[0].id);  // linked within the same transaction
+  EXPECT_EQ(store->TestsOfSerial("B-1").size(), 2u);
+
+  std::vector<TestRecord> bad = {MakeRecord("B-3", "2024-05-01T10:03:00.000Z"),
+                                 MakeRecord("", "2024-05-01T10:04:00.000Z")};  // no serial
+  EXPECT_THROW(store->InsertAll(bad), StoreError);
+  EXPECT_TRUE(store->TestsOfSerial("B-3").empty());  // rolled back with the bad one
+  EXPECT_EQ(bad[0].id, 0);                           // and no id kept that is not in the file
+}
+
 TEST_F(StoreTest, CurvesLoadOnlyWhenAsked) {
   auto store = Open();
   TestRecord r = MakeFullRecord("M-1", "2024-05-01T10:00:00.000Z");

@@ -1,0 +1,55 @@
+// `eol db-bench`: the store at a production line's scale (issue 16, "records that scale").
+//
+// Generates a store of `tests` tests from a template record (the newest test of a station
+// store, with its curves: what the station really writes), one test per `interval_s` of a
+// line from 2026-01-01, a share of them retests of the previous serial, each with its
+// measurements and curve values perturbed (so nothing compresses better than real data), in
+// transactions of `batch` tests (Store::InsertAll). Then, on that file, through the same Store
+// calls `eol query` and `eol export` make:
+//   - the history of a serial (TestsOfSerial) and its newest test with curves
+//     (LatestOfSerial) for `queries` random serials: median and 99th percentile latency;
+//   - the export of one day of tests (Tests, keyset pages of 10,000, with and without curves)
+//     and of one day's measurement rows (MeasurementRows): rows per second;
+// and the file's size: bytes per test and the growth per year at the line's rate.
+// Progress goes to `progress` (analysis/progress.h).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "analysis/progress.h"
+
+namespace eol::station {
+
+struct DbBenchOptions {
+  std::string db;           // created; must not exist
+  std::string template_db;  // a station store with at least one finished test
+  std::int64_t tests = 100000;
+  int batch = 10000;
+  double interval_s = 10.0;    // one test per interval on the simulated line
+  double retest_share = 0.03;  // tests that repeat the previous serial
+  int queries = 1000;          // random serials looked up
+  std::uint64_t seed = 1;
+  analysis::ProgressCallback progress;
+};
+
+struct DbBenchSummary {
+  std::int64_t tests = 0;
+  double insert_s = 0.0;    // wall time of the generation
+  double file_bytes = 0.0;  // database + WAL after a checkpoint
+  double bytes_per_test = 0.0;
+  double growth_gb_per_year = 0.0;                       // at one test per interval_s, all year
+  double history_median_ms = 0.0, history_p99_ms = 0.0;  // TestsOfSerial
+  double latest_median_ms = 0.0, latest_p99_ms = 0.0;    // LatestOfSerial (with curves)
+  std::int64_t day_tests = 0;
+  double day_export_s = 0.0;         // one day's tests, no curves
+  double day_export_curves_s = 0.0;  // the same with curves
+  std::int64_t day_measurement_rows = 0;
+  double day_measurements_s = 0.0;
+  std::string template_serial;  // whose record was the template
+};
+
+// Throws std::runtime_error (or db::StoreError) naming the cause.
+DbBenchSummary RunDbBench(const DbBenchOptions& options);
+
+}  // namespace eol::station
