@@ -37,17 +37,23 @@ Curve Measured(std::size_t n = 601, double sigma = 5e-3) {
   return c;
 }
 
+// The curve as schema versions 1-5 stored it: the zlib stream of its JSON.
+std::string ZlibJson(const Curve& c) {
+  const std::string j = nlohmann::json(c).dump();
+  uLongf size = compressBound(static_cast<uLong>(j.size()));
+  std::string packed(size, '\0');
+  EXPECT_EQ(compress2(reinterpret_cast<Bytef*>(packed.data()), &size,
+                      reinterpret_cast<const Bytef*>(j.data()), j.size(), Z_DEFAULT_COMPRESSION),
+            Z_OK);
+  packed.resize(size);
+  return packed;
+}
+
 TEST(CurveCodec, MeasuredCurveKeepsItsLinesToAThousandthOfSigmaInAThirdOfTheBytes) {
   const Curve c = Measured();
   const std::string bytes = EncodeCurve(c);
-  std::printf("601-line curve with sigma: %zu bytes (zlib JSON: %zu)\n", bytes.size(), [&] {
-    const std::string j = nlohmann::json(c).dump();
-    uLongf size = compressBound(static_cast<uLong>(j.size()));
-    std::string out(size, '\0');
-    compress2(reinterpret_cast<Bytef*>(out.data()), &size, reinterpret_cast<const Bytef*>(j.data()),
-              j.size(), Z_DEFAULT_COMPRESSION);
-    return static_cast<std::size_t>(size);
-  }());
+  std::printf("601-line curve with sigma: %zu bytes (zlib JSON: %zu)\n", bytes.size(),
+              ZlibJson(c).size());
   EXPECT_LE(bytes.size(), 12u * 601u + 40u);  // float32 re, im, sigma; the grid as first, step
   const Curve back = DecodeCurve(bytes, "impedance");
   EXPECT_EQ(back.name, "impedance");
@@ -153,14 +159,8 @@ TEST(CurveStore, VersionFiveZlibJsonCurvesStillReadAndNewOnesAreBinary) {
          "software_version, started_at, finished_at, outcome, reasons) VALUES (1, "
          "'OLD-5', 's', 'r', 1, 'h', 'v', '2025-01-01T00:00:00.000Z', "
          "'2025-01-01T00:00:01.000Z', 'PASS', '[]')");
-    // The curve as versions 1-5 wrote it: the zlib stream of its JSON.
     const std::string j = nlohmann::json(old_curve).dump();
-    uLongf size = compressBound(static_cast<uLong>(j.size()));
-    std::string packed(size, '\0');
-    ASSERT_EQ(compress2(reinterpret_cast<Bytef*>(packed.data()), &size,
-                        reinterpret_cast<const Bytef*>(j.data()), j.size(), Z_DEFAULT_COMPRESSION),
-              Z_OK);
-    packed.resize(size);
+    const std::string packed = ZlibJson(old_curve);
     sqlite3_stmt* s = nullptr;
     ASSERT_EQ(sqlite3_prepare_v2(raw,
                                  "INSERT INTO curves (test_id, name, raw_size, data) VALUES "
