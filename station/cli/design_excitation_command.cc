@@ -80,10 +80,13 @@ int RunDesign(const DesignArgs& a) {
   // The recipe as it is (its own excitation, for comparison), and as designed (--crest-for).
   const nlohmann::json original = io::ReadJsonFile(a.recipe);
   const Recipe as_is = ParseRecipe(original, a.recipe, {.check_excitation_design = false});
-  nlohmann::json source = original;
-  if (!a.crest_for.empty() && source.contains("excitation") && source["excitation"].is_object())
-    source["excitation"]["crest_for"] = a.crest_for;
-  const Recipe recipe = ParseRecipe(source, a.recipe, {.check_excitation_design = false});
+  const Recipe recipe = [&] {
+    if (a.crest_for.empty()) return as_is;
+    nlohmann::json source = original;
+    if (source.contains("excitation") && source["excitation"].is_object())
+      source["excitation"]["crest_for"] = a.crest_for;
+    return ParseRecipe(source, a.recipe, {.check_excitation_design = false});
+  }();
   if (!recipe.excitation_design)
     throw std::runtime_error(a.recipe +
                              ": has no \"excitation_design\" block (the required std(f0), the "
