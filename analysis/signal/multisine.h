@@ -13,16 +13,16 @@
 //
 // Crest factor of the current too (crest_load_ohm set): a motor's current I_k = U_k / Z(f_k)
 // falls with frequency (the winding's inductance), and phases that make a flat-amplitude voltage
-// compact make that current peaky (crest factor about 2.9 for the fast recipe's 142 lines
+// compact make that current peaky (crest factor about 3 for the fast recipe's 142 lines
 // through the nominal motor, against 1.55 for the voltage). When the current channel's range
 // limits the amplitude, what matters is the larger of the two peaks, each against its limit:
 // max(peak u, w peak i) with w = the voltage's limit / the current's (crest_current_weight_ohm;
 // 0: the current's peak alone). Each clipping iteration clips whichever channel binds, restores
 // its line amplitudes keeping the phases (U_k = Z_k I_k for the current) and keeps the voltage's
 // line amplitudes equal; the best period seen (the smallest max(peak u, w peak i) / rms u) is
-// kept and scaled to peak_v as before. For the fast recipe's limits (10 V, 1.6 A) the same
-// current range then carries about 1.7 times the line amplitude (about 2.7 times the
-// information).
+// kept and scaled to peak_v as before. For the fast recipe's limits (8 V, 1.6 A) the same
+// current range then carries about 1.6 times the line amplitude (about 2.6 times the
+// information; README, Transient-aware estimator and cycle time).
 #pragma once
 
 #include <complex>
