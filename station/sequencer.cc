@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <condition_variable>
+#include <future>
 #include <sstream>
 #include <thread>
 
@@ -110,11 +111,14 @@ struct Sequencer::Fault {
 };
 
 // One phase pair measured: its recording is kept for the judge (conditions are computed
-// from it).
+// from it). The analysis of its first look ran on a worker from analysis_start to
+// analysis_end (steady clock).
 struct Sequencer::MeasuredPair {
   drivers::PhasePair pair;
   analysis::Recording recording;
   analysis::ImpedanceAnalysis analysis;
+  Clock::time_point analysis_start{};
+  Clock::time_point analysis_end{};
 };
 
 // Polls the interlocks while the stator is excited. On the first broken interlock it opens
@@ -278,6 +282,7 @@ void Sequencer::ClampAndConfirm(db::TestRecord& record) {
     throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
   if (const drivers::Status s = fixture_.SelectPhasePair(recipe_->phase_pair); !s.ok())
     throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
+  selected_pair_ = recipe_->phase_pair;
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, true); !s.ok())
     throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
 
@@ -367,31 +372,79 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size
   return std::move(result->value());
 }
 
-void Sequencer::MeasurePair(db::TestRecord& record, std::size_t k,
-                            std::vector<MeasuredPair>& measured) {
-  const drivers::PhasePair pair = recipe_->phase_pairs[k];
-  const std::string suffix = k == 0 ? "" : std::string("@") + PairName(pair);
-  if (k > 0) {
-    ThrowIfAborted();
-    Enter(record, SeqState::kClamp, "phase pair " + std::to_string(static_cast<int>(pair)));
-    if (const drivers::Status s = fixture_.SelectPhasePair(pair); !s.ok())
-      throw Fault{
-          Outcome::kError,
-          {ReasonCode::kFixture, "phase pair " + std::string(PairName(pair)) + ": " + s.message()}};
+void Sequencer::SelectPair(db::TestRecord& record, drivers::PhasePair pair) {
+  if (pair == selected_pair_) return;
+  ThrowIfAborted();
+  Enter(record, SeqState::kClamp, "phase pair " + std::to_string(static_cast<int>(pair)));
+  if (const drivers::Status s = fixture_.SelectPhasePair(pair); !s.ok())
+    throw Fault{
+        Outcome::kError,
+        {ReasonCode::kFixture, "phase pair " + std::string(PairName(pair)) + ": " + s.message()}};
+  selected_pair_ = pair;
+}
+
+std::vector<Sequencer::MeasuredPair> Sequencer::MeasurePairs(db::TestRecord& record) {
+  const std::vector<drivers::PhasePair>& pairs = recipe_->phase_pairs;
+  // The analysis reads only what the task owns: the recording, the lines and the recipe.
+  auto analyse = [recipe = recipe_, lines = excitation_.lines](drivers::PhasePair pair,
+                                                               analysis::Recording recording) {
+    MeasuredPair m{pair, std::move(recording), {}, Clock::now(), {}};
+    m.analysis = analysis::AnalyzeRecording(m.recording, lines, recipe->analysis);
+    m.analysis_end = Clock::now();
+    return m;
+  };
+  // Unwinding on a fault waits for the tasks still running (std::async's futures), at most
+  // one analysis: the relay is already off then (ExciteAndRecord opens it before it throws).
+  std::vector<std::future<MeasuredPair>> pending;
+  std::vector<MeasuredPair> measured;
+  std::vector<std::pair<Clock::time_point, Clock::time_point>> excited;
+  auto collect_next = [&] { measured.push_back(pending[measured.size()].get()); };
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    if (k > 0) SelectPair(record, pairs[k]);
+    const Clock::time_point t0 = Clock::now();
+    analysis::Recording recording =
+        ExciteAndRecord(record, recipe_->transient_periods + recipe_->periods);
+    excited.emplace_back(t0, Clock::now());
+    pending.push_back(std::async(std::launch::async, analyse, pairs[k], std::move(recording)));
+    if (k > 0) {
+      // Pair k-1 was analysed while pair k was excited: an unusable pair makes the verdict
+      // ERROR whatever follows, so the motor is not excited again.
+      collect_next();
+      if (!measured.back().analysis.usable) break;
+    }
   }
-  analysis::Recording recording =
-      ExciteAndRecord(record, recipe_->transient_periods + recipe_->periods);
   Enter(record, SeqState::kAnalyse);
-  analysis::ImpedanceAnalysis a =
-      analysis::AnalyzeRecording(recording, excitation_.lines, recipe_->analysis);
-  if (recipe_->sequential) ExtendWhileUndecided(record, pair, suffix, recording, a);
-  if (a.frf.frf.size() > 0) record.curves.push_back(ToCurve(a.frf.frf, "impedance" + suffix));
-  record.conditions["periods_used"] = a.frf.periods_used;
-  if (!a.fit.params.empty()) {
-    if (k == 0) record.fit = a.fit;  // analysis/fit/fit_json.h
-    record.curves.push_back(ToCurve(a.fit.Model().Evaluate(a.frf.frf.freq_hz), "model" + suffix));
+  while (measured.size() < pending.size()) collect_next();
+  // Seconds of analysis hidden behind a later pair's excitation (0 with one pair).
+  double hidden_s = 0.0;
+  for (std::size_t k = 0; k < measured.size(); ++k)
+    for (std::size_t later = k + 1; later < excited.size(); ++later) {
+      const Clock::time_point from = std::max(measured[k].analysis_start, excited[later].first);
+      const Clock::time_point to = std::min(measured[k].analysis_end, excited[later].second);
+      if (to > from) hidden_s += std::chrono::duration<double>(to - from).count();
+    }
+  if (pending.size() > 1) record.conditions["analysis_overlapped_s"] = hidden_s;
+
+  // Extensions only while every pair is usable (else the verdict is ERROR already).
+  bool extend = recipe_->sequential.has_value() &&
+                std::all_of(measured.begin(), measured.end(),
+                            [](const MeasuredPair& m) { return m.analysis.usable; });
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    MeasuredPair& m = measured[k];
+    const std::string suffix = k == 0 ? "" : std::string("@") + PairName(m.pair);
+    if (extend) {
+      ExtendWhileUndecided(record, m.pair, suffix, m.recording, m.analysis);
+      extend = m.analysis.usable;
+    }
+    const analysis::ImpedanceAnalysis& a = m.analysis;
+    if (a.frf.frf.size() > 0) record.curves.push_back(ToCurve(a.frf.frf, "impedance" + suffix));
+    record.conditions["periods_used"] = a.frf.periods_used;
+    if (!a.fit.params.empty()) {
+      if (k == 0) record.fit = a.fit;  // analysis/fit/fit_json.h
+      record.curves.push_back(ToCurve(a.fit.Model().Evaluate(a.frf.frf.freq_hz), "model" + suffix));
+    }
   }
-  measured.push_back({pair, std::move(recording), std::move(a)});
+  return measured;
 }
 
 void Sequencer::ExtendWhileUndecided(db::TestRecord& record, drivers::PhasePair pair,
@@ -414,6 +467,7 @@ void Sequencer::ExtendWhileUndecided(db::TestRecord& record, drivers::PhasePair 
         "undecided at z " + Fixed(policy.confidence_z, 1) + ": " + undecided.front() +
             (undecided.size() > 1 ? " and " + std::to_string(undecided.size() - 1) + " more" : "") +
             "; extending");
+    SelectPair(record, pair);  // another pair was excited after this one's first look
     analysis::Recording more = ExciteAndRecord(record, policy.extend_periods);
     Enter(record, SeqState::kAnalyse, "look " + std::to_string(looks + 1));
     analysis::ImpedanceAnalysis b =
@@ -632,12 +686,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
     if (options_.on_serial) options_.on_serial(serial);
     CheckInterlocks(record);
     ClampAndConfirm(record);
-    std::vector<MeasuredPair> measured;
-    for (std::size_t k = 0; k < recipe_->phase_pairs.size(); ++k) {
-      MeasurePair(record, k, measured);
-      // The verdict cannot be better than ERROR now: do not excite the motor again.
-      if (!measured.back().analysis.usable) break;
-    }
+    const std::vector<MeasuredPair> measured = MeasurePairs(record);
     Judge(record, measured);
     Unclamp(record);
   } catch (const Fault& f) {

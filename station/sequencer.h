@@ -115,14 +115,20 @@ class Sequencer {
   void ClampAndConfirm(db::TestRecord& record);
   // Plays `periods` periods of the excitation (the first look: transient + averaged periods).
   analysis::Recording ExciteAndRecord(db::TestRecord& record, std::size_t periods);
-  // The recipe's phase pair k in the same clamping (k > 0: relay off, switch the pair first):
-  // excite, analyse, record the curves ("impedance", "model"; "<name>@<pair>" for k > 0) and,
-  // for the first pair, the fit summary. Appends the recording and analysis to `measured`.
-  // With a "sequential" recipe, a pair whose measurements are undecided after a look is
-  // excited again and the looks combined (station/recipe.h SequentialPolicy); the record's
-  // conditions keep the looks ("looks", "looks@<pair>") and what was undecided.
+  // The recipe's phase pairs in one clamping, excited back to back: pair k is analysed on a
+  // worker thread while pair k+1 is switched (relay off) and excited. Then, with a
+  // "sequential" recipe, a pair whose measurements are undecided after its first look is
+  // selected again, excited again and the looks combined (station/recipe.h
+  // SequentialPolicy; the conditions keep "looks", "looks@<pair>" and what was undecided).
+  // Last, each pair's curves ("impedance", "model"; "<name>@<pair>" for k > 0) and the first
+  // pair's fit summary go into the record. A pair found unusable (its verdict can only be
+  // ERROR) stops further excitation once its analysis is known: at most one pair later than
+  // a strictly serial order would. With more than one pair the conditions keep
+  // "analysis_overlapped_s": the seconds of analysis that ran while a later pair was excited.
   struct MeasuredPair;
-  void MeasurePair(db::TestRecord& record, std::size_t k, std::vector<MeasuredPair>& measured);
+  std::vector<MeasuredPair> MeasurePairs(db::TestRecord& record);
+  // Switches the fixture's relays to `pair` (relay off) unless it is the one selected.
+  void SelectPair(db::TestRecord& record, drivers::PhasePair pair);
   void ExtendWhileUndecided(db::TestRecord& record, drivers::PhasePair pair,
                             const std::string& suffix, analysis::Recording& recording,
                             analysis::ImpedanceAnalysis& a);
@@ -144,6 +150,7 @@ class Sequencer {
   HeartbeatMonitor heartbeat_;
   // The heartbeat read right after the last excitation ended; Unclamp waits for a newer one.
   std::optional<std::uint32_t> beat_after_excitation_;
+  drivers::PhasePair selected_pair_ = drivers::PhasePair::kUV;  // set when clamping
 
   std::atomic<SeqState> state_{SeqState::kWaitSerial};
   std::atomic<bool> stop_requested_{false};  // sticky: RequestAbort() was called

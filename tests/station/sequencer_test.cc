@@ -156,6 +156,80 @@ TEST_F(SequencerTest, EveryPhasePairOfTheRecipeIsMeasuredInOneClamping) {
   ExpectStored(bad);
 }
 
+// Issue 16, overlap: pair k is analysed on a worker while pair k+1 is excited, so the three
+// excitations follow one another with no analysis state between them, and the record says how
+// much analysis ran behind a later excitation; with one pair nothing can overlap.
+TEST_F(SequencerTest, EachPairIsAnalysedWhileTheNextIsExcited) {
+  Build(1.0);  // real-time acquisition: each excitation lasts its 0.47 s
+  recipe_ = LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json");
+  recipe_.sequential.reset();  // one look per pair: the order of states is then fixed
+  auto rebuild = [&] {
+    SequencerOptions o;
+    o.station_id = "test";
+    sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
+                                             std::make_shared<const Recipe>(recipe_), *board_, o);
+  };
+  auto excite_and_analyse = [](const db::TestRecord& r) {
+    std::vector<std::string> states;
+    for (const auto& t : r.trace)
+      if (t.state == "excite" || t.state == "analyse") states.push_back(t.state);
+    return states;
+  };
+  recipe_.phase_pairs = {drivers::PhasePair::kUV, drivers::PhasePair::kVW, drivers::PhasePair::kWU};
+  rebuild();
+  const db::TestRecord three = Test("OVERLAP-3", false);
+  ASSERT_EQ(three.outcome, Outcome::kPass)
+      << (three.reasons.empty() ? "" : three.reasons.front().text);
+  EXPECT_EQ(excite_and_analyse(three),
+            (std::vector<std::string>{"excite", "excite", "excite", "analyse"}));
+  ASSERT_TRUE(three.conditions.contains("analysis_overlapped_s"));
+  EXPECT_GT(three.conditions["analysis_overlapped_s"].get<double>(), 0.0);
+  EXPECT_EQ(three.measurements.size(), 3 * recipe_.Specs().size());
+  const auto stored = store_->Test(three.id);
+  ASSERT_TRUE(stored.has_value());
+  std::vector<std::string> curves;
+  for (const auto& c : stored->curves) curves.push_back(c.name);
+  EXPECT_EQ(curves, (std::vector<std::string>{"impedance", "model", "impedance@V-W", "model@V-W",
+                                              "impedance@W-U", "model@W-U"}));
+
+  recipe_.phase_pairs = {drivers::PhasePair::kUV};
+  rebuild();
+  const db::TestRecord one = Test("OVERLAP-1", false);
+  EXPECT_EQ(one.outcome, Outcome::kPass) << (one.reasons.empty() ? "" : one.reasons.front().text);
+  EXPECT_EQ(excite_and_analyse(one), (std::vector<std::string>{"excite", "analyse"}));
+  EXPECT_FALSE(one.conditions.contains("analysis_overlapped_s"));
+}
+
+// A sequential recipe with three pairs: the first looks come back to back, then each pair still
+// undecided is selected again and extended, in the recipe's order.
+TEST_F(SequencerTest, UndecidedPairsAreSelectedAgainForTheirExtension) {
+  Build(0.0);
+  recipe_.phase_pairs = {drivers::PhasePair::kUV, drivers::PhasePair::kVW, drivers::PhasePair::kWU};
+  recipe_.sequential =
+      SequentialPolicy{.extend_periods = 8, .max_extensions = 1, .confidence_z = 3.0};
+  for (auto& spec : recipe_.limits)
+    if (spec.name == analysis::names::kResonanceFHz) spec.limit.marginal = 100.0;
+  SequencerOptions o;
+  o.station_id = "test";
+  sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
+                                           std::make_shared<const Recipe>(recipe_), *board_, o);
+  const db::TestRecord r = Test("SEQ-PAIRS", false);
+  EXPECT_EQ(r.outcome, Outcome::kPass) << (r.reasons.empty() ? "" : r.reasons.front().text);
+  for (const char* looks : {"looks", "looks@V-W", "looks@W-U"})
+    EXPECT_EQ(r.conditions.value(looks, 0), 2) << looks;
+  // Pair switches and excitations in order: 0 (clamping), 1, 2, then 0, 1, 2 again.
+  std::vector<std::string> steps;
+  for (const auto& t : r.trace) {
+    if (t.state == "excite") steps.push_back("excite");
+    if (t.state == "clamp") steps.push_back(t.detail);
+  }
+  EXPECT_EQ(steps, (std::vector<std::string>{"phase pair 0", "excite", "phase pair 1", "excite",
+                                             "phase pair 2", "excite", "phase pair 0", "excite",
+                                             "phase pair 1", "excite", "phase pair 2", "excite"}));
+  EXPECT_EQ(bench_->phase_pair(), drivers::PhasePair::kWU);
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+}
+
 // Issue 16's sequential decision: a unit whose measurements are decided stops after its first
 // look; one that sits near a limit (here: a marginal band wider than the window) is excited
 // again and judged on both looks combined, with a smaller sigma.
