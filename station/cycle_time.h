@@ -7,7 +7,9 @@
 //   clamp       clamp, confirm_clamp (command to clamp confirmed with the interlocks
 //               re-read before excitation; phase-pair switches)
 //   excitation  excite (relay on, acquisition, relay off, watchdog stopped), all pairs
-//   analysis    analyse (Z(f), fit), all pairs
+//   analysis    analyse (Z(f), fit): the wait for it; with several phase pairs each pair but
+//               the last is analysed while the next is excited, which is not counted here
+//               (the record's conditions.analysis_overlapped_s says how much that was)
 //   judge       judge
 //   unclamp     unclamp (release confirmed, fresh heartbeat)
 //   safe_state  safe_state (after a fault)
