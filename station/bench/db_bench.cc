@@ -12,6 +12,7 @@
 
 #include "db/clock.h"
 #include "db/store.h"
+#include "station/bench/db_replicate.h"
 
 namespace eol::station {
 namespace {
@@ -53,11 +54,11 @@ db::TestRecord Template(const std::string& path) {
 }  // namespace
 
 DbBenchSummary RunDbBench(const DbBenchOptions& o) {
-  if (o.tests < 1 || o.batch < 1 || !(o.interval_s > 0.0) || o.queries < 1 ||
+  if (o.tests < 1 || o.batch < 1 || !(o.interval_s > 0.0) || o.queries < 1 || o.replicate < 1 ||
       !(o.retest_share >= 0.0 && o.retest_share < 1.0))
     throw std::runtime_error(
-        "db-bench: tests, batch and queries must be positive, interval_s positive and "
-        "retest_share in [0, 1)");
+        "db-bench: tests, batch, queries and replicate must be positive, interval_s positive "
+        "and retest_share in [0, 1)");
   if (std::filesystem::exists(o.db))
     throw std::runtime_error(o.db +
                              " exists: db-bench creates its own store (choose another --db)");
@@ -73,7 +74,6 @@ DbBenchSummary RunDbBench(const DbBenchOptions& o) {
   std::normal_distribution<double> gauss;
   std::uniform_real_distribution<double> uniform;
   std::int64_t unit = 0;
-  std::vector<std::string> serials;  // every serial made, for the lookups
   {
     auto store = db::Store::Open(o.db);
     const auto start = Clock::now();
@@ -84,8 +84,8 @@ DbBenchSummary RunDbBench(const DbBenchOptions& o) {
       r.id = 0;
       r.retest_of.reset();
       const bool retest = i > 0 && uniform(rng) < o.retest_share;
-      if (!retest) serials.push_back(SerialOf(++unit));
-      r.serial = serials.back();
+      if (!retest) ++unit;
+      r.serial = SerialOf(unit);
       const auto at = std::chrono::system_clock::time_point(t0) + i * step;
       r.started_at = db::UtcIso8601(at);
       r.finished_at = db::UtcIso8601(at + std::chrono::milliseconds(850));
@@ -105,7 +105,12 @@ DbBenchSummary RunDbBench(const DbBenchOptions& o) {
     }
     s.insert_s = Seconds(start);
   }
-  s.tests = o.tests;
+  s.generated = o.tests;
+  const auto copy_start = Clock::now();
+  ReplicateBlock(o.db, o.tests, unit, static_cast<double>(o.tests) * o.interval_s, o.replicate,
+                 o.progress);
+  s.replicate_s = Seconds(copy_start);
+  s.tests = o.tests * o.replicate;
 
   // 2. Size: the database file (closing the writer checkpointed the WAL into it).
   auto store = db::Store::Open(o.db, db::Store::Role::kReadOnly);
@@ -117,9 +122,10 @@ DbBenchSummary RunDbBench(const DbBenchOptions& o) {
 
   // 3. Per-serial lookups.
   std::vector<double> history, latest;
-  std::uniform_int_distribution<std::size_t> pick(0, serials.size() - 1);
+  std::uniform_int_distribution<std::int64_t> pick_unit(1, unit);
+  std::uniform_int_distribution<int> pick_copy(0, o.replicate - 1);
   for (int q = 0; q < o.queries; ++q) {
-    const std::string& serial = serials[pick(rng)];
+    const std::string serial = SerialOf(pick_unit(rng) + pick_copy(rng) * unit);
     auto t = Clock::now();
     if (store->TestsOfSerial(serial).empty()) throw std::runtime_error("lost serial " + serial);
     history.push_back(1e3 * Seconds(t));
@@ -133,7 +139,7 @@ DbBenchSummary RunDbBench(const DbBenchOptions& o) {
 
   // 4. One day's export (the middle day of the generated span), as eol export pages it.
   const std::int64_t per_day = static_cast<std::int64_t>(86400.0 / o.interval_s);
-  const std::int64_t day = std::max<std::int64_t>(0, (o.tests / per_day) / 2);
+  const std::int64_t day = std::max<std::int64_t>(0, (s.tests / per_day) / 2);
   const auto day_start = std::chrono::system_clock::time_point(t0) + std::chrono::days(day);
   for (bool curves : {false, true}) {
     db::TestQuery q;

@@ -11,6 +11,9 @@
 //   - the export of one day of tests (Tests, keyset pages of 10,000, with and without curves)
 //     and of one day's measurement rows (MeasurementRows): rows per second;
 // and the file's size: bytes per test and the growth per year at the line's rate.
+// With replicate K > 1 the generated block is then copied K - 1 times inside SQLite
+// (db_replicate.h: later in time, new serials, the same bytes), so a store of tests x K is
+// measured without generating each test through the Store.
 // Progress goes to `progress` (analysis/progress.h).
 #pragma once
 
@@ -30,13 +33,16 @@ struct DbBenchOptions {
   double retest_share = 0.03;  // tests that repeat the previous serial
   int queries = 1000;          // random serials looked up
   std::uint64_t seed = 1;
+  int replicate = 1;  // copies of the generated block in the store (1: the block alone)
   analysis::ProgressCallback progress;
 };
 
 struct DbBenchSummary {
-  std::int64_t tests = 0;
-  double insert_s = 0.0;    // wall time of the generation
-  double file_bytes = 0.0;  // database + WAL after a checkpoint
+  std::int64_t tests = 0;      // in the store: generated x replicate
+  std::int64_t generated = 0;  // generated through the Store
+  double insert_s = 0.0;       // wall time of the generation
+  double replicate_s = 0.0;    // wall time of the copies
+  double file_bytes = 0.0;     // database + WAL after a checkpoint
   double bytes_per_test = 0.0;
   double growth_gb_per_year = 0.0;                       // at one test per interval_s, all year
   double history_median_ms = 0.0, history_p99_ms = 0.0;  // TestsOfSerial

@@ -47,5 +47,43 @@ TEST(DbBench, GeneratedStoreHoldsEveryTestAndItsFiguresAddUp) {
   EXPECT_NE(again.output().find("exists"), std::string::npos) << again.output();
 }
 
+// --replicate: the generated block copied inside SQLite; each copy is its own serials later in
+// time with the same bytes, read back through the Store like any test.
+TEST(DbBench, ReplicatedBlocksAreNewSerialsLaterInTimeWithTheSameRecords) {
+  testing::TempDir dir;
+  const std::string tpl = dir / "template.sqlite";
+  ChildProcess demo(
+      {EOL_BINARY, "demo", "--units", "1", "--db", tpl, "--port", "0", "--fixture", "sim"});
+  ASSERT_EQ(demo.Wait(std::chrono::seconds(300)), 0) << demo.output();
+  const std::string db = dir / "bench.sqlite";
+  // 400 tests at one per 10 s, no retests: units DBB-1..400 span 4000 s; three blocks.
+  ChildProcess bench({EOL_BINARY, "db-bench", "--template", tpl, "--db", db, "--tests", "400",
+                      "--retest-share", "0", "--replicate", "3", "--queries", "30", "--json"},
+                     /*merge_stderr=*/false);
+  ASSERT_EQ(bench.Wait(std::chrono::seconds(300)), 0) << bench.output();
+  const nlohmann::json s = nlohmann::json::parse(bench.output());
+  EXPECT_EQ(s["tests"], 1200);
+  EXPECT_EQ(s["generated"], 400);
+  EXPECT_EQ(s["day_tests"], 1200);
+  auto store = db::Store::Open(db, db::Store::Role::kReadOnly);
+  const auto original = store->TestsOfSerial("DBB-000000007", /*with_curves=*/true);
+  const auto copy = store->TestsOfSerial("DBB-000000807", /*with_curves=*/true);
+  ASSERT_EQ(original.size(), 1u);
+  ASSERT_EQ(copy.size(), 1u);
+  EXPECT_EQ(original[0].id, 7);
+  EXPECT_EQ(copy[0].id, 807);
+  EXPECT_EQ(original[0].started_at, "2026-01-01T00:01:00.000Z");
+  EXPECT_EQ(copy[0].started_at, "2026-01-01T02:14:20.000Z");  // + 2 x 4000 s
+  ASSERT_EQ(copy[0].measurements.size(), original[0].measurements.size());
+  for (std::size_t k = 0; k < copy[0].measurements.size(); ++k) {
+    EXPECT_EQ(copy[0].measurements[k].name, original[0].measurements[k].name);
+    EXPECT_EQ(copy[0].measurements[k].value, original[0].measurements[k].value);
+  }
+  ASSERT_EQ(copy[0].curves.size(), original[0].curves.size());
+  EXPECT_EQ(copy[0].curves.front().re, original[0].curves.front().re);
+  EXPECT_TRUE(store->TestsOfSerial("DBB-000001201").empty());
+  EXPECT_EQ(store->MeasurementRows({}).size(), 1200 * original[0].measurements.size());
+}
+
 }  // namespace
 }  // namespace eol::station

@@ -1,0 +1,104 @@
+#include "station/bench/db_replicate.h"
+
+#include <sqlite3.h>
+
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <stdexcept>
+
+namespace eol::station {
+namespace {
+
+using Db = std::unique_ptr<sqlite3, decltype(&sqlite3_close)>;
+
+Db OpenForWrite(const std::string& path) {
+  sqlite3* raw = nullptr;
+  const int rc = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE, nullptr);
+  Db db(raw, &sqlite3_close);
+  if (rc != SQLITE_OK)
+    throw std::runtime_error(
+        path + ": open for replication: " + (raw ? sqlite3_errmsg(raw) : sqlite3_errstr(rc)));
+  return db;
+}
+
+void Exec(sqlite3* db, const std::string& path, const std::string& sql, const std::string& step) {
+  char* error = nullptr;
+  if (sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
+    const std::string why = error ? error : sqlite3_errmsg(db);
+    sqlite3_free(error);
+    throw std::runtime_error(path + ": " + step + ": " + why);
+  }
+}
+
+std::int64_t Count(sqlite3* db, const std::string& path, const char* sql) {
+  sqlite3_stmt* raw = nullptr;
+  if (sqlite3_prepare_v2(db, sql, -1, &raw, nullptr) != SQLITE_OK)
+    throw std::runtime_error(path + ": " + sql + ": " + sqlite3_errmsg(db));
+  std::unique_ptr<sqlite3_stmt, decltype(&sqlite3_finalize)> s(raw, &sqlite3_finalize);
+  if (sqlite3_step(raw) != SQLITE_ROW)
+    throw std::runtime_error(path + ": " + sql + ": " + sqlite3_errmsg(db));
+  return sqlite3_column_int64(raw, 0);
+}
+
+// `sql` with every {NAME} replaced by its number.
+std::string Fill(std::string sql, const std::map<std::string, std::string>& values) {
+  for (const auto& [name, value] : values)
+    for (std::size_t at; (at = sql.find("{" + name + "}")) != std::string::npos;)
+      sql.replace(at, name.size() + 2, value);
+  return sql;
+}
+
+// Copy k of tests 1..{N}: ids + {SHIFT}, units + {UNITS}, times + {LATER} seconds.
+constexpr const char* kCopySql =
+    "INSERT INTO tests (id, serial, station_id, recipe_id, recipe_version, recipe_hash, "
+    "software_version, started_at, finished_at, outcome, retest_of, reasons, record, kind, "
+    "operator_id, shift, order_number) "
+    "SELECT id + {SHIFT}, 'DBB-' || printf('%09d', CAST(substr(serial, 5) AS INTEGER) + {UNITS}), "
+    "station_id, recipe_id, recipe_version, recipe_hash, software_version, "
+    "strftime('%Y-%m-%dT%H:%M:%fZ', started_at, '+{LATER} seconds'), "
+    "strftime('%Y-%m-%dT%H:%M:%fZ', finished_at, '+{LATER} seconds'), outcome, "
+    "retest_of + {SHIFT}, reasons, record, kind, operator_id, shift, order_number "
+    "FROM tests WHERE id <= {N};"
+    "INSERT INTO measurements (test_id, name, value, sigma, unit, lo, hi, outcome, marginal) "
+    "SELECT test_id + {SHIFT}, name, value, sigma, unit, lo, hi, outcome, marginal "
+    "FROM measurements WHERE test_id <= {N};"
+    "INSERT INTO curves (test_id, name, raw_size, data, encoding) "
+    "SELECT test_id + {SHIFT}, name, raw_size, data, encoding FROM curves WHERE test_id <= {N};"
+    "INSERT INTO outbox (test_id, created_at) "
+    "SELECT test_id + {SHIFT}, created_at FROM outbox WHERE test_id <= {N};";
+
+}  // namespace
+
+void ReplicateBlock(const std::string& path, std::int64_t block_tests, std::int64_t block_units,
+                    double block_span_s, int copies, const analysis::ProgressCallback& progress) {
+  if (copies <= 1) return;
+  Db db = OpenForWrite(path);
+  sqlite3_busy_timeout(db.get(), 5000);
+  if (Count(db.get(), path, "SELECT count(*) FROM tests") != block_tests ||
+      Count(db.get(), path, "SELECT min(id) FROM tests") != 1 ||
+      Count(db.get(), path, "SELECT max(id) FROM tests") != block_tests)
+    throw std::runtime_error(path + ": replication needs a fresh store of tests 1.." +
+                             std::to_string(block_tests));
+  for (int k = 1; k < copies; ++k) {
+    char later[64];
+    std::snprintf(later, sizeof later, "%.3f", k * block_span_s);
+    const std::string sql = Fill(kCopySql, {{"N", std::to_string(block_tests)},
+                                            {"SHIFT", std::to_string(k * block_tests)},
+                                            {"UNITS", std::to_string(k * block_units)},
+                                            {"LATER", later}});
+    Exec(db.get(), path, "BEGIN IMMEDIATE", "begin copy");
+    try {
+      Exec(db.get(), path, sql, "copy " + std::to_string(k));
+      Exec(db.get(), path, "COMMIT", "commit copy");
+    } catch (...) {
+      sqlite3_exec(db.get(), "ROLLBACK", nullptr, nullptr, nullptr);
+      throw;
+    }
+    if (progress) progress("replicate", k + 1, copies);
+  }
+  if (Count(db.get(), path, "SELECT count(*) FROM tests") != block_tests * copies)
+    throw std::runtime_error(path + ": replication left a wrong number of tests");
+}
+
+}  // namespace eol::station
