@@ -13,12 +13,18 @@ namespace {
 
 using testing::ChildProcess;
 
-TEST(DbBench, GeneratedStoreHoldsEveryTestAndItsFiguresAddUp) {
-  testing::TempDir dir;
+// A station store of `units` demo tests (fast recipe, simulated fixture): db-bench's template.
+std::string DemoTemplate(const testing::TempDir& dir, const char* units) {
   const std::string tpl = dir / "template.sqlite";
   ChildProcess demo(
-      {EOL_BINARY, "demo", "--units", "2", "--db", tpl, "--port", "0", "--fixture", "sim"});
-  ASSERT_EQ(demo.Wait(std::chrono::seconds(300)), 0) << demo.output();
+      {EOL_BINARY, "demo", "--units", units, "--db", tpl, "--port", "0", "--fixture", "sim"});
+  EXPECT_EQ(demo.Wait(std::chrono::seconds(300)), 0) << demo.output();
+  return tpl;
+}
+
+TEST(DbBench, GeneratedStoreHoldsEveryTestAndItsFiguresAddUp) {
+  testing::TempDir dir;
+  const std::string tpl = DemoTemplate(dir, "2");
   const std::string db = dir / "bench.sqlite";
   ChildProcess bench({EOL_BINARY, "db-bench", "--template", tpl, "--db", db, "--tests", "3000",
                       "--batch", "700", "--queries", "50", "--json"},
@@ -51,10 +57,7 @@ TEST(DbBench, GeneratedStoreHoldsEveryTestAndItsFiguresAddUp) {
 // time with the same bytes, read back through the Store like any test.
 TEST(DbBench, ReplicatedBlocksAreNewSerialsLaterInTimeWithTheSameRecords) {
   testing::TempDir dir;
-  const std::string tpl = dir / "template.sqlite";
-  ChildProcess demo(
-      {EOL_BINARY, "demo", "--units", "1", "--db", tpl, "--port", "0", "--fixture", "sim"});
-  ASSERT_EQ(demo.Wait(std::chrono::seconds(300)), 0) << demo.output();
+  const std::string tpl = DemoTemplate(dir, "1");
   const std::string db = dir / "bench.sqlite";
   // 400 tests at one per 10 s, no retests: units DBB-1..400 span 4000 s; three blocks.
   ChildProcess bench({EOL_BINARY, "db-bench", "--template", tpl, "--db", db, "--tests", "400",

@@ -38,6 +38,11 @@ class SequencerTest : public ::testing::Test {
     store_ = db::Store::Open(dir_ / "eol.sqlite");
     recipe_ = LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json");
     board_ = std::make_unique<StatusBoard>("test");
+    Rebuild();
+  }
+
+  // A sequencer on the bench with recipe_ as it is now.
+  void Rebuild() {
     SequencerOptions o;
     o.station_id = "test";
     sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
@@ -128,10 +133,7 @@ TEST_F(SequencerTest, RetestLimitRefusesASerialBeforeClamping) {
 TEST_F(SequencerTest, EveryPhasePairOfTheRecipeIsMeasuredInOneClamping) {
   Build(0.0);
   recipe_.phase_pairs = {drivers::PhasePair::kUV, drivers::PhasePair::kVW, drivers::PhasePair::kWU};
-  SequencerOptions o;
-  o.station_id = "test";
-  sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
-                                           std::make_shared<const Recipe>(recipe_), *board_, o);
+  Rebuild();
   const db::TestRecord good = Test("PAIRS-GOOD", false);
   EXPECT_EQ(good.outcome, Outcome::kPass)
       << (good.reasons.empty() ? "" : good.reasons.front().text);
@@ -163,12 +165,6 @@ TEST_F(SequencerTest, EachPairIsAnalysedWhileTheNextIsExcited) {
   Build(1.0);  // real-time acquisition: each excitation lasts its 0.47 s
   recipe_ = LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json");
   recipe_.sequential.reset();  // one look per pair: the order of states is then fixed
-  auto rebuild = [&] {
-    SequencerOptions o;
-    o.station_id = "test";
-    sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
-                                             std::make_shared<const Recipe>(recipe_), *board_, o);
-  };
   auto excite_and_analyse = [](const db::TestRecord& r) {
     std::vector<std::string> states;
     for (const auto& t : r.trace)
@@ -176,7 +172,7 @@ TEST_F(SequencerTest, EachPairIsAnalysedWhileTheNextIsExcited) {
     return states;
   };
   recipe_.phase_pairs = {drivers::PhasePair::kUV, drivers::PhasePair::kVW, drivers::PhasePair::kWU};
-  rebuild();
+  Rebuild();
   const db::TestRecord three = Test("OVERLAP-3", false);
   ASSERT_EQ(three.outcome, Outcome::kPass)
       << (three.reasons.empty() ? "" : three.reasons.front().text);
@@ -193,7 +189,7 @@ TEST_F(SequencerTest, EachPairIsAnalysedWhileTheNextIsExcited) {
                                               "impedance@W-U", "model@W-U"}));
 
   recipe_.phase_pairs = {drivers::PhasePair::kUV};
-  rebuild();
+  Rebuild();
   const db::TestRecord one = Test("OVERLAP-1", false);
   EXPECT_EQ(one.outcome, Outcome::kPass) << (one.reasons.empty() ? "" : one.reasons.front().text);
   EXPECT_EQ(excite_and_analyse(one), (std::vector<std::string>{"excite", "analyse"}));
@@ -209,10 +205,7 @@ TEST_F(SequencerTest, UndecidedPairsAreSelectedAgainForTheirExtension) {
       SequentialPolicy{.extend_periods = 8, .max_extensions = 1, .confidence_z = 3.0};
   for (auto& spec : recipe_.limits)
     if (spec.name == analysis::names::kResonanceFHz) spec.limit.marginal = 100.0;
-  SequencerOptions o;
-  o.station_id = "test";
-  sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
-                                           std::make_shared<const Recipe>(recipe_), *board_, o);
+  Rebuild();
   const db::TestRecord r = Test("SEQ-PAIRS", false);
   EXPECT_EQ(r.outcome, Outcome::kPass) << (r.reasons.empty() ? "" : r.reasons.front().text);
   for (const char* looks : {"looks", "looks@V-W", "looks@W-U"})
@@ -237,12 +230,6 @@ TEST_F(SequencerTest, SequentialRecipeExtendsOnlyUndecidedUnits) {
   Build(0.0);
   recipe_.sequential =
       SequentialPolicy{.extend_periods = 8, .max_extensions = 1, .confidence_z = 3.0};
-  auto rebuild = [&] {
-    SequencerOptions o;
-    o.station_id = "test";
-    sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
-                                             std::make_shared<const Recipe>(recipe_), *board_, o);
-  };
   auto f0_of = [](const db::TestRecord& r) {
     for (const auto& m : r.measurements)
       if (m.name == analysis::names::kResonanceFHz) return m;
@@ -252,7 +239,7 @@ TEST_F(SequencerTest, SequentialRecipeExtendsOnlyUndecidedUnits) {
     return std::count_if(r.trace.begin(), r.trace.end(),
                          [](const auto& t) { return t.state == "excite"; });
   };
-  rebuild();
+  Rebuild();
   const db::TestRecord far = Test("SEQ-1", false);
   EXPECT_EQ(far.outcome, Outcome::kPass) << (far.reasons.empty() ? "" : far.reasons[0].text);
   EXPECT_EQ(far.conditions.value("looks", 0), 1);
@@ -261,7 +248,7 @@ TEST_F(SequencerTest, SequentialRecipeExtendsOnlyUndecidedUnits) {
 
   for (auto& spec : recipe_.limits)
     if (spec.name == analysis::names::kResonanceFHz) spec.limit.marginal = 100.0;
-  rebuild();
+  Rebuild();
   const db::TestRecord near = Test("SEQ-1", false);
   EXPECT_EQ(near.outcome, Outcome::kPass) << (near.reasons.empty() ? "" : near.reasons[0].text);
   EXPECT_EQ(near.conditions.value("looks", 0), 2);
