@@ -109,10 +109,20 @@ void ReadGapInputs(const std::string& simulation, const std::vector<std::string>
 }
 
 void DiagnoseGapReport(const GapRunOptions& o, GapReport* r) {
-  r->inertia_kg_m2 = o.inertia_kg_m2 > 0.0               ? o.inertia_kg_m2
-                     : r->simulation.inertia_kg_m2 > 0.0 ? r->simulation.inertia_kg_m2
-                     : o.io.quantity == analysis::Quantity::kImpedanceOhm ? o.fallback_inertia_kg_m2
-                                                                          : 0.0;
+  const bool impedance = o.io.quantity == analysis::Quantity::kImpedanceOhm;
+  if (o.inertia_kg_m2 > 0.0) {
+    r->inertia_kg_m2 = o.inertia_kg_m2;
+    r->inertia_source = "given";
+  } else if (r->simulation.inertia_kg_m2 > 0.0) {
+    r->inertia_kg_m2 = r->simulation.inertia_kg_m2;
+    r->inertia_source = "simulation";
+  } else if (impedance && o.fallback_inertia_kg_m2 > 0.0) {
+    r->inertia_kg_m2 = o.fallback_inertia_kg_m2;
+    r->inertia_source = "recipe";
+  } else {
+    r->inertia_kg_m2 = 0.0;
+    r->inertia_source = "";
+  }
   r->calibration = CalibrateToSimulation(r->simulation, r->inertia_kg_m2);
   if (!r->calibration.usable)
     throw GapNotUsable(r->simulation.source + ": " + r->calibration.message);

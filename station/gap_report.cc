@@ -159,7 +159,8 @@ json GapReportJson(const GapReport& r) {
                       {"message", r.calibration.message},
                       {"params", FittedParams(r.calibration.params)},
                       {"misfit_rel_rms", Num(r.calibration.misfit_rel_rms)},
-                      {"inertia_kg_m2", Num(r.calibration.nominal.inertia_kg_m2)}};
+                      {"inertia_kg_m2", Num(r.calibration.nominal.inertia_kg_m2)},
+                      {"inertia_source", r.inertia_source}};
   json meas = json::array();
   for (std::size_t u = 0; u < r.measured.size(); ++u) {
     json m = {{"source", r.measured[u].source},
@@ -210,7 +211,11 @@ std::string GapReportText(const GapReport& r) {
   for (const auto& p : r.calibration.params) os << p.name << " " << Fmt("%.5g", p.value) << "  ";
   os << "(misfit " << Fmt("%.2g", r.calibration.misfit_rel_rms) << " rms relative";
   if (r.calibration.nominal.inertia_kg_m2 > 0.0)
-    os << ", J_r " << Fmt("%.4g", r.calibration.nominal.inertia_kg_m2) << " kg m^2";
+    os << ", J_r " << Fmt("%.4g", r.calibration.nominal.inertia_kg_m2) << " kg m^2"
+       << (r.inertia_source == "recipe"
+               ? " assumed from the recipe's rotor: the simulation names none (--inertia-kg-m2)"
+           : r.inertia_source == "given" ? " given"
+                                         : "");
   os << ")\n";
   for (std::size_t u = 0; u < r.measured.size(); ++u) {
     os << "measured     " << r.measured[u].source << ": " << r.measured[u].note << "\n";

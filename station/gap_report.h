@@ -24,7 +24,8 @@
 //                       names f0_hz, q, peak_height_ohm, r_ohm, l_h (impedance) or
 //                       gain_rad_per_s2_per_a, damping_per_s (mobility)
 //   calibration         {simulation, kind, note, params {name: {value, sigma}},
-//                       misfit_rel_rms, inertia_kg_m2}: the nominal fitted to the simulation
+//                       misfit_rel_rms, inertia_kg_m2, inertia_source}: the nominal fitted to the
+//                       simulation; inertia_source says where J_r came from (GapReport)
 //   refit               [{measurement, params {name: {value, sigma}}, gap_after_refit}]: the
 //                       nominal refitted to each measurement (not an unmodelled effect)
 //   split               calibration and structure apart (diagnosis.h GapSplit): {g_nominal,
@@ -70,6 +71,10 @@ struct GapReport {
   int sigma_pool = 0;
   double sigma_dof = 0.0;
   double inertia_kg_m2 = 0.0;  // J_r the calibration used (0: unknown)
+  // Where J_r came from: "given" (--inertia), "simulation" (its motor file), "recipe" (the
+  // recipe's rotor, assumed because the simulation names none: meaningless for another
+  // machine) or "" (unknown).
+  std::string inertia_source;
   analysis::GapSummary gap;
   std::vector<analysis::FeatureSummary> features;  // per measured unit
   std::optional<GapPrediction> prediction;

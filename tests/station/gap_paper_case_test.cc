@@ -153,6 +153,7 @@ TEST(GapPaperCase, TorsionalChainMotorJson) {
   const double k = j["params"]["k_fixture_nm_per_rad"].get<double>();
   EXPECT_NEAR(k / analysis::MotorPopulation{}.KFixtureNmPerRad(), 1.0, 0.05) << k;
   EXPECT_NEAR(j["calibration"]["inertia_kg_m2"].get<double>(), 1e-4, 1e-9);
+  EXPECT_EQ(j["calibration"]["inertia_source"], "simulation");
   // The chain puts the poorly cemented rotor at 366 Hz in the fixture, the series spring at
   // about 350: the prediction must land in that neighbourhood, far from the naive 529 * 390/706.
   const double f_pred = j["prediction"]["f0_predicted_hz"].get<double>();

@@ -86,6 +86,10 @@ TEST(GapPublicImpedance, LoudspeakerNamesTheLossyCoilAndSplitsCalibrationFromStr
   EXPECT_LT(g_refit_effect, g_refit / 5.0) << s.dump();
   EXPECT_LT(g_refit_effect, kRightPhysicsRefitG) << s.dump();
   EXPECT_LT(s["heldout_g_refit_effect"].get<double>(), 1.2 * g_refit_effect) << s.dump();
+
+  // A loudspeaker's simulation names no rotor: the J_r used is the recipe's, and said so.
+  EXPECT_EQ(j["calibration"]["inertia_source"], "recipe") << j["calibration"].dump();
+  EXPECT_NE(text.find("assumed from the recipe's rotor"), std::string::npos) << text;
 }
 
 }  // namespace
