@@ -23,12 +23,6 @@ double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
 }
 
-std::string SerialOf(std::int64_t unit) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "DBB-%09lld", static_cast<long long>(unit));
-  return buf;
-}
-
 // Median and 99th percentile of `ms` (sorted in place).
 std::pair<double, double> MedianP99(std::vector<double>& ms) {
   if (ms.empty()) return {0.0, 0.0};
@@ -85,7 +79,7 @@ DbBenchSummary RunDbBench(const DbBenchOptions& o) {
       r.retest_of.reset();
       const bool retest = i > 0 && uniform(rng) < o.retest_share;
       if (!retest) ++unit;
-      r.serial = SerialOf(unit);
+      r.serial = DbBenchSerial(unit);
       const auto at = std::chrono::system_clock::time_point(t0) + i * step;
       r.started_at = db::UtcIso8601(at);
       r.finished_at = db::UtcIso8601(at + std::chrono::milliseconds(850));
@@ -125,7 +119,7 @@ DbBenchSummary RunDbBench(const DbBenchOptions& o) {
   std::uniform_int_distribution<std::int64_t> pick_unit(1, unit);
   std::uniform_int_distribution<int> pick_copy(0, o.replicate - 1);
   for (int q = 0; q < o.queries; ++q) {
-    const std::string serial = SerialOf(pick_unit(rng) + pick_copy(rng) * unit);
+    const std::string serial = DbBenchSerial(pick_unit(rng) + pick_copy(rng) * unit);
     auto t = Clock::now();
     if (store->TestsOfSerial(serial).empty()) throw std::runtime_error("lost serial " + serial);
     history.push_back(1e3 * Seconds(t));

@@ -3,6 +3,7 @@
 #include <sqlite3.h>
 
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -54,7 +55,8 @@ constexpr const char* kCopySql =
     "INSERT INTO tests (id, serial, station_id, recipe_id, recipe_version, recipe_hash, "
     "software_version, started_at, finished_at, outcome, retest_of, reasons, record, kind, "
     "operator_id, shift, order_number) "
-    "SELECT id + {SHIFT}, 'DBB-' || printf('%09d', CAST(substr(serial, 5) AS INTEGER) + {UNITS}), "
+    "SELECT id + {SHIFT}, "
+    "'{PREFIX}' || printf('%0{DIGITS}d', CAST(substr(serial, {FROM}) AS INTEGER) + {UNITS}), "
     "station_id, recipe_id, recipe_version, recipe_hash, software_version, "
     "strftime('%Y-%m-%dT%H:%M:%fZ', started_at, '+{LATER} seconds'), "
     "strftime('%Y-%m-%dT%H:%M:%fZ', finished_at, '+{LATER} seconds'), outcome, "
@@ -70,6 +72,13 @@ constexpr const char* kCopySql =
 
 }  // namespace
 
+std::string DbBenchSerial(std::int64_t unit) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%s%0*lld", kDbBenchSerialPrefix, kDbBenchSerialDigits,
+                static_cast<long long>(unit));
+  return buf;
+}
+
 void ReplicateBlock(const std::string& path, std::int64_t block_tests, std::int64_t block_units,
                     double block_span_s, int copies, const analysis::ProgressCallback& progress) {
   if (copies <= 1) return;
@@ -83,10 +92,14 @@ void ReplicateBlock(const std::string& path, std::int64_t block_tests, std::int6
   for (int k = 1; k < copies; ++k) {
     char later[64];
     std::snprintf(later, sizeof later, "%.3f", k * block_span_s);
-    const std::string sql = Fill(kCopySql, {{"N", std::to_string(block_tests)},
-                                            {"SHIFT", std::to_string(k * block_tests)},
-                                            {"UNITS", std::to_string(k * block_units)},
-                                            {"LATER", later}});
+    const std::string sql =
+        Fill(kCopySql, {{"N", std::to_string(block_tests)},
+                        {"SHIFT", std::to_string(k * block_tests)},
+                        {"UNITS", std::to_string(k * block_units)},
+                        {"LATER", later},
+                        {"PREFIX", kDbBenchSerialPrefix},
+                        {"DIGITS", std::to_string(kDbBenchSerialDigits)},
+                        {"FROM", std::to_string(std::strlen(kDbBenchSerialPrefix) + 1)}});
     Exec(db.get(), path, "BEGIN IMMEDIATE", "begin copy");
     try {
       Exec(db.get(), path, sql, "copy " + std::to_string(k));
