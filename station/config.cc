@@ -110,6 +110,7 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       s->RejectUnknown();
     }
     c.serial_from_stdin = root.Bool("serial_from_stdin", false);
+    c.publish_before_release = root.Bool("publish_before_release", false);
     if (auto sc = root.OptionalObject("self_check")) {
       SelfCheckConfig& k = c.self_check;
       k.good_master = sc->RequiredString("good_master");

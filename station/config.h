@@ -90,6 +90,8 @@ struct StationConfig {
   std::vector<ApiToken> tokens;
   SafetyOptions safety;
   bool serial_from_stdin = false;
+  // Store and publish the verdict while the clamp opens (SequencerOptions, station/sequencer.h).
+  bool publish_before_release = false;
   SelfCheckConfig self_check;
   nlohmann::json drivers = nlohmann::json::object();  // {"fixture", "daq", "sim"}
   // Plant integration (issue 15): the line PLC's handshake; nullopt without a "plc" block.

@@ -11,7 +11,9 @@
 //               the last is analysed while the next is excited, which is not counted here
 //               (the record's conditions.analysis_overlapped_s says how much that was)
 //   judge       judge
-//   unclamp     unclamp (release confirmed, fresh heartbeat)
+//   unclamp     unclamp (release confirmed, fresh heartbeat); with publish_before_release
+//               the release command and the fresh heartbeat only: the release is
+//               confirmed after publish (confirm_release), outside the cycle
 //   safe_state  safe_state (after a fault)
 //   store       store (the durable write)
 //   publish     publish (board, event stream, lamps)

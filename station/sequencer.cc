@@ -73,6 +73,8 @@ const char* ToString(SeqState s) {
       return "store";
     case SeqState::kPublish:
       return "publish";
+    case SeqState::kConfirmRelease:
+      return "confirm_release";
   }
   return "unknown";
 }
@@ -500,17 +502,18 @@ void Sequencer::Judge(db::TestRecord& record, const std::vector<MeasuredPair>& m
         {"outcome", analysis::ToString(j.pair_outcomes[k])}};
 }
 
-void Sequencer::Unclamp(db::TestRecord& record) {
-  Enter(record, SeqState::kUnclamp);
+void Sequencer::Unclamp(db::TestRecord& record, bool until_released) {
+  Enter(record, SeqState::kUnclamp, until_released ? "" : "verdict before the clamp is open");
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false); !s.ok())
     throw Fault{Outcome::kError, {ReasonCode::kFixture, "unclamp: " + s.message()}};
+  release_commanded_at_ = Clock::now();
   const auto deadline =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                         std::chrono::duration<double>(recipe_->release_timeout_s));
+      release_commanded_at_ + std::chrono::duration_cast<Clock::duration>(
+                                  std::chrono::duration<double>(recipe_->release_timeout_s));
   // Before the verdict is published the controller must prove it was alive at the end of
   // excitation: a heartbeat newer than the one read when the relay opened (a freeze near the
   // end of excitation is shorter than the watchdog's timeout and would pass unseen).
-  bool released = false;
+  bool released = !until_released;
   bool fresh_beat = !beat_after_excitation_;
   for (;;) {
     const drivers::FixtureInputs in = ReadInputs("confirm release");
@@ -530,7 +533,50 @@ void Sequencer::Unclamp(db::TestRecord& record) {
     std::this_thread::sleep_for(
         std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
   }
+  if (until_released) (void)fixture_.Deactivate();
+}
+
+void Sequencer::ConfirmRelease(db::TestRecord& record) {
+  Enter(record, SeqState::kConfirmRelease);
+  const auto deadline =
+      release_commanded_at_ + std::chrono::duration_cast<Clock::duration>(
+                                  std::chrono::duration<double>(recipe_->release_timeout_s));
+  std::string why;
+  for (;;) {
+    auto in = fixture_.ReadInputs();
+    if (in.ok() && in.value().released) break;
+    if (Clock::now() > deadline) {
+      why = in.ok() ? "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s"
+                    : "fixture not answering (" + in.status().message() + ")";
+      break;
+    }
+    std::this_thread::sleep_for(
+        std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
+  }
   (void)fixture_.Deactivate();
+  if (why.empty()) return;
+  release_fault_ = why + " after the test of " + record.serial + " (its " +
+                   analysis::ToString(record.outcome) +
+                   " stands): free the part and check the clamp; tests resume when the clamp "
+                   "reads released";
+  spdlog::error("[{}] {}", record.serial, release_fault_);
+  board_.SetReadiness(false, release_fault_);
+}
+
+bool Sequencer::RefusedForReleaseFault(db::TestRecord& record) {
+  if (release_fault_.empty()) return false;
+  if (auto in = fixture_.ReadInputs(); in.ok() && in.value().released) {
+    spdlog::warn("clamp reads released again: {} cleared", release_fault_);
+    release_fault_.clear();
+    return false;
+  }
+  // Refused before anything moves; not a test of the motor, so nothing is stored.
+  record.reasons = {{ReasonCode::kFixture, "station stopped: " + release_fault_}};
+  board_.SetReadiness(false, release_fault_);
+  Enter(record, SeqState::kPublish, "ERROR");
+  board_.OnVerdict(record);
+  Enter(record, SeqState::kWaitSerial);
+  return true;
 }
 
 // Excitation off, then the clamp released when that is safe. On a communication loss both
@@ -642,6 +688,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
   if (master) record.kind = db::RecordKind::kSelfCheck;
 
   try {
+    if (RefusedForReleaseFault(record)) return record;
     if (options_.self_check.enabled() && !master) {
       const LockoutState lock =
           EvaluateLockout(options_.self_check, store_, std::chrono::system_clock::now());
@@ -681,6 +728,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
     return record;
   }
 
+  bool release_pending = false;
   try {
     ThrowIfAborted();
     if (options_.on_serial) options_.on_serial(serial);
@@ -688,7 +736,9 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
     ClampAndConfirm(record);
     const std::vector<MeasuredPair> measured = MeasurePairs(record);
     Judge(record, measured);
-    Unclamp(record);
+    Unclamp(record, !options_.publish_before_release);
+    // The clamp still moving behind the verdict (after a fault SafeState has unclamped).
+    release_pending = options_.publish_before_release;
   } catch (const Fault& f) {
     record.outcome = f.outcome;
     record.reasons.insert(record.reasons.begin(), f.reason);
@@ -708,10 +758,13 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
              record.self_check["detail"].get<std::string>()});
   }
   StoreAndPublish(record);
+  // Serial received -> verdict published: the cycle ends where publish does.
+  const std::size_t published = record.trace.size();
+  if (release_pending) ConfirmRelease(record);
   if (options_.self_check.enabled()) PublishLockout();
   Enter(record, SeqState::kWaitSerial);
-  record.cycle_s =
-      CycleBreakdown({record.trace.begin(), record.trace.end() - 1}, record.trace.back().t_ms);
+  record.cycle_s = CycleBreakdown({record.trace.begin(), record.trace.begin() + published},
+                                  record.trace[published].t_ms);
   return record;
 }
 

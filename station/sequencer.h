@@ -45,6 +45,7 @@ enum class SeqState {
   kSafeState,
   kStore,
   kPublish,
+  kConfirmRelease,  // after publish, with SequencerOptions::publish_before_release only
 };
 const char* ToString(SeqState s);
 
@@ -77,6 +78,14 @@ struct SequencerOptions {
   std::function<void(const std::string& serial)> on_serial;
   // Self-checks with master parts and the lockout (station/self_check.h); off by default.
   SelfCheckConfig self_check;
+  // Off (default): the release is confirmed before the record is stored, and a clamp that
+  // does not open makes the test ERROR (a teardown failure, as OpenHTF counts it). On: the
+  // record is stored and the verdict published as soon as the release is commanded and the
+  // controller's heartbeat after excitation has been seen, while the clamp still moves; the
+  // release is confirmed after. A clamp that then does not open is the station's fault, not
+  // the motor's: the stored verdict stands, the board says the station is not ready and why,
+  // and every serial is refused (nothing clamps or excites) until the clamp reads released.
+  bool publish_before_release = false;
 };
 
 class Sequencer {
@@ -135,7 +144,16 @@ class Sequencer {
   // The verdict of every pair measured, by the one judge (station/judge.h): the sequencer
   // decides nothing about the motor itself.
   void Judge(db::TestRecord& record, const std::vector<MeasuredPair>& measured);
-  void Unclamp(db::TestRecord& record);
+  // Commands the release and polls until the controller's heartbeat after excitation has
+  // been seen and, when `until_released`, the clamp reads released.
+  void Unclamp(db::TestRecord& record, bool until_released);
+  // publish_before_release: after publish, polls until the clamp reads released; a clamp that
+  // does not open within the recipe's release_timeout_s (from the command) sets
+  // release_fault_. Never throws.
+  void ConfirmRelease(db::TestRecord& record);
+  // While release_fault_ is set: clears it when the clamp now reads released, else refuses
+  // the serial (returns true; nothing moves, nothing is stored, as a lockout).
+  bool RefusedForReleaseFault(db::TestRecord& record);
   void SafeState(db::TestRecord& record);
   void StoreAndPublish(db::TestRecord& record);
   void ThrowIfAborted();
@@ -151,6 +169,9 @@ class Sequencer {
   // The heartbeat read right after the last excitation ended; Unclamp waits for a newer one.
   std::optional<std::uint32_t> beat_after_excitation_;
   drivers::PhasePair selected_pair_ = drivers::PhasePair::kUV;  // set when clamping
+  std::chrono::steady_clock::time_point release_commanded_at_{};
+  // Non-empty after a clamp did not open behind a published verdict (publish_before_release).
+  std::string release_fault_;
 
   std::atomic<SeqState> state_{SeqState::kWaitSerial};
   std::atomic<bool> stop_requested_{false};  // sticky: RequestAbort() was called

@@ -87,6 +87,7 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
   opts.simulation = simulation;
   opts.safety = config_.safety;
   opts.self_check = config_.self_check;
+  opts.publish_before_release = config_.publish_before_release;
   if (drivers_.bench && drivers_.bench->settings().load_part_on_serial) {
     drivers::SimBench* bench = drivers_.bench.get();
     opts.on_serial = [bench](const std::string& serial) { bench->LoadPart(serial); };

@@ -22,14 +22,14 @@ const char* ToString(SimFault f) {
       return "heartbeat_freezes";
     case SimFault::kDaqFails:
       return "daq_fails";
+    case SimFault::kClampSticks:
+      return "clamp_sticks";
   }
   return "unknown";
 }
 
 std::optional<SimFault> ParseSimFault(const std::string& s) {
-  for (SimFault f :
-       {SimFault::kStopsAnswering, SimFault::kClampDrops, SimFault::kPressureLow,
-        SimFault::kDoorOpens, SimFault::kEstop, SimFault::kHeartbeatFreezes, SimFault::kDaqFails})
+  for (SimFault f : kSimFaults)
     if (s == ToString(f)) return f;
   return std::nullopt;
 }
@@ -110,7 +110,8 @@ FixtureInputs SimBench::ReadInputs() {
     in.clamp_pressure_bar += 0.02 * std::sin(since_cmd * 37.0) * ramp;
   } else {
     in.clamped = false;
-    in.released = since_cmd >= settings_.clamp_open_s;
+    in.released =
+        since_cmd >= settings_.clamp_open_s && !FaultActiveLocked(SimFault::kClampSticks, now);
     in.clamp_pressure_bar = 0.0;
   }
   if (dropped) in.clamp_pressure_bar = 0.0;

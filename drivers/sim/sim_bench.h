@@ -9,6 +9,7 @@
 // passes a ManualClock, and every time point it reports is on that clock.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <mutex>
@@ -49,8 +50,14 @@ enum class SimFault {
   kDoorOpens,
   kEstop,  // emergency-stop chain opens
   kHeartbeatFreezes,
-  kDaqFails,  // the acquisition device fails mid-stream
+  kDaqFails,     // the acquisition device fails mid-stream
+  kClampSticks,  // after an open command the released sensor never comes on
 };
+// Every simulated fault, in the order the CLIs list them.
+inline constexpr std::array<SimFault, 8> kSimFaults = {
+    SimFault::kStopsAnswering, SimFault::kClampDrops, SimFault::kPressureLow,
+    SimFault::kDoorOpens,      SimFault::kEstop,      SimFault::kHeartbeatFreezes,
+    SimFault::kDaqFails,       SimFault::kClampSticks};
 const char* ToString(SimFault f);
 std::optional<SimFault> ParseSimFault(const std::string& s);
 

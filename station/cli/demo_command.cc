@@ -33,6 +33,8 @@ struct DemoArgs {
   double defect_share = 0.2;
   double time_scale = 0.0;
   bool verbose = false;
+  bool publish_before_release = false;
+  drivers::SimBenchSettings timing;  // the simulated fixture's clamp travel and heartbeat
   std::string fixture = "modbus";
   std::string sim = "time_domain";
 };
@@ -44,7 +46,10 @@ double MeasurementValue(const db::TestRecord& r, std::string_view name) {
 }
 
 int RunDemo(const DemoArgs& a) {
-  const nlohmann::json sim = {{"population", {{"defect_share", a.defect_share}, {"seed", a.seed}}}};
+  const nlohmann::json sim = {{"population", {{"defect_share", a.defect_share}, {"seed", a.seed}}},
+                              {"clamp_close_s", a.timing.clamp_close_s},
+                              {"clamp_open_s", a.timing.clamp_open_s},
+                              {"heartbeat_period_s", a.timing.heartbeat_period_s}};
   nlohmann::json cfg = {
       {"station_id", "demo"},
       {"recipe", a.recipe},
@@ -52,7 +57,8 @@ int RunDemo(const DemoArgs& a) {
       {"http", {{"listen", a.listen}, {"port", a.port}}},
       {"fixture", {{"driver", "sim"}}},
       {"daq", {{"driver", "sim"}, {"time_scale", a.time_scale}, {"model", a.sim}}},
-      {"sim", sim}};
+      {"sim", sim},
+      {"publish_before_release", a.publish_before_release}};
   spdlog::set_level(a.verbose ? spdlog::level::info : spdlog::level::warn);
   // One simulated bench: the DAQ plays into its motor, and with --fixture modbus the station
   // reaches its clamp and interlocks over real Modbus TCP through the fixture emulator that
@@ -191,6 +197,18 @@ void AddDemoCommand(CLI::App& app) {
                   "included, as a real motor) or steady_state (no transient, faster)")
       ->capture_default_str()
       ->check(CLI::IsMember({"time_domain", "steady_state"}));
+  cmd->add_option("--clamp-close-s", args->timing.clamp_close_s,
+                  "Simulated clamp: command to clamped sensor")
+      ->capture_default_str();
+  cmd->add_option("--clamp-open-s", args->timing.clamp_open_s,
+                  "Simulated clamp: command to released sensor")
+      ->capture_default_str();
+  cmd->add_option("--heartbeat-period-s", args->timing.heartbeat_period_s,
+                  "Simulated controller: heartbeat increment period")
+      ->capture_default_str();
+  cmd->add_flag("--publish-before-release", args->publish_before_release,
+                "Store and publish each verdict while the clamp opens (the station config's "
+                "publish_before_release)");
   cmd->add_flag("--verbose", args->verbose, "Log every sequencer state (to stderr)");
   cmd->callback([args] { RunGuarded("demo", [&] { return RunDemo(*args); }); });
 }

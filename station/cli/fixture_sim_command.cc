@@ -54,10 +54,7 @@ struct FixtureSimOptions {
 
 std::string FaultNames() {
   std::string names;
-  for (drivers::SimFault f :
-       {drivers::SimFault::kStopsAnswering, drivers::SimFault::kClampDrops,
-        drivers::SimFault::kPressureLow, drivers::SimFault::kDoorOpens, drivers::SimFault::kEstop,
-        drivers::SimFault::kHeartbeatFreezes, drivers::SimFault::kDaqFails})
+  for (drivers::SimFault f : drivers::kSimFaults)
     names += (names.empty() ? "" : ", ") + std::string(drivers::ToString(f));
   return names;
 }

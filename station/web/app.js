@@ -5,7 +5,7 @@
 "use strict";
 
 const STATES = ["wait_serial", "check_interlocks", "clamp", "confirm_clamp", "excite",
-                "analyse", "judge", "unclamp", "store", "publish"];
+                "analyse", "judge", "unclamp", "store", "publish", "confirm_release"];
 const FINAL = ["PASS", "FAIL", "ERROR", "ABORTED"];
 let recipe = null;
 let shownTestId = null;

@@ -113,6 +113,26 @@ TEST(CycleTime, EveryRecordCarriesItsBreakdownAndMetricsCountIt) {
   EXPECT_TRUE(info);
 }
 
+// Issue 16: the station config's publish_before_release stores and publishes while a slow
+// clamp (0.4 s of travel, heartbeat every 20 ms) opens; the cycle ends with the verdict.
+TEST(CycleTime, PublishBeforeReleaseTakesTheClampTravelOutOfTheCycle) {
+  std::map<bool, double> unclamp_s;
+  for (const bool early : {false, true}) {
+    eol::testing::TempDir dir;
+    nlohmann::json cfg = ConfigWith(dir, {{"driver", "sim"}});
+    cfg["sim"] = {{"clamp_open_s", 0.4}, {"heartbeat_period_s", 0.02}};
+    cfg["publish_before_release"] = early;
+    Station s(ParseStationConfig(cfg, "t", ""));
+    const db::TestRecord r = s.RunTest(early ? "EARLY-1" : "LATE-1");
+    EXPECT_EQ(r.outcome, analysis::Outcome::kPass);
+    unclamp_s[early] = r.cycle_s.at("unclamp");
+    EXPECT_EQ(r.trace.back().state, "wait_serial");
+    EXPECT_EQ(r.trace[r.trace.size() - 2].state, early ? "confirm_release" : "publish");
+  }
+  EXPECT_GE(unclamp_s[false], 0.39);
+  EXPECT_LT(unclamp_s[true], 0.3);
+}
+
 TEST(CycleTime, FixtureErrorsAndReasonsAreCounted) {
   eol::testing::TempDir dir;
   // Port 1 on loopback: nothing listens, every connection is refused.

@@ -8,11 +8,13 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <functional>
 
 #include "../support/child_process.h"
 #include "analysis/qc/measurement_names.h"
 #include "drivers/sim/sim_daq.h"
 #include "drivers/sim/sim_fixture.h"
+#include "station/cycle_time.h"
 
 namespace eol::station {
 namespace {
@@ -24,10 +26,12 @@ using namespace std::chrono_literals;
 
 class SequencerTest : public ::testing::Test {
  protected:
-  void Build(double time_scale) {
+  void Build(double time_scale,
+             const std::function<void(drivers::SimBenchSettings&)>& tweak = nullptr) {
     drivers::SimBenchSettings bench_settings;
     bench_settings.clamp_close_s = 0.05;
     bench_settings.clamp_open_s = 0.03;
+    if (tweak) tweak(bench_settings);
     bench_ = std::make_shared<drivers::SimBench>(bench_settings);
     fixture_ = std::make_unique<drivers::SimFixture>(bench_);
     drivers::SimDaqSettings daq_settings;
@@ -42,9 +46,10 @@ class SequencerTest : public ::testing::Test {
   }
 
   // A sequencer on the bench with recipe_ as it is now.
-  void Rebuild() {
+  void Rebuild(bool publish_before_release = false) {
     SequencerOptions o;
     o.station_id = "test";
+    o.publish_before_release = publish_before_release;
     sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
                                              std::make_shared<const Recipe>(recipe_), *board_, o);
   }
@@ -112,6 +117,92 @@ TEST_F(SequencerTest, GoodRotorPassesAndIsStoredWithEverything) {
   EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
   EXPECT_FALSE(bench_->output(FixtureOutput::kClampCmd));
   EXPECT_TRUE(bench_->output(FixtureOutput::kLampPass));
+}
+
+// Where each sequencer state starts in a returned record (ms since the serial), -1 if absent.
+double StateAtMs(const db::TestRecord& r, const std::string& state) {
+  for (const auto& t : r.trace)
+    if (t.state == state) return t.t_ms;
+  return -1;
+}
+
+// By default the release is part of the test: a clamp that does not open makes it ERROR.
+TEST_F(SequencerTest, ClampThatDoesNotOpenIsErrorByDefault) {
+  Build(0.0);
+  recipe_.release_timeout_s = 0.3;
+  Rebuild();
+  bench_->InjectFault(SimFault::kClampSticks, 0ms);
+  const db::TestRecord r = Test("STICK-0", false);
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(r, "clamp not released within 0.3 s")) << r.reasons.front().text;
+  ExpectStored(r);
+  EXPECT_LT(StateAtMs(r, "unclamp"), StateAtMs(r, "store"));
+  EXPECT_EQ(StateAtMs(r, "confirm_release"), -1);
+  bench_->ClearFaults();
+  EXPECT_EQ(Test("STICK-0B", false).outcome, Outcome::kPass);
+}
+
+// Issue 16: with publish_before_release the record is stored and the verdict published once
+// the release is commanded and a fresh heartbeat seen; the clamp's 0.4 s of travel comes after.
+TEST_F(SequencerTest, VerdictIsPublishedWhileTheClampOpens) {
+  Build(0.0, [](drivers::SimBenchSettings& s) {
+    s.clamp_open_s = 0.4;
+    s.heartbeat_period_s = 0.02;
+  });
+  Rebuild(/*publish_before_release=*/true);
+  const db::TestRecord r = Test("EARLY-1", false);
+  EXPECT_EQ(r.outcome, Outcome::kPass) << (r.reasons.empty() ? "" : r.reasons.front().text);
+  ExpectStored(r);
+  const double unclamp = StateAtMs(r, "unclamp");
+  const double published = StateAtMs(r, "confirm_release");  // publish has ended
+  ASSERT_GE(unclamp, 0);
+  ASSERT_GT(published, unclamp);
+  EXPECT_LT(published - unclamp, 300.0) << "the verdict waited for the clamp";
+  EXPECT_GE(r.trace.back().t_ms - unclamp, 390.0) << "the release was not confirmed after";
+  EXPECT_EQ(r.trace.back().state, "wait_serial");
+  EXPECT_NEAR(CycleStepS(r.cycle_s, "total") * 1000.0, published, 1e-6);
+  // The stored record ends where the verdict was decided and stored.
+  const auto stored = store_->Test(r.id);
+  ASSERT_TRUE(stored);
+  EXPECT_EQ(stored->trace.back().state, "store");
+  EXPECT_FALSE(bench_->output(FixtureOutput::kClampCmd));
+  EXPECT_TRUE(bench_->output(FixtureOutput::kLampPass));
+}
+
+// A clamp that does not open behind a published verdict: the verdict stands, the station says
+// why it is not ready and refuses every serial (nothing clamps, excites or is stored) until
+// the clamp reads released.
+TEST_F(SequencerTest, ClampStuckBehindAPublishedVerdictStopsTheStationUntilReleased) {
+  Build(0.0);
+  recipe_.release_timeout_s = 0.3;
+  Rebuild(/*publish_before_release=*/true);
+  bench_->InjectFault(SimFault::kClampSticks, 0ms);
+  const db::TestRecord r = Test("STICK-1", false);
+  EXPECT_EQ(r.outcome, Outcome::kPass) << (r.reasons.empty() ? "" : r.reasons.front().text);
+  ExpectStored(r);
+  const nlohmann::json status = board_->Snapshot();
+  EXPECT_FALSE(status.value("ready", true));
+  EXPECT_NE(
+      status.value("not_ready_reason", "")
+          .find("clamp not released within 0.3 s after the test of STICK-1 (its PASS stands)"),
+      std::string::npos)
+      << status.dump();
+
+  const db::TestRecord refused = Test("STICK-2", false);
+  EXPECT_EQ(refused.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(refused, "station stopped: clamp not released"))
+      << refused.reasons.front().text;
+  EXPECT_EQ(StateAtMs(refused, "excite"), -1);
+  EXPECT_EQ(StateAtMs(refused, "clamp"), -1);
+  EXPECT_TRUE(store_->TestsOfSerial("STICK-2").empty());
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+  EXPECT_FALSE(bench_->output(FixtureOutput::kClampCmd));
+
+  bench_->ClearFaults();  // the clamp reads released again
+  const db::TestRecord next = Test("STICK-3", false);
+  EXPECT_EQ(next.outcome, Outcome::kPass)
+      << (next.reasons.empty() ? "" : next.reasons.front().text);
+  EXPECT_TRUE(board_->Snapshot().value("ready", false));
 }
 
 TEST_F(SequencerTest, RetestLimitRefusesASerialBeforeClamping) {
