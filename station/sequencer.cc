@@ -507,9 +507,7 @@ void Sequencer::Unclamp(db::TestRecord& record, bool until_released) {
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false); !s.ok())
     throw Fault{Outcome::kError, {ReasonCode::kFixture, "unclamp: " + s.message()}};
   release_commanded_at_ = Clock::now();
-  const auto deadline =
-      release_commanded_at_ + std::chrono::duration_cast<Clock::duration>(
-                                  std::chrono::duration<double>(recipe_->release_timeout_s));
+  const auto deadline = ReleaseDeadline();
   // Before the verdict is published the controller must prove it was alive at the end of
   // excitation: a heartbeat newer than the one read when the relay opened (a freeze near the
   // end of excitation is shorter than the watchdog's timeout and would pass unseen).
@@ -536,11 +534,14 @@ void Sequencer::Unclamp(db::TestRecord& record, bool until_released) {
   if (until_released) (void)fixture_.Deactivate();
 }
 
+std::chrono::steady_clock::time_point Sequencer::ReleaseDeadline() const {
+  return release_commanded_at_ + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(recipe_->release_timeout_s));
+}
+
 void Sequencer::ConfirmRelease(db::TestRecord& record) {
   Enter(record, SeqState::kConfirmRelease);
-  const auto deadline =
-      release_commanded_at_ + std::chrono::duration_cast<Clock::duration>(
-                                  std::chrono::duration<double>(recipe_->release_timeout_s));
+  const auto deadline = ReleaseDeadline();
   std::string why;
   for (;;) {
     auto in = fixture_.ReadInputs();

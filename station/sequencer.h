@@ -151,6 +151,8 @@ class Sequencer {
   // does not open within the recipe's release_timeout_s (from the command) sets
   // release_fault_. Never throws.
   void ConfirmRelease(db::TestRecord& record);
+  // The release command's time plus the recipe's release_timeout_s.
+  std::chrono::steady_clock::time_point ReleaseDeadline() const;
   // While release_fault_ is set: clears it when the clamp now reads released, else refuses
   // the serial (returns true; nothing moves, nothing is stored, as a lockout).
   bool RefusedForReleaseFault(db::TestRecord& record);
