@@ -333,6 +333,24 @@ TEST_F(ModbusFixtureTest, LoadsAPartWhenTheClampClosesOnAnEmptyFixture) {
   EXPECT_TRUE(Read().part_present);
 }
 
+// The simulator's clamp_sticks fault reaches the station as a released sensor that stays off
+// after the open command (the sequencer's release time-out, station/sequencer.h).
+TEST_F(ModbusFixtureTest, StuckClampNeverReadsReleasedUntilTheFaultClears) {
+  ModbusFixture& f = Connected();
+  ASSERT_TRUE(f.Activate().ok());
+  ASSERT_TRUE(f.Write(FixtureOutput::kClampCmd, true).ok());
+  clock_->AdvanceSeconds(bench_settings_.clamp_close_s + 0.05);
+  EXPECT_TRUE(Read().clamped);
+  bench_->InjectFault(SimFault::kClampSticks, 0ms, /*on_excitation=*/false);
+  ASSERT_TRUE(f.Write(FixtureOutput::kClampCmd, false).ok());
+  clock_->AdvanceSeconds(10 * bench_settings_.clamp_open_s);
+  const FixtureInputs stuck = Read();
+  EXPECT_FALSE(stuck.released);
+  EXPECT_FALSE(stuck.clamped);
+  bench_->ClearFaults();
+  EXPECT_TRUE(Read().released);
+}
+
 TEST(ModbusMapTest, DefaultMapReadsInTwoRequests) {
   const ModbusMap m;
   std::string why;
