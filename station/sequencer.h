@@ -3,6 +3,8 @@
 //   wait_serial -> check_interlocks -> clamp -> confirm_clamp -> excite -> check_interlocks
 //     -> analyse -> judge -> unclamp -> store -> publish -> wait_serial
 //   (further phase pairs: after analyse, clamp (pair switch) -> excite -> ... again)
+//   (publish_before_release: unclamp waits for the fresh heartbeat only, and publish ->
+//    confirm_release -> wait_serial)
 //   any fault:  -> safe_state (excitation off first; unclamp only when that is safe)
 //               -> store (ERROR or ABORTED with the cause) -> publish
 //
@@ -95,7 +97,8 @@ class Sequencer {
   Sequencer(const Sequencer&) = delete;
   Sequencer& operator=(const Sequencer&) = delete;
 
-  // Runs one test to its end and returns the stored record. Never throws for station,
+  // Runs one test to its end and returns the stored record (with publish_before_release its
+  // trace goes on past the stored one: confirm_release). Never throws for station,
   // fixture, acquisition or data faults: they end as ERROR with the cause in reasons.
   db::TestRecord RunTest(const std::string& serial);
   // The same, with who tests it for which order (stored with the record; issue 15).
