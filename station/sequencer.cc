@@ -564,6 +564,13 @@ void Sequencer::ConfirmRelease(db::TestRecord& record) {
   board_.SetReadiness(false, release_fault_);
 }
 
+void Sequencer::PublishRefusal(db::TestRecord& record) {
+  record.outcome = Outcome::kError;
+  Enter(record, SeqState::kPublish, "ERROR");
+  board_.OnVerdict(record);
+  Enter(record, SeqState::kWaitSerial);
+}
+
 bool Sequencer::RefusedForReleaseFault(db::TestRecord& record) {
   if (release_fault_.empty()) return false;
   if (auto in = fixture_.ReadInputs(); in.ok() && in.value().released) {
@@ -574,9 +581,7 @@ bool Sequencer::RefusedForReleaseFault(db::TestRecord& record) {
   // Refused before anything moves; not a test of the motor, so nothing is stored.
   record.reasons = {{ReasonCode::kFixture, "station stopped: " + release_fault_}};
   board_.SetReadiness(false, release_fault_);
-  Enter(record, SeqState::kPublish, "ERROR");
-  board_.OnVerdict(record);
-  Enter(record, SeqState::kWaitSerial);
+  PublishRefusal(record);
   return true;
 }
 
@@ -697,9 +702,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
         // Refused before anything moves; not a test of the motor, so nothing is stored.
         record.reasons = {{ReasonCode::kLockout, "station locked out: " + lock.reason}};
         board_.SetLockout(lock.ToJson());
-        Enter(record, SeqState::kPublish, "ERROR");
-        board_.OnVerdict(record);
-        Enter(record, SeqState::kWaitSerial);
+        PublishRefusal(record);
         return record;
       }
     }
@@ -712,9 +715,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
                            "retest limit: serial " + serial + " already has " +
                                std::to_string(earlier) + " tests (recipe allows " +
                                std::to_string(max_tests) + "); send the motor to rework"}};
-        Enter(record, SeqState::kPublish, "ERROR");
-        board_.OnVerdict(record);
-        Enter(record, SeqState::kWaitSerial);
+        PublishRefusal(record);
         return record;
       }
     }
@@ -723,9 +724,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
     // No durable record possible: do not clamp, do not excite.
     record.reasons = {
         {ReasonCode::kStore, std::string("database unavailable, test not started: ") + e.what()}};
-    Enter(record, SeqState::kPublish, "ERROR");
-    board_.OnVerdict(record);
-    Enter(record, SeqState::kWaitSerial);
+    PublishRefusal(record);
     return record;
   }
 

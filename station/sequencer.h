@@ -159,6 +159,8 @@ class Sequencer {
   // While release_fault_ is set: clears it when the clamp now reads released, else refuses
   // the serial (returns true; nothing moves, nothing is stored, as a lockout).
   bool RefusedForReleaseFault(db::TestRecord& record);
+  // A serial refused before anything moved (its reasons set): shown as ERROR, never stored.
+  void PublishRefusal(db::TestRecord& record);
   void SafeState(db::TestRecord& record);
   void StoreAndPublish(db::TestRecord& record);
   void ThrowIfAborted();
