@@ -35,13 +35,13 @@ ExportColumn Base(const char* key, ExportType type, const char* unit, const char
 }
 
 // The base columns of schema version 1, in row order. Append only (export_schema.h).
-static_assert(kExportSchemaVersion == 4, "say the new version in schema_version's meaning");
+static_assert(kExportSchemaVersion == 5, "say the new version in schema_version's meaning");
 
 std::vector<ExportColumn> BaseColumns() {
   using T = ExportType;
   std::vector<ExportColumn> c;
   c.push_back(
-      Base("schema_version", T::kInteger, "", "Version of this export schema (4)",
+      Base("schema_version", T::kInteger, "", "Version of this export schema (5)",
            [](const TestRecord&) -> ExportValue { return std::int64_t{kExportSchemaVersion}; }));
   c.push_back(Base("id", T::kInteger, "", "Test id in the station's database",
                    [](const TestRecord& r) -> ExportValue { return r.id; }));

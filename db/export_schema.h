@@ -32,8 +32,9 @@ namespace eol::db {
 
 // Version 2 (issue 12) appended the standard measurement motional_residue_ohm_per_s after
 // fit_chi2_per_dof; version 1 files have the same columns up to there. Version 3 appended
-// bond_index_pct (analysis/qc/bond_index.h) after it, version 4 second_mode_chi2_drop.
-inline constexpr int kExportSchemaVersion = 4;
+// bond_index_pct (analysis/qc/bond_index.h) after it, version 4 second_mode_chi2_drop,
+// version 5 resonance_f_ref_pressure_hz (analysis/qc/f0_pressure.h).
+inline constexpr int kExportSchemaVersion = 5;
 
 enum class ExportType { kInteger, kNumber, kText, kTime, kBool };
 const char* ToString(ExportType t);  // "integer", "number", "text", "time", "bool"

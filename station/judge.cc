@@ -34,7 +34,13 @@ PairJudgement JudgePair(const Recipe& recipe, const PairMeasurement& p, nlohmann
     return j;
   }
   std::map<std::string, analysis::Estimate> values = a.values;
-  if (recipe.bond_index) analysis::AddBondIndex(values, *recipe.bond_index);
+  std::optional<double> clamp_pressure_bar;
+  if (const auto it = conditions.find(std::string(analysis::names::kClampPressureBar));
+      it != conditions.end() && it->is_number())
+    clamp_pressure_bar = it->get<double>();
+  if (recipe.f0_pressure)
+    analysis::AddF0AtRefPressure(values, clamp_pressure_bar, *recipe.f0_pressure);
+  if (recipe.bond_index) analysis::AddBondIndex(values, *recipe.bond_index);  // may weigh it
   std::vector<analysis::MeasurementSpec> mask_specs;
   std::vector<Reason> mask_details;
   for (const analysis::CurveMask& mask : recipe.masks) {
@@ -52,6 +58,12 @@ PairJudgement JudgePair(const Recipe& recipe, const PairMeasurement& p, nlohmann
   j.measurements = limits.measurements;
   j.measurements.insert(j.measurements.end(), masks.measurements.begin(), masks.measurements.end());
   j.reasons = limits.reasons;
+  if (recipe.f0_pressure && !clamp_pressure_bar)
+    j.reasons.push_back(
+        {ReasonCode::kAnalysis, std::string(analysis::names::kResonanceFRefPressureHz) +
+                                    " needs the clamp pressure read at clamp confirmation "
+                                    "(conditions.clamp_pressure_bar; offline: eol analyze "
+                                    "--clamp-pressure-bar P)"});
   j.reasons.insert(j.reasons.end(), masks.reasons.begin(), masks.reasons.end());
   if (j.outcome == Outcome::kFail)
     j.reasons.insert(j.reasons.end(), mask_details.begin(), mask_details.end());

@@ -8,7 +8,11 @@
 //   2. scalar limits (recipe "limits")     -> FAIL "limit" outside; ERROR "analysis" when a
 //                                             declared value is missing or not finite.
 //                                             bond_index_pct is computed here from f0 and the
-//                                             residue when the recipe has "bond_index".
+//                                             residue when the recipe has "bond_index";
+//                                             resonance_f_ref_pressure_hz from f0 and
+//                                             conditions.clamp_pressure_bar when it has
+//                                             "f0_pressure" (without a pressure: ERROR, and a
+//                                             reason that says where it comes from).
 //   3. curve masks (recipe "masks")        -> the count of lines outside is a measurement
 //                                             mask_<name>_lines_outside judged against
 //                                             max_lines_outside (FAIL "mask"); when the pair

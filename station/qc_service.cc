@@ -1,5 +1,8 @@
 #include "station/qc_service.h"
 
+#include <algorithm>
+
+#include "analysis/qc/measurement_names.h"
 #include "db/clock.h"
 #include "station/serial_number.h"
 
@@ -21,6 +24,14 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
   }
   if (!s.masks.empty()) taught.masks = s.masks;
   if (s.bond_index) taught.bond_index = s.bond_index;
+  // The pressure-normalised resonance: declared by teach when the golden units' f0 follows
+  // their clamp pressure (f0_pressure.h), dropped when it no longer does.
+  taught.f0_pressure = s.f0_pressure.definition;
+  std::erase_if(taught.limits, [](const analysis::MeasurementSpec& l) {
+    return l.name == analysis::names::kResonanceFRefPressureHz;
+  });
+  for (const analysis::MeasurementSpec& spec : s.limits)
+    if (spec.name == analysis::names::kResonanceFRefPressureHz) taught.limits.push_back(spec);
   std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
                      std::to_string(s.units_used) + " golden units (" +
                      analysis::ToString(o.method) + ", allocation " + o.allocation +
@@ -39,11 +50,17 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
 
 json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOptions& o) {
   json limits = json::array(), stats = json::array(), masks = json::array();
-  json bond_index = nullptr;
-  if (s.bond_index)
-    bond_index = {{"f0_exponent", s.bond_index->f0_exponent},
-                  {"f0_ref_hz", s.bond_index->f0_ref_hz},
-                  {"residue_ref_ohm_per_s", s.bond_index->residue_ref_ohm_per_s}};
+  const json bond_index = s.bond_index ? BondIndexJson(*s.bond_index) : json(nullptr);
+  json f0_pressure = {{"used", s.f0_pressure.definition.has_value()},
+                      {"note", s.f0_pressure.note},
+                      {"units", s.f0_pressure.units},
+                      {"slope", s.f0_pressure.slope},
+                      {"slope_sigma", s.f0_pressure.slope_sigma},
+                      {"t", s.f0_pressure.t},
+                      {"spread_before_pct", s.f0_pressure.spread_before_pct},
+                      {"spread_after_pct", s.f0_pressure.spread_after_pct}};
+  if (s.f0_pressure.definition)
+    f0_pressure["definition"] = F0PressureJson(*s.f0_pressure.definition);
   for (const auto& l : s.limits) limits.push_back(LimitJson(l));
   for (const auto& t : s.statistics)
     stats.push_back({{"name", t.name}, {"centre", t.centre}, {"scale", t.scale}});
@@ -81,6 +98,7 @@ json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOpti
           {"masks", masks},
           {"statistics", stats},
           {"bond_index", bond_index},
+          {"f0_pressure", f0_pressure},
           {"message", s.message}};
 }
 
@@ -88,6 +106,10 @@ analysis::GoldenUnit GoldenFromRecord(const db::TestRecord& r, const std::string
   analysis::GoldenUnit u;
   u.label = label;
   for (const analysis::Measurement& m : r.measurements) u.values[m.name] = m.value;
+  // The clamp pressure read at clamp confirmation (f0_pressure.h).
+  const std::string pressure(analysis::names::kClampPressureBar);
+  if (r.conditions.contains(pressure) && r.conditions.at(pressure).is_number())
+    u.values[pressure] = r.conditions.at(pressure).get<double>();
   for (const db::Curve& c : r.curves) {
     if (c.name != "impedance") continue;
     u.curve.freq_hz = c.freq_hz;

@@ -244,6 +244,10 @@ void ParseBondIndex(const JsonObject& o, Recipe& r) {
   d.f0_exponent = o.RequiredNumber("f0_exponent");
   d.f0_ref_hz = o.RequiredNumber("f0_ref_hz");
   d.residue_ref_ohm_per_s = o.RequiredNumber("residue_ref_ohm_per_s");
+  d.f0_name = o.String("f0", d.f0_name);
+  o.Require(d.f0_name == analysis::names::kResonanceFHz ||
+                d.f0_name == analysis::names::kResonanceFRefPressureHz,
+            "f0", "must be resonance_f_hz or resonance_f_ref_pressure_hz");
   o.Require(d.f0_exponent >= 0.0 && d.f0_exponent <= 1000.0, "f0_exponent", "must be in [0, 1000]");
   o.Require(d.f0_ref_hz > 0.0, "f0_ref_hz", "must be positive");
   o.Require(d.residue_ref_ohm_per_s > 0.0, "residue_ref_ohm_per_s", "must be positive");
@@ -251,6 +255,18 @@ void ParseBondIndex(const JsonObject& o, Recipe& r) {
   o.Require(d.IsValid(&why), "f0_exponent", why);  // finite (the checks above pass NaN)
   o.RejectUnknown();
   r.bond_index = d;
+}
+
+void ParseF0Pressure(const JsonObject& o, Recipe& r) {
+  analysis::F0PressureDefinition d;
+  d.exponent = o.RequiredNumber("exponent");
+  d.pressure_ref_bar = o.RequiredNumber("pressure_ref_bar");
+  std::string why;
+  o.Require(d.exponent > 0.0 && d.exponent <= 0.5 && std::isfinite(d.exponent), "exponent",
+            "must be in (0, 0.5] (f0 ~ sqrt(k), the clamp's k at most ~ p)");
+  o.Require(d.IsValid(&why), "pressure_ref_bar", why);
+  o.RejectUnknown();
+  r.f0_pressure = d;
 }
 
 // After the excitation and the analysis: the recipe's own excitation must meet the requirement
@@ -420,6 +436,7 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source,
     if (auto i = root.OptionalObject("instructions")) ParseInstructions(*i, r);
     if (auto a = root.OptionalObject("approval")) ParseApproval(*a, r);
     if (auto b = root.OptionalObject("bond_index")) ParseBondIndex(*b, r);
+    if (auto p = root.OptionalObject("f0_pressure")) ParseF0Pressure(*p, r);
     if (auto q = root.OptionalObject("sequential")) ParseSequential(*q, r);
     if (auto d = root.OptionalObject("excitation_design"))
       ParseExcitationDesign(*d, r, options.check_excitation_design);
@@ -433,6 +450,17 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source,
     root.Require(!index_declared || r.bond_index.has_value(), "bond_index",
                  "is required when a limit is declared on bond_index_pct (eol teach sets it; "
                  "analysis/qc/bond_index.h)");
+    root.Require(!r.bond_index ||
+                     r.bond_index->f0_name != analysis::names::kResonanceFRefPressureHz ||
+                     r.f0_pressure.has_value(),
+                 "f0_pressure", "is required when bond_index weighs resonance_f_ref_pressure_hz");
+    const bool f0_pressure_declared =
+        std::any_of(r.limits.begin(), r.limits.end(), [](const analysis::MeasurementSpec& s) {
+          return s.name == analysis::names::kResonanceFRefPressureHz;
+        });
+    root.Require(!f0_pressure_declared || r.f0_pressure.has_value(), "f0_pressure",
+                 "is required when a limit is declared on resonance_f_ref_pressure_hz (eol "
+                 "teach sets it; analysis/qc/f0_pressure.h)");
     root.RejectUnknown();
     r.source = j;
     r.hash = CanonicalHash(j);
@@ -526,6 +554,18 @@ nlohmann::json LimitJson(const analysis::MeasurementSpec& s) {
   return j;
 }
 
+nlohmann::json BondIndexJson(const analysis::BondIndexDefinition& d) {
+  nlohmann::json j = {{"f0_exponent", d.f0_exponent},
+                      {"f0_ref_hz", d.f0_ref_hz},
+                      {"residue_ref_ohm_per_s", d.residue_ref_ohm_per_s}};
+  if (d.f0_name != analysis::BondIndexDefinition{}.f0_name) j["f0"] = d.f0_name;
+  return j;
+}
+
+nlohmann::json F0PressureJson(const analysis::F0PressureDefinition& d) {
+  return {{"exponent", d.exponent}, {"pressure_ref_bar", d.pressure_ref_bar}};
+}
+
 nlohmann::json MaskJson(const analysis::CurveMask& m) {
   nlohmann::json points = nlohmann::json::array();
   for (const analysis::MaskPoint& p : m.points) {
@@ -579,10 +619,8 @@ nlohmann::json RecipeToJson(const Recipe& r) {
       {"instructions", InstructionsJson(r.instructions)}};
   if (r.conditions.enabled) j["conditions"] = ConditionsJson(r.conditions);
   if (r.crest_for_current) j["excitation"]["crest_for"] = "current";
-  if (r.bond_index)
-    j["bond_index"] = {{"f0_exponent", r.bond_index->f0_exponent},
-                       {"f0_ref_hz", r.bond_index->f0_ref_hz},
-                       {"residue_ref_ohm_per_s", r.bond_index->residue_ref_ohm_per_s}};
+  if (r.bond_index) j["bond_index"] = BondIndexJson(*r.bond_index);
+  if (r.f0_pressure) j["f0_pressure"] = F0PressureJson(*r.f0_pressure);
   if (r.sequential)
     j["sequential"] = {{"extend_periods", r.sequential->extend_periods},
                        {"max_extensions", r.sequential->max_extensions},

@@ -25,9 +25,14 @@
 //                  "excitation_v_rms": {"lo": 1.2, "hi": 1.45}, "excitation_a_rms": {...},
 //                  "out_of_window": "error" | "record"}       optional, station/conditions.h
 //   "instructions": {"fail": "...", "error": "...", "aborted": "..."}  optional, each optional
-//   "bond_index": {"f0_exponent": 5.3, "f0_ref_hz": 390, "residue_ref_ohm_per_s": 25.6}
+//   "bond_index": {"f0_exponent": 5.3, "f0_ref_hz": 390, "residue_ref_ohm_per_s": 25.6,
+//                  "f0": "resonance_f_hz" (default) | "resonance_f_ref_pressure_hz"}
 //                  optional; required by a limit on bond_index_pct (analysis/qc/bond_index.h;
 //                  eol teach writes it from the golden units)
+//   "f0_pressure": {"exponent": 0.114, "pressure_ref_bar": 5.5}
+//                  optional; required by a limit on resonance_f_ref_pressure_hz
+//                  (analysis/qc/f0_pressure.h; eol teach writes it when the golden units' f0
+//                  follows their clamp pressure significantly)
 //   "sequential": {"extend_periods": 8, "max_extensions": 1, "confidence_z": 3}   optional
 //                  (SequentialPolicy below)
 //   "excitation_design": {"sigma_f0_hz": 0.009, "verdict_margin_hz": 0, "margin_z": 3,
@@ -56,6 +61,7 @@
 #include "analysis/impedance_analysis.h"
 #include "analysis/qc/bond_index.h"
 #include "analysis/qc/curve_mask.h"
+#include "analysis/qc/f0_pressure.h"
 #include "analysis/qc/measurement.h"
 #include "analysis/signal/excitation_design.h"
 #include "analysis/signal/multisine.h"
@@ -155,6 +161,7 @@ struct Recipe {
   OperatorInstructions instructions;
   std::optional<RecipeApproval> approval;
   std::optional<analysis::BondIndexDefinition> bond_index;
+  std::optional<analysis::F0PressureDefinition> f0_pressure;
   // The precision the excitation is designed for (issue 16); the recipe's own excitation must
   // reach it at the nominal motor, or the recipe is refused.
   std::optional<analysis::ExcitationRequirement> excitation_design;
@@ -203,6 +210,9 @@ nlohmann::json InstructionsJson(const OperatorInstructions& instructions);
 // One limit in the recipe's "limits" schema ({"name", "unit", "doc", "lo"?, "hi"?, "marginal"};
 // an open side is left out). Also how a taught or benched limit is reported.
 nlohmann::json LimitJson(const analysis::MeasurementSpec& spec);
+// The recipe's "bond_index" and "f0_pressure" blocks (also how teach reports them).
+nlohmann::json BondIndexJson(const analysis::BondIndexDefinition& d);
+nlohmann::json F0PressureJson(const analysis::F0PressureDefinition& d);
 
 std::string Sha256Hex(const std::string& data);
 std::string CanonicalHash(const nlohmann::json& j);

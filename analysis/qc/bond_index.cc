@@ -18,6 +18,8 @@ bool BondIndexDefinition::IsValid(std::string* why) const {
     if (why) *why = m;
     return false;
   };
+  if (f0_name != names::kResonanceFHz && f0_name != names::kResonanceFRefPressureHz)
+    return fail("f0 must be resonance_f_hz or resonance_f_ref_pressure_hz");
   if (!std::isfinite(f0_exponent) || f0_exponent < 0.0 || f0_exponent > 1000.0)
     return fail("f0_exponent must be finite and in [0, 1000]");
   if (!PositiveFinite(f0_ref_hz)) return fail("f0_ref_hz must be positive and finite");
@@ -28,7 +30,7 @@ bool BondIndexDefinition::IsValid(std::string* why) const {
 
 std::optional<Estimate> BondIndex(const std::map<std::string, Estimate>& values,
                                   const BondIndexDefinition& d) {
-  const auto f0 = values.find(std::string(names::kResonanceFHz));
+  const auto f0 = values.find(d.f0_name);
   const auto a = values.find(std::string(names::kMotionalResidueOhmPerS));
   if (f0 == values.end() || a == values.end() || !PositiveFinite(f0->second.value) ||
       !PositiveFinite(a->second.value))

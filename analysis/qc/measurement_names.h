@@ -22,16 +22,23 @@ inline constexpr std::string_view kBondIndexPct = "bond_index_pct";
 // search range (impedance_analysis.h): the likelihood-ratio test for a soft magnet's local mode
 // (only where the recipe declares it)
 inline constexpr std::string_view kSecondModeChi2Drop = "second_mode_chi2_drop";
+// Hz: f0 (p_ref / p)^m, the resonance at the reference clamp pressure (f0_pressure.h); only
+// where the recipe defines it ("f0_pressure" block, set by teaching when the slope is significant)
+inline constexpr std::string_view kResonanceFRefPressureHz = "resonance_f_ref_pressure_hz";
+// bar: the clamp pressure read at clamp confirmation (conditions.clamp_pressure_bar); an input
+// of f0_pressure.h, not a measurement a recipe judges
+inline constexpr std::string_view kClampPressureBar = "clamp_pressure_bar";
 
 // In the export schema's column order (db/export_schema.h): append only.
-inline constexpr std::array<std::string_view, 9> kAll = {kResonanceFHz,
-                                                         kResonanceQ,
-                                                         kWindingROhm,
-                                                         kWindingLH,
-                                                         kMotionalRpOhm,
-                                                         kFitChi2PerDof,
-                                                         kMotionalResidueOhmPerS,
-                                                         kBondIndexPct,
-                                                         kSecondModeChi2Drop};
+inline constexpr std::array<std::string_view, 10> kAll = {kResonanceFHz,
+                                                          kResonanceQ,
+                                                          kWindingROhm,
+                                                          kWindingLH,
+                                                          kMotionalRpOhm,
+                                                          kFitChi2PerDof,
+                                                          kMotionalResidueOhmPerS,
+                                                          kBondIndexPct,
+                                                          kSecondModeChi2Drop,
+                                                          kResonanceFRefPressureHz};
 
 }  // namespace eol::analysis::names

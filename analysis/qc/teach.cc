@@ -10,6 +10,7 @@
 
 #include "analysis/enum_names.h"
 #include "analysis/qc/bond_index.h"
+#include "analysis/qc/f0_pressure.h"
 #include "analysis/qc/measurement_names.h"
 #include "analysis/qc/statistics.h"
 #include "analysis/qc/tolerance.h"
@@ -35,10 +36,14 @@ struct SideWeights {
   bool defect_lo = false, defect_hi = false;
 };
 
-SideWeights DesignWeights(const std::string& name) {
+// With the pressure-normalised resonance declared (f0_pressure.h) it takes the f0 lower bound's
+// share, and f0 itself keeps plausibility bounds.
+SideWeights DesignWeights(const std::string& name, bool f0_normalised) {
   namespace n = names;
   const double p = kPlausibilityWeight;
-  if (name == n::kResonanceFHz) return {kResonanceLoWeight, p, true, false};
+  if (name == n::kResonanceFHz && f0_normalised) return {p, p, false, false};
+  if (name == n::kResonanceFHz || name == n::kResonanceFRefPressureHz)
+    return {kResonanceLoWeight, p, true, false};
   if (name == n::kFitChi2PerDof) return {p, 0.35, false, true};
   if (name == n::kResonanceQ) return {0.05, p, true, false};
   if (name == n::kMotionalResidueOhmPerS) return {p, kResidueWeight, false, true};
@@ -222,6 +227,9 @@ static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
   if (!o.IsValid(&why)) return Fail(s, "teach options: " + why);
   if (declared.empty()) return Fail(s, "the recipe declares no scalar limit to teach");
   const bool robust = o.method == TeachMethod::kMad;
+  const bool f0_normalised = std::any_of(
+      declared.begin(), declared.end(),
+      [](const MeasurementSpec& d) { return d.name == names::kResonanceFRefPressureHz; });
 
   // Every golden (and known-bad) unit must carry every declared measurement, finite.
   for (const auto* set : {&golden, &known_bad})
@@ -346,7 +354,7 @@ static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
       return Fail(s, "no spread in " + d.name + " among the golden units (" +
                          std::to_string(used.size()) +
                          " units, all equal?): a limit cannot be learned from it");
-    const SideWeights sw = DesignWeights(d.name);
+    const SideWeights sw = DesignWeights(d.name, f0_normalised);
     stats.push_back(Stat{TaughtStatistic{d.name, cs.centre, cs.scale, 0.0, 0.0},
                          d.limit.lo.has_value(), d.limit.hi.has_value(), sw.lo, sw.hi, sw.defect_lo,
                          sw.defect_hi});
@@ -438,9 +446,13 @@ static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
       }
       return out;
     };
+    // The resonance's lower bound that carries the defect share: the pressure-normalised one
+    // when it is declared.
+    const std::string_view f0_name =
+        f0_normalised ? names::kResonanceFRefPressureHz : names::kResonanceFHz;
     std::size_t f0 = scalar_count;
     for (std::size_t i = 0; i < scalar_count; ++i)
-      if (stats[i].t.name == names::kResonanceFHz && stats[i].want_lo) f0 = i;
+      if (stats[i].t.name == f0_name && stats[i].want_lo) f0 = i;
     std::vector<bool> by_lo(scalar_count, false), by_hi(scalar_count, false);
     s.known_bad_units = static_cast<int>(known_bad.size());
     s.known_bad_escapes_budget = escapes(&by_lo, &by_hi);
@@ -610,20 +622,91 @@ static void FromLogScale(TeachSummary& s) {
     if (TaughtOnLogScale(t.name)) t.name += " (taught on ln(1 + x))";
 }
 
+// The pressure-normalised resonance (f0_pressure.h): fitted when f0 has a lower limit and every
+// golden unit carries its clamp pressure; declared (with the f0 limit's unit) when used.
+static F0PressureFit FitF0Pressure(const std::vector<MeasurementSpec>& declared,
+                                   const std::vector<GoldenUnit>& golden,
+                                   std::optional<MeasurementSpec>* spec) {
+  F0PressureFit fit;
+  const auto f0_spec = std::find_if(declared.begin(), declared.end(), [](const MeasurementSpec& d) {
+    return d.name == names::kResonanceFHz && d.limit.lo;
+  });
+  if (f0_spec == declared.end()) {
+    fit.note = "not used: the recipe has no lower limit on resonance_f_hz";
+    return fit;
+  }
+  std::vector<std::pair<double, double>> f0_and_pressure;
+  int without = 0;
+  std::string first_without;
+  for (const GoldenUnit& u : golden) {
+    const auto f0 = u.values.find(std::string(names::kResonanceFHz));
+    const auto p = u.values.find(std::string(names::kClampPressureBar));
+    if (f0 == u.values.end() || p == u.values.end() || !std::isfinite(f0->second) ||
+        !std::isfinite(p->second) || !(f0->second > 0.0) || !(p->second > 0.0)) {
+      if (without++ == 0) first_without = u.label;
+      continue;
+    }
+    f0_and_pressure.emplace_back(f0->second, p->second);
+  }
+  if (without > 0) {
+    fit.note = "not used: " + std::to_string(without) + " of " + std::to_string(golden.size()) +
+               " golden units carry no clamp pressure (first: " + first_without +
+               "; station records carry it, `eol analyze --clamp-pressure-bar P --json` adds it)";
+    return fit;
+  }
+  fit = TeachF0Pressure(f0_and_pressure);
+  if (fit.definition) {
+    MeasurementSpec m;
+    m.name = std::string(names::kResonanceFRefPressureHz);
+    m.unit = f0_spec->unit;
+    m.doc =
+        "first torsional mode at the reference clamp pressure, f0 (p_ref / p)^m "
+        "(analysis/qc/f0_pressure.h)";
+    m.limit.lo = f0_spec->limit.lo;
+    *spec = m;
+  }
+  return fit;
+}
+
 // A declared bond index is taught first: its exponent and references from the golden units'
 // f0 and residue (bond_index.h), then its value is added to every unit and it is taught as
-// any other measurement. Log-scale measurements are taught on ln(1 + x) (above).
-TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
+// any other measurement. So is the pressure-normalised resonance, when the golden units' f0
+// follows their clamp pressure (FitF0Pressure; a limit on it declared by an earlier teaching is
+// taught afresh or dropped). Log-scale measurements are taught on ln(1 + x) (above).
+TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared_in,
                          const std::vector<GoldenUnit>& golden, const TeachOptions& o,
                          const std::vector<GoldenUnit>& known_bad) {
+  std::vector<MeasurementSpec> declared;
+  for (const MeasurementSpec& d : declared_in)
+    if (d.name != names::kResonanceFRefPressureHz) declared.push_back(d);
+  std::optional<MeasurementSpec> f0_pressure_spec;
+  const F0PressureFit f0_pressure = FitF0Pressure(declared, golden, &f0_pressure_spec);
+  if (f0_pressure_spec) declared.push_back(*f0_pressure_spec);
   const bool index_declared =
       std::any_of(declared.begin(), declared.end(),
                   [](const MeasurementSpec& d) { return d.name == names::kBondIndexPct; });
   std::optional<BondIndexDefinition> index;
+  // The normalised resonance first: the bond index weighs it when it is used.
+  const auto add_f0_at_ref_pressure = [&](std::vector<GoldenUnit> units) {
+    if (f0_pressure.definition)
+      for (GoldenUnit& u : units) {
+        std::map<std::string, Estimate> values;
+        for (const auto& [name, v] : u.values) values[name] = Estimate{v, 0.0};
+        const auto p = u.values.find(std::string(names::kClampPressureBar));
+        if (p == u.values.end()) continue;  // a known-bad unit without it is refused by name
+        AddF0AtRefPressure(values, p->second, *f0_pressure.definition);
+        const auto e = values.find(std::string(names::kResonanceFRefPressureHz));
+        if (e != values.end()) u.values[e->first] = e->second.value;
+      }
+    return units;
+  };
+  const std::vector<GoldenUnit> golden_p = add_f0_at_ref_pressure(golden);
   if (index_declared) {
-    const std::string f0_name(names::kResonanceFHz), a_name(names::kMotionalResidueOhmPerS);
+    const std::string f0_name(f0_pressure.definition ? names::kResonanceFRefPressureHz
+                                                     : names::kResonanceFHz);
+    const std::string a_name(names::kMotionalResidueOhmPerS);
     std::vector<std::pair<double, double>> f0_and_residue;
-    for (const GoldenUnit& u : golden) {
+    for (const GoldenUnit& u : golden_p) {
       const auto f0 = u.values.find(f0_name);
       const auto a = u.values.find(a_name);
       if (f0 == u.values.end() || a == u.values.end() || !(f0->second > 0.0) ||
@@ -637,6 +720,7 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
       f0_and_residue.emplace_back(f0->second, a->second);
     }
     index = TeachBondIndex(f0_and_residue);
+    index->f0_name = f0_name;
   }
   const auto prepared = [&](std::vector<GoldenUnit> units) {
     if (index)
@@ -648,9 +732,11 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared,
       }
     return ToLogScale(std::move(units));
   };
-  TeachSummary s = TeachOnValues(declared, prepared(golden), o, prepared(known_bad));
+  TeachSummary s =
+      TeachOnValues(declared, prepared(golden_p), o, prepared(add_f0_at_ref_pressure(known_bad)));
   FromLogScale(s);
   s.bond_index = index;
+  s.f0_pressure = f0_pressure;
   return s;
 }
 

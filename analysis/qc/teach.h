@@ -16,6 +16,13 @@
 // the recipe keeps its shape without spending the budget there.
 //   measurement        defect side  weight  why
 //   resonance_f_hz     lo           0.20    a softer bond (or looser clamp) only lowers the mode
+//   resonance_f_ref    lo           0.20    the same, with the clamp pressure's share of the
+//     _pressure_hz                          good units' spread taken out (f0_pressure.h);
+//                                           declared by teach itself when every golden unit
+//                                           carries its clamp pressure and ln f0 follows ln p
+//                                           (t >= 3). It then takes f0's share, and f0 keeps
+//                                           plausibility bounds on both sides. Known-bad units
+//                                           move share to it instead of f0.
 //   motional_residue   hi           0.10    T^2/J: a softer bond lets less inertia follow the
 //     _ohm_per_s                            magnets (where the torque acts); it rises about
 //                                           twelve times faster than f0 falls and hardly moves
@@ -104,6 +111,7 @@
 #include "analysis/frf.h"
 #include "analysis/qc/bond_index.h"
 #include "analysis/qc/curve_mask.h"
+#include "analysis/qc/f0_pressure.h"
 #include "analysis/qc/measurement.h"
 
 namespace eol::analysis {
@@ -191,6 +199,10 @@ struct TeachSummary {
   // When bond_index_pct is declared: its definition taught from the golden units (bond_index.h),
   // to be written into the taught recipe's "bond_index" block.
   std::optional<BondIndexDefinition> bond_index;
+  // The pressure-normalised resonance (f0_pressure.h): what the regression of ln f0 on ln p over
+  // the golden units found; its definition, when used, goes into the taught recipe's
+  // "f0_pressure" block with the limit on resonance_f_ref_pressure_hz.
+  F0PressureFit f0_pressure;
 };
 
 // Never throws for bad data: usable == false with the reason (names the unit or measurement).

@@ -22,6 +22,7 @@
 #include "analysis/impedance_analysis.h"
 #include "analysis/model/two_mass.h"
 #include "analysis/qc/measurement_json.h"
+#include "analysis/qc/measurement_names.h"
 #include "analysis/signal/waveform.h"
 #include "analysis/signal/welch.h"
 #include "analysis/text.h"
@@ -48,9 +49,10 @@ struct AnalyzeArgs {
   std::string excitation_band;
   double voltage_gain = 0.0;
   double current_gain = 0.0;
-  std::size_t welch_segment = 0;  // > 0: a non-periodic recording, Welch H1
-  std::string band;               // Welch: f_lo,f_hi of the reported lines
-  std::string plot;               // SVG (or .png) of the curve against model and limits
+  std::size_t welch_segment = 0;    // > 0: a non-periodic recording, Welch H1
+  std::string band;                 // Welch: f_lo,f_hi of the reported lines
+  std::string plot;                 // SVG (or .png) of the curve against model and limits
+  double clamp_pressure_bar = 0.0;  // > 0: the unit's clamp pressure, as the station reads it
 };
 
 class UsageError : public std::runtime_error {
@@ -191,7 +193,7 @@ json VerdictJson(const Judgement& v) {
 json JudgeJson(const Recipe& recipe, const analysis::ImpedanceAnalysis& result,
                const analysis::Recording* recording, json& out, Judgement* judgement = nullptr) {
   const PairMeasurement pair{recipe.phase_pair, &result, recording};
-  json conditions = json::object();
+  json conditions = out.value("conditions", json::object());  // --clamp-pressure-bar
   Judgement j = JudgeUnit(recipe, std::span<const PairMeasurement>(&pair, 1), conditions);
   out["conditions"] = conditions;
   json v = VerdictJson(j);
@@ -243,6 +245,8 @@ int AnalyzeMobility(const AnalyzeArgs& a, const analysis::Frf& h, json out) {
 
 int RunAnalyze(const AnalyzeArgs& a) {
   json out = {{"file", a.measured}};
+  if (a.clamp_pressure_bar > 0.0)
+    out["conditions"] = {{std::string(analysis::names::kClampPressureBar), a.clamp_pressure_bar}};
   std::unique_ptr<Recipe> recipe;
   io::MeasuredInput in;
   std::vector<std::size_t> lines;
@@ -420,6 +424,11 @@ void AddAnalyzeCommand(CLI::App& app) {
                   "segments of N samples, 50 % overlap, sigma from the coherence");
   cmd->add_option("--band", args->band,
                   "Welch: f_lo,f_hi of the lines to fit (default: the recipe's excitation band)");
+  cmd->add_option("--clamp-pressure-bar", args->clamp_pressure_bar,
+                  "The unit's clamp pressure (bar) as the station read it: the judge's\n"
+                  "resonance_f_ref_pressure_hz needs it; kept in the output's conditions\n"
+                  "(so eol teach finds it in --json outputs)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--voltage-gain", args->voltage_gain, "WAV: volts per unit of full scale");
   cmd->add_option("--current-gain", args->current_gain, "WAV: amperes per unit of full scale");
   cmd->callback([args] { RunGuarded("analyze", [&] { return RunAnalyze(*args); }); });

@@ -85,8 +85,12 @@ int RunTeach(const TeachArgs& a) {
   }
   std::cout << "teach: " << s.message << "\n";
   for (const std::string& r : s.rejected) std::cout << "  rejected golden unit " << r << "\n";
+  std::cout << "clamp-pressure-normalised resonance: " << s.f0_pressure.note << "\n";
   for (std::size_t i = 0; i < s.limits.size(); ++i) {
-    const auto& old = recipe.limits[i].limit;
+    // By name: teach declares or drops resonance_f_ref_pressure_hz itself.
+    analysis::Limit old;
+    for (const analysis::MeasurementSpec& l : recipe.limits)
+      if (l.name == s.limits[i].name) old = l.limit;
     const auto& now = s.limits[i].limit;
     auto bound = [](const std::optional<double>& v) {
       return v ? json(*v).dump() : std::string("-");

@@ -88,19 +88,20 @@ TEST(ExportSchema, BaseColumnsComeFirstInTheDocumentedOrder) {
   for (std::size_t i = 0; i < base.size(); ++i) EXPECT_EQ(names[i], base[i]) << "column " << i;
   EXPECT_EQ(names[base.size()], "resonance_f_hz_value");
   const std::vector<std::string> fields = {"value", "sigma", "lo", "hi", "unit", "outcome"};
-  EXPECT_EQ(names.size(), base.size() + 9 * 6) << "nine standard measurements, six fields each";
+  EXPECT_EQ(names.size(), base.size() + 10 * 6) << "ten standard measurements, six fields each";
   for (std::size_t k = 0; k < fields.size(); ++k)
     EXPECT_EQ(names[base.size() + 6 + k], "resonance_q_" + fields[k]);
 }
 
 TEST(ExportSchema, RecipeNamesFollowTheStandardOnesOnce) {
   const auto names = ExportMeasurementNames({"resonance_q", "mask_low_lines_outside"});
-  ASSERT_EQ(names.size(), 10u);
+  ASSERT_EQ(names.size(), 11u);
   EXPECT_EQ(names[1], "resonance_q");
-  EXPECT_EQ(names[6], "motional_residue_ohm_per_s");  // appended in schema version 2
-  EXPECT_EQ(names[7], "bond_index_pct");              // appended in schema version 3
-  EXPECT_EQ(names[8], "second_mode_chi2_drop");       // appended in schema version 4
-  EXPECT_EQ(names[9], "mask_low_lines_outside");
+  EXPECT_EQ(names[6], "motional_residue_ohm_per_s");   // appended in schema version 2
+  EXPECT_EQ(names[7], "bond_index_pct");               // appended in schema version 3
+  EXPECT_EQ(names[8], "second_mode_chi2_drop");        // appended in schema version 4
+  EXPECT_EQ(names[9], "resonance_f_ref_pressure_hz");  // appended in schema version 5
+  EXPECT_EQ(names[10], "mask_low_lines_outside");
   EXPECT_THROW(ExportColumns({"a", "a"}), std::invalid_argument);
 }
 
@@ -155,7 +156,7 @@ TEST(ExportSchema, JsonRowHasTheSameFieldsAsTheCsv) {
   for (const auto& [key, value] : j.items()) {
     if (key != "measurements") ++fields;
   }
-  ASSERT_EQ(j["measurements"].size(), 10u);
+  ASSERT_EQ(j["measurements"].size(), 11u);
   for (const auto& [name, m] : j["measurements"].items()) fields += m.size();
   EXPECT_EQ(fields, columns.size());
   EXPECT_EQ(j["serial"], "SN-1");

@@ -56,7 +56,8 @@ Output in --out: unit-NNNN.csv (f_hz,re_ohm,im_ohm,sigma_ohm), and truth.csv: un
 first_mode_hz (lowest mode of the undamped chain; with a very soft bond it is that
 magnet's local mode), k_fixture, defect_size (the stiffness loss a: that of the one soft
 magnet, the largest of three, the common loss of all ten; 0 for good units), and per magnet
-the kept fraction r_bond_i and the loss loss_i = 1 - r_bond_i (0 for a good bond).
+the kept fraction r_bond_i and the loss loss_i = 1 - r_bond_i (0 for a good bond), and the
+clamp pressure (bar, 0.001 resolution: what the station reads at clamp confirmation).
 """
 import argparse
 import csv
@@ -156,7 +157,7 @@ def draw_parts(rng):
         k_fixture=n["k_fixture"] * (pressure / 5.5) ** (1.0 / 3.0)
         * np.exp(0.02 * rng.standard_normal()),
         r=n["r_ohm"] * g(0.01) * (1.0 + 0.00393 * (temp_c - 20.0)),
-        l=n["l_h"] * g(0.02), t=n["t_nm_per_a"] * g(0.04))
+        l=n["l_h"] * g(0.02), t=n["t_nm_per_a"] * g(0.04), clamp_pressure_bar=pressure)
 
 
 ALL_SOFT_SPREAD = 0.15  # lognormal spread of each magnet's kept fraction around the common one
@@ -261,7 +262,7 @@ def main():
         tw = csv.writer(tf)
         tw.writerow(["unit", "class", "first_mode_hz", "k_fixture_nm_per_rad", "defect_size"]
                     + ["r_bond_%d" % (i + 1) for i in range(MAGNETS)]
-                    + ["loss_%d" % (i + 1) for i in range(MAGNETS)])
+                    + ["loss_%d" % (i + 1) for i in range(MAGNETS)] + ["clamp_pressure_bar"])
         for idx, j in enumerate(order):
             cls = plan[j]
             p = draw_parts(rng)
@@ -274,7 +275,8 @@ def main():
                 for fk, zk, sk in zip(f_hz, zh, sigma):
                     f.write("%.1f,%.9g,%.9g,%.6g\n" % (fk, zk.real, zk.imag, sk))
             tw.writerow([name, cls, "%.3f" % first_mode_hz(p, r), "%.2f" % p["k_fixture"],
-                         "%.4f" % size] + ["%.4f" % x for x in r] + ["%.4f" % (1.0 - x) for x in r])
+                         "%.4f" % size] + ["%.4f" % x for x in r] + ["%.4f" % (1.0 - x) for x in r]
+                        + ["%.3f" % p["clamp_pressure_bar"]])
     return 0
 
 

@@ -24,6 +24,10 @@
 // 4. The resonance's residue T^2/J (motional_residue_ohm_per_s) earns its place: on rotors
 //    with all ten bonds at losses of 0.85-0.94 (f0 1-4 % low, mostly inside the good spread)
 //    the shipped recipe taught with it rejects clearly more than the same recipe without it.
+// 5. The resonance at the reference clamp pressure (analysis/qc/f0_pressure.h) is taught when
+//    every unit's clamp pressure goes with it (population_rejects.py --clamp-pressure), and then
+//    never rejects fewer all-ten-soft rotors nor more good ones than the same teaching without
+//    the pressure.
 // Milder softness (losses below about 0.9) moves f0 by less than the good units' spread: no
 // limit on this fixture sees it (README, "Learning limits and detectability").
 #include <gtest/gtest.h>
@@ -182,6 +186,34 @@ TEST_F(IndependentPopulation, ResidueCatchesSofterBondsThanTheResonanceAlone) {
   std::cout << "all ten soft (loss 0.85-0.94) rejected with / without the residue: " << with_n
             << " / " << without_n << " of 80\n";
   EXPECT_GE(with_n, without_n + 6);
+}
+
+// Part 5. Without the pressure the golden units are read from their CSV files and would get
+// masks; the analyze outputs read with it carry no curve, so both are taught without masks.
+TEST_F(IndependentPopulation, ClampPressureNormalisationIsTaughtAndNeverCatchesFewer) {
+  const std::vector<std::string> sweep = {
+      "--seeds", "505",        "--good", "100",       "--one-soft", "0",         "--three-soft",
+      "0",       "--all-soft", "60",     "--loss-lo", "0.88",       "--loss-hi", "0.96"};
+  std::vector<std::string> with_args = sweep, without_args = sweep;
+  with_args.push_back("--clamp-pressure");
+  without_args.push_back("--teach-arg=--mask-segments=0");
+  const nlohmann::json with_j = Rejects("pressure", with_args);
+  const nlohmann::json without_j = Rejects("no_pressure", without_args);
+  ASSERT_TRUE(with_j.is_object() && without_j.is_object());
+  const nlohmann::json& taught = with_j.at("teach").at(0).at("f0_pressure");
+  std::cout << "with the pressure: " << taught.at("note").get<std::string>() << "\n";
+  EXPECT_TRUE(taught.at("used").get<bool>());
+  EXPECT_NEAR(taught.at("slope").get<double>(), 0.114,
+              4.0 * taught.at("slope_sigma").get<double>());
+  EXPECT_FALSE(without_j.at("teach").at(0).at("f0_pressure").at("used").get<bool>());
+  auto rejected = [](const nlohmann::json& j, const char* cls) {
+    return j.at("table").at(cls).at("rejected").get<int>();
+  };
+  std::cout << "rejected with / without the pressure: all_soft " << rejected(with_j, "all_soft")
+            << " / " << rejected(without_j, "all_soft") << " of 60, good "
+            << rejected(with_j, "good") << " / " << rejected(without_j, "good") << " of 100\n";
+  EXPECT_GE(rejected(with_j, "all_soft"), rejected(without_j, "all_soft"));
+  EXPECT_LE(rejected(with_j, "good"), rejected(without_j, "good"));
 }
 
 }  // namespace

@@ -12,7 +12,11 @@ class) and, with --json FILE, writes the same as JSON for tests. With --hits FIL
 the per-unit hit/miss table (class, size = the truth's bond stiffness loss, hit, f0_hz) and
 runs `eol pod --hits FILE --json` on it: POD(a) and a90/95 per defect class, fitted by eol
 (analysis/qc/pod.h), printed and added to the JSON; --pod-svg FILE draws it with the taught
-f0 lower limit. Exit 0 when everything ran,
+f0 lower limit. With --clamp-pressure every unit's clamp pressure (truth.csv, what the station
+reads at clamp confirmation) goes with it, as on the station: the golden units are analysed
+with `eol analyze --recipe R --json --clamp-pressure-bar P` and taught from those outputs (so
+teach may normalise f0 by the pressure, analysis/qc/f0_pressure.h), and every judged unit gets
+--clamp-pressure-bar P. Exit 0 when everything ran,
 1 when teach failed (its stderr is printed), 2 on usage errors.
 """
 import argparse
@@ -28,9 +32,13 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 CLASSES = ("good", "one_soft", "three_soft", "all_soft")
 
 
-def judge(eol, recipe, path):
-    r = subprocess.run([eol, "analyze", "--measured", path, "--recipe", recipe, "--json"],
-                       capture_output=True, text=True)
+def pressure_args(a, t):
+    return ["--clamp-pressure-bar", t["clamp_pressure_bar"]] if a.clamp_pressure else []
+
+
+def judge(eol, recipe, path, extra=()):
+    r = subprocess.run([eol, "analyze", "--measured", path, "--recipe", recipe, "--json"]
+                       + list(extra), capture_output=True, text=True)
     try:
         out = json.loads(r.stdout)
     except ValueError:
@@ -53,10 +61,21 @@ def run_population(a, seed, workdir):
                     "--out", pop, "--seed", str(seed)] + counts, check=True)
     with open(os.path.join(pop, "truth.csv")) as f:
         truth = list(csv.DictReader(f))
-    golden = [t["unit"] for t in truth if t["class"] == "good"][:a.golden]
+    golden_rows = [t for t in truth if t["class"] == "good"][:a.golden]
+    golden = [t["unit"] for t in golden_rows]
+    golden_files = [os.path.join(pop, u + ".csv") for u in golden]
+    if a.clamp_pressure:  # analysed as the station would, the pressure kept in the output
+        golden_files = []
+        for t in golden_rows:
+            out = os.path.join(pop, t["unit"] + ".analyze.json")
+            with open(out, "w") as f:
+                subprocess.run([a.eol, "analyze", "--measured", os.path.join(pop, t["unit"] + ".csv"),
+                                "--recipe", a.recipe, "--json"] + pressure_args(a, t),
+                               stdout=f, check=True)
+            golden_files.append(out)
     taught = os.path.join(pop, "taught.json")
     r = subprocess.run([a.eol, "teach", "--recipe", a.recipe, "--out", taught, "--json",
-                        "--golden"] + [os.path.join(pop, u + ".csv") for u in golden]
+                        "--golden"] + golden_files
                        + a.teach_arg, capture_output=True, text=True)
     if r.returncode != 0:
         sys.stderr.write("eol teach failed (seed %d): %s\n" % (seed, r.stderr))
@@ -64,7 +83,8 @@ def run_population(a, seed, workdir):
     summary = json.loads(r.stdout)
     judged = [t for t in truth if t["unit"] not in set(golden)]
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
-        verdicts = list(ex.map(lambda t: judge(a.eol, taught, os.path.join(pop, t["unit"] + ".csv")),
+        verdicts = list(ex.map(lambda t: judge(a.eol, taught, os.path.join(pop, t["unit"] + ".csv"),
+                                               pressure_args(a, t)),
                                judged))
     for t, v in zip(judged, verdicts):
         t.update(v)
@@ -89,6 +109,8 @@ def main():
                     help="loss factor of a soft bond (generator; default: the generator's)")
     ap.add_argument("--hits", help="write the per-unit hit/miss CSV here and fit POD with eol pod")
     ap.add_argument("--pod-svg", help="with --hits: the POD figure (eol pod --pod-svg)")
+    ap.add_argument("--clamp-pressure", action="store_true",
+                    help="give eol each unit's clamp pressure (see above)")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--teach-arg", action="append", default=[],
                     help="extra argument passed to eol teach (repeat)")
@@ -106,7 +128,8 @@ def main():
                 return 1
             teach.append({"seed": seed, "message": summary.get("message"),
                           "limits": summary.get("limits"),
-                          "expected_false_reject": summary.get("expected_false_reject")})
+                          "expected_false_reject": summary.get("expected_false_reject"),
+                          "f0_pressure": summary.get("f0_pressure")})
             rows += judged
 
     table = {}
@@ -123,6 +146,8 @@ def main():
                                                   "%.1f" % min(f0) if f0 else "-"))
     for t in teach:
         print("teach seed %d: %s" % (t["seed"], t["message"]))
+        if t.get("f0_pressure"):
+            print("  clamp-pressure-normalised resonance: %s" % t["f0_pressure"].get("note"))
         for lim in t["limits"] or []:
             print("  %s: lo %s hi %s" % (lim.get("name"), lim.get("lo"), lim.get("hi")))
     pod = None

@@ -6,6 +6,7 @@
 // mask, ERROR by a test condition.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <memory>
 
@@ -50,7 +51,10 @@ class JudgeParityTest : public ::testing::Test {
 
   // Judges the recording on the station and offline with `recipe`, checks they agree and
   // returns the station's record.
-  db::TestRecord JudgeBothWays(const std::string& name, const nlohmann::json& recipe_json) {
+  // With `with_pressure` the offline judge gets the clamp pressure the station read
+  // (--clamp-pressure-bar, written to round-trip to the same double).
+  db::TestRecord JudgeBothWays(const std::string& name, const nlohmann::json& recipe_json,
+                               bool with_pressure = false) {
     const std::string recipe_path = *dir_ / (name + ".json");
     std::ofstream(recipe_path) << recipe_json.dump(2);
     const Recipe recipe = LoadRecipe(recipe_path);
@@ -70,8 +74,13 @@ class JudgeParityTest : public ::testing::Test {
                         board, SequencerOptions{});
     const db::TestRecord station = sequencer.RunTest(serial);
 
-    const auto cli = RunEol({"analyze", "--recipe", recipe_path, "--measured", recording, "--json"},
-                            false, 120s);
+    std::vector<std::string> args = {"analyze",    "--recipe", recipe_path,
+                                     "--measured", recording,  "--json"};
+    if (with_pressure) {
+      args.push_back("--clamp-pressure-bar");
+      args.push_back(station.conditions.at("clamp_pressure_bar").dump());
+    }
+    const auto cli = RunEol(args, false, 120s);
     EXPECT_EQ(cli.code, 0) << cli.out;  // analysed, whatever the verdict
     nlohmann::json offline;
     try {
@@ -151,6 +160,44 @@ TEST_F(JudgeParityTest, ErrorByCondition) {
   EXPECT_EQ(r.reasons.front().code, ReasonCode::kCondition);
   EXPECT_EQ(r.reasons.front().text.rfind("condition out of window: excitation level ", 0), 0u)
       << r.reasons.front().text;
+}
+
+// The resonance at the reference clamp pressure (analysis/qc/f0_pressure.h) is judged from the
+// pressure read at clamp confirmation on the station and from --clamp-pressure-bar offline:
+// the same value to the bit; offline without the pressure it is ERROR, with a reason that says
+// where the pressure comes from.
+TEST_F(JudgeParityTest, FailByPressureNormalisedResonance) {
+  nlohmann::json j = BaseRecipe();
+  j["f0_pressure"] = {{"exponent", 0.11}, {"pressure_ref_bar", 4.0}};
+  j["limits"].push_back({{"name", "resonance_f_ref_pressure_hz"}, {"unit", "Hz"}, {"lo", 370.0}});
+  const db::TestRecord pass = JudgeBothWays("pressure-pass", j, true);
+  EXPECT_EQ(pass.outcome, Outcome::kPass) << nlohmann::json(pass.reasons).dump();
+  const double p = pass.conditions.at("clamp_pressure_bar").get<double>();
+  double f0 = 0.0, f0p = 0.0;
+  for (const analysis::Measurement& m : pass.measurements) {
+    if (m.name == "resonance_f_hz") f0 = m.value;
+    if (m.name == "resonance_f_ref_pressure_hz") f0p = m.value;
+  }
+  // 5.5 bar on the simulated clamp, 4.0 the reference: about 3.6 % lower than f0.
+  EXPECT_NEAR(p, 5.5, 0.05);
+  EXPECT_NEAR(f0p, f0 * std::pow(4.0 / p, 0.11), 1e-9 * f0);
+
+  j["limits"].back()["lo"] = f0p + 1.0;  // between f0p and f0: only the normalised one fails
+  const db::TestRecord fail = JudgeBothWays("pressure-fail", j, true);
+  EXPECT_EQ(fail.outcome, Outcome::kFail);
+  ASSERT_FALSE(fail.reasons.empty());
+  EXPECT_EQ(fail.reasons.front().text.rfind("resonance_f_ref_pressure_hz = ", 0), 0u)
+      << fail.reasons.front().text;
+
+  const std::string recipe_path = *dir_ / "pressure-fail.json";
+  const auto cli =
+      RunEol({"analyze", "--recipe", recipe_path, "--measured", *dir_ / "unit.csv", "--json"},
+             false, 120s);
+  const nlohmann::json offline = nlohmann::json::parse(cli.out);
+  EXPECT_EQ(offline.at("verdict").at("outcome"), "ERROR");
+  EXPECT_NE(offline.at("verdict").at("reasons").dump().find("--clamp-pressure-bar"),
+            std::string::npos)
+      << offline.at("verdict").at("reasons").dump();
 }
 
 }  // namespace

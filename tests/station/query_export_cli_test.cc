@@ -269,7 +269,7 @@ TEST_F(QueryExportTest, CsvReadByPythonRoundTripsValuesLimitsOutcomesAndText) {
   EXPECT_EQ(jr["measurements"]["resonance_f_hz"]["value"].get<double>(), 361.123456789);
   EXPECT_EQ(jr["measurements"]["resonance_f_hz"]["lo"], 370.0);
   EXPECT_EQ(jr["reason_text"], row["reason_text"]);
-  EXPECT_EQ(jr.size(), row.size() - 9 * 6 + 1) << "base fields plus \"measurements\"";
+  EXPECT_EQ(jr.size(), row.size() - 10 * 6 + 1) << "base fields plus \"measurements\"";
 }
 
 TEST_F(QueryExportTest, RecipeDeclaresItsMaskColumnsAndRecordsKeepCurves) {

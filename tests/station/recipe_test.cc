@@ -116,6 +116,27 @@ TEST(Recipe, ErrorsNameTheJsonPathAndRule) {
       {[](auto& j) { j["bond_index"]["residue_ref_ohm_per_s"] = 0; },
        "/bond_index/residue_ref_ohm_per_s: must be positive"},
       {[](auto& j) { j["bond_index"]["f0_ref"] = 390; }, "/bond_index/f0_ref: unknown field"},
+      // The resonance at the reference clamp pressure needs its definition, and a sane one.
+      {[](auto& j) {
+         j["limits"].push_back({{"name", "resonance_f_ref_pressure_hz"}, {"lo", 370.0}});
+       },
+       "/f0_pressure: is required when a limit is declared on resonance_f_ref_pressure_hz"},
+      {[](auto& j) {
+         j["f0_pressure"] = {{"exponent", 0.7}, {"pressure_ref_bar", 5.5}};
+       },
+       "/f0_pressure/exponent: must be in (0, 0.5]"},
+      {[](auto& j) {
+         j["f0_pressure"] = {{"exponent", 0.1}, {"pressure_ref_bar", -1}};
+       },
+       "/f0_pressure/pressure_ref_bar: pressure_ref_bar must be positive"},
+      {[](auto& j) {
+         j["f0_pressure"] = {{"exponent", 0.1}};
+       },
+       "/f0_pressure/pressure_ref_bar"},
+      {[](auto& j) { j["bond_index"]["f0"] = "resonance_f_ref_pressure_hz"; },
+       "/f0_pressure: is required when bond_index weighs resonance_f_ref_pressure_hz"},
+      {[](auto& j) { j["bond_index"]["f0"] = "winding_r_ohm"; },
+       "/bond_index/f0: must be resonance_f_hz or resonance_f_ref_pressure_hz"},
   };
   for (const Case& c : cases) {
     nlohmann::json j = Good();
@@ -247,6 +268,13 @@ TEST(RecipeJson, OneFieldListReadsAndWritesEveryKey) {
       {"excitation_v_rms", {{"lo", 0.1}}},
       {"excitation_a_rms", {{"hi", 3.0}}},
       {"out_of_window", "record"}};
+  source["f0_pressure"] = {{"exponent", 0.114}, {"pressure_ref_bar", 5.5}};
+  source["bond_index"]["f0"] = "resonance_f_ref_pressure_hz";
+  source["limits"].push_back({{"name", "resonance_f_ref_pressure_hz"},
+                              {"unit", "Hz"},
+                              {"doc", ""},
+                              {"lo", 372.0},
+                              {"marginal", 0.0}});
   const Recipe r = ParseRecipe(source, "test");
   const nlohmann::json written = RecipeToJson(r);
   ExpectContained(source, written, "");  // nothing the file said is lost or changed
@@ -256,6 +284,8 @@ TEST(RecipeJson, OneFieldListReadsAndWritesEveryKey) {
   EXPECT_EQ(again.masks.size(), r.masks.size());
   EXPECT_FALSE(again.conditions.error_when_out);
   EXPECT_EQ(again.instructions, r.instructions);
+  EXPECT_EQ(again.f0_pressure, r.f0_pressure);
+  EXPECT_EQ(again.bond_index, r.bond_index);
 }
 
 // Issue 17: what the operator does after FAIL, ERROR or ABORTED comes from the recipe; a key
