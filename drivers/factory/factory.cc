@@ -32,6 +32,13 @@ SimBenchSettings ParseSimBenchSettings(const io::JsonObject& o) {
   s.fixture_wear_per_test = o.Number("fixture_wear_per_test", s.fixture_wear_per_test);
   o.Require(s.fixture_wear_per_test >= 0 && s.fixture_wear_per_test <= 0.01,
             "fixture_wear_per_test", "must be in [0, 0.01] (share of the stiffness per part)");
+  s.clamp_pressure_spread_bar = o.Number("clamp_pressure_spread_bar", s.clamp_pressure_spread_bar);
+  o.Require(
+      s.clamp_pressure_spread_bar >= 0 && s.clamp_pressure_spread_bar <= 0.1 * s.clamp_pressure_bar,
+      "clamp_pressure_spread_bar", "must be in [0, 10 % of clamp_pressure_bar] (bar)");
+  s.fixture_pressure_exponent = o.Number("fixture_pressure_exponent", s.fixture_pressure_exponent);
+  o.Require(s.fixture_pressure_exponent >= 0 && s.fixture_pressure_exponent <= 1,
+            "fixture_pressure_exponent", "must be in [0, 1] (k_fixture ~ p^exponent)");
   if (o.Has("masters")) {
     const nlohmann::json& list = o.Raw("masters");
     if (!list.is_array()) throw io::ConfigError(o.PathOf("masters") + ": must be an array");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 namespace eol::drivers {
 
@@ -52,7 +53,18 @@ void SimBench::LoadPart(const std::string& serial) {
   } else {
     unit = analysis::DrawUnit(settings_.population, serial);
   }
+  double pressure = settings_.clamp_pressure_bar;
+  if (!master && settings_.clamp_pressure_spread_bar > 0.0) {
+    std::seed_seq seed(serial.begin(), serial.end());  // the same part, the same pressure
+    std::mt19937_64 rng(seed);
+    const double p0 = settings_.clamp_pressure_bar;
+    pressure = std::clamp(
+        p0 + settings_.clamp_pressure_spread_bar * std::normal_distribution<double>()(rng),
+        0.8 * p0, 1.2 * p0);
+    unit.rotor.k_fixture_nm_per_rad *= std::pow(pressure / p0, settings_.fixture_pressure_exponent);
+  }
   std::lock_guard<std::mutex> lock(mu_);
+  part_pressure_bar_ = pressure;
   const double wear = settings_.fixture_wear_per_test * static_cast<double>(parts_loaded_++);
   unit.rotor.k_fixture_nm_per_rad *= std::max(0.05, 1.0 - wear);
   part_ = unit;
@@ -61,6 +73,7 @@ void SimBench::LoadPart(const std::string& serial) {
 void SimBench::LoadUnit(const analysis::SimUnit& unit) {
   std::lock_guard<std::mutex> lock(mu_);
   part_ = unit;
+  part_pressure_bar_ = settings_.clamp_pressure_bar;
 }
 
 void SimBench::RemovePart() {
@@ -106,7 +119,7 @@ FixtureInputs SimBench::ReadInputs() {
     in.released = false;
     // Pressure ramps up over the closing time, with a small ripple.
     const double ramp = std::clamp(since_cmd / settings_.clamp_close_s, 0.0, 1.0);
-    in.clamp_pressure_bar = part_ ? settings_.clamp_pressure_bar * ramp : 0.0;
+    in.clamp_pressure_bar = part_ ? part_pressure_bar_ * ramp : 0.0;
     in.clamp_pressure_bar += 0.02 * std::sin(since_cmd * 37.0) * ramp;
   } else {
     in.clamped = false;

@@ -41,6 +41,15 @@ struct SimBenchSettings {
   // Fixture wear: each part loaded softens the fixture spring by this share of its new
   // stiffness (k_fixture x (1 - wear n) after n parts, at least 5 %), which lowers f0 slowly.
   double fixture_wear_per_test = 0.0;
+  // The clamp's pressure from part to part (the regulator and the seat: standard deviation,
+  // bar; 0 keeps every part at clamp_pressure_bar) and what it does to the fixture spring: a
+  // friction clamp's contact stiffness grows with the force, k_fixture ~ p^exponent (Hertz:
+  // 1/3). A production part's pressure is drawn from its serial (clipped to +-20 %), its
+  // fixture spring scaled by (p / clamp_pressure_bar)^exponent, and the clamp reads p; masters
+  // and LoadUnit parts sit at clamp_pressure_bar. This is what teach's pressure-normalised
+  // resonance (analysis/qc/f0_pressure.h) takes out.
+  double clamp_pressure_spread_bar = 0.0;
+  double fixture_pressure_exponent = 1.0 / 3.0;
 };
 
 enum class SimFault {
@@ -105,6 +114,7 @@ class SimBench {
   const SimClock now_;
   mutable std::mutex mu_;
   std::optional<analysis::SimUnit> part_;
+  double part_pressure_bar_ = 0.0;  // the clamp pressure the part in the fixture gets
   std::uint64_t parts_loaded_ = 0;
   bool clamp_cmd_ = false;
   std::optional<Clock::time_point> clamp_cmd_at_;  // none: never commanded, long released
