@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/text.h"
 
 namespace eol::analysis {
 namespace {
@@ -13,12 +13,6 @@ namespace {
 bool PositiveFinite(double v) { return std::isfinite(v) && v > 0.0; }
 
 constexpr double kMaxExponent = 0.5;
-
-std::string Format(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
 
 }  // namespace
 
@@ -84,13 +78,12 @@ F0PressureFit TeachF0Pressure(const std::vector<std::pair<double, double>>& f0_a
   fit.spread_after_pct = 100.0 * std::sqrt(rss / (n - 2.0));
   fit.slope_sigma = std::sqrt(rss / (n - 2.0) / sxx);
   fit.t = fit.slope_sigma > 0.0 ? fit.slope / fit.slope_sigma : 0.0;
-  const std::string found = "d ln f0 / d ln p = " + Format("%.4f", fit.slope) + " +- " +
-                            Format("%.4f", fit.slope_sigma) + " (t " + Format("%.1f", fit.t) +
-                            ", " + std::to_string(fit.units) + " units); f0 spread " +
-                            Format("%.3f", fit.spread_before_pct) + " % -> " +
-                            Format("%.3f", fit.spread_after_pct) + " %";
+  const std::string found =
+      "d ln f0 / d ln p = " + Fixed(fit.slope, 4) + " +- " + Fixed(fit.slope_sigma, 4) + " (t " +
+      Fixed(fit.t, 1) + ", " + std::to_string(fit.units) + " units); f0 spread " +
+      Fixed(fit.spread_before_pct, 3) + " % -> " + Fixed(fit.spread_after_pct, 3) + " %";
   if (fit.t < kF0PressureMinT) {
-    fit.note = "not used: " + found + ", t below " + Format("%.1f", kF0PressureMinT);
+    fit.note = "not used: " + found + ", t below " + Fixed(kF0PressureMinT, 1);
     return fit;
   }
   if (fit.slope > kMaxExponent) {
@@ -98,7 +91,7 @@ F0PressureFit TeachF0Pressure(const std::vector<std::pair<double, double>>& f0_a
     return fit;
   }
   fit.definition = F0PressureDefinition{fit.slope, std::exp(mean_x)};
-  fit.note = "used: " + found + ", p_ref " + Format("%.3f", std::exp(mean_x)) + " bar";
+  fit.note = "used: " + found + ", p_ref " + Fixed(std::exp(mean_x), 3) + " bar";
   return fit;
 }
 
