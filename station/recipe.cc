@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string_view>
 #include <tuple>
 
 #include "analysis/qc/measurement_names.h"
@@ -239,6 +240,11 @@ void ParseConditions(const JsonObject& c, Recipe& r) {
   c.RejectUnknown();
 }
 
+bool DeclaresLimit(const Recipe& r, std::string_view name) {
+  return std::any_of(r.limits.begin(), r.limits.end(),
+                     [&](const analysis::MeasurementSpec& s) { return s.name == name; });
+}
+
 void ParseBondIndex(const JsonObject& o, Recipe& r) {
   analysis::BondIndexDefinition d;
   d.f0_exponent = o.RequiredNumber("f0_exponent");
@@ -427,10 +433,7 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source,
       retest->RejectUnknown();
     }
     ParseLimits(root.Raw("limits"), "/limits", r);
-    r.analysis.fit.second_mode_test =
-        std::any_of(r.limits.begin(), r.limits.end(), [](const analysis::MeasurementSpec& s) {
-          return s.name == analysis::names::kSecondModeChi2Drop;
-        });
+    r.analysis.fit.second_mode_test = DeclaresLimit(r, analysis::names::kSecondModeChi2Drop);
     if (root.Has("masks")) ParseMasks(root.Raw("masks"), "/masks", r);
     if (auto c = root.OptionalObject("conditions")) ParseConditions(*c, r);
     if (auto i = root.OptionalObject("instructions")) ParseInstructions(*i, r);
@@ -443,10 +446,7 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source,
     root.Require(!r.crest_for_current || r.excitation_design.has_value(), "excitation",
                  "crest_for \"current\" needs the \"excitation_design\" block: its nominal "
                  "motor is the load the phases are designed for");
-    const bool index_declared =
-        std::any_of(r.limits.begin(), r.limits.end(), [](const analysis::MeasurementSpec& s) {
-          return s.name == analysis::names::kBondIndexPct;
-        });
+    const bool index_declared = DeclaresLimit(r, analysis::names::kBondIndexPct);
     root.Require(!index_declared || r.bond_index.has_value(), "bond_index",
                  "is required when a limit is declared on bond_index_pct (eol teach sets it; "
                  "analysis/qc/bond_index.h)");
@@ -454,10 +454,7 @@ Recipe ParseRecipe(const nlohmann::json& j, const std::string& source,
                      r.bond_index->f0_name != analysis::names::kResonanceFRefPressureHz ||
                      r.f0_pressure.has_value(),
                  "f0_pressure", "is required when bond_index weighs resonance_f_ref_pressure_hz");
-    const bool f0_pressure_declared =
-        std::any_of(r.limits.begin(), r.limits.end(), [](const analysis::MeasurementSpec& s) {
-          return s.name == analysis::names::kResonanceFRefPressureHz;
-        });
+    const bool f0_pressure_declared = DeclaresLimit(r, analysis::names::kResonanceFRefPressureHz);
     root.Require(!f0_pressure_declared || r.f0_pressure.has_value(), "f0_pressure",
                  "is required when a limit is declared on resonance_f_ref_pressure_hz (eol "
                  "teach sets it; analysis/qc/f0_pressure.h)");
