@@ -36,8 +36,9 @@ The channel noise is scaled so that the effect's strength
 is log-uniform in [s_lo, s_hi]; a case is "separable" when it has no effect or S >= 20, and
 for a coupled inertia also when the data can tell it from a fixture spring: --score fits the
 best massless fixture spring (`eol gap --effects fixture_compliance`) and counts the case only
-when the true model's chi2 = sum 2 |Z_meas - Z_true|^2 / sigma^2 is at least 10 (the
-diagnosis' min_score_gain) below that fit's. A coupled mode at 1.3-3.5 f0 can be so weak that
+when the true model's cost (-2 ln L as `eol gap` scores it: chi2 = sum 2 |r|^2 for an exact
+sigma, the Student t for one on few degrees of freedom, r in the report's residual form) is
+at least 10 (the diagnosis' min_score_gain) below that fit's. A coupled mode at 1.3-3.5 f0 can be so weak that
 the fixture spring fits as well as the truth: no rule can name it then.
 
 Usage:
@@ -146,17 +147,25 @@ def impedance(m, f, effect=None, p=None):
     return z
 
 
-def draw_effect(rng, kind, m):
+# The coupled inertia's draw: mass ratio mu log-uniform in [mu_lo, mu_hi], J2-on-k2 frequency
+# uniform in [f2_lo, f2_hi] times f0 and at most cap_hz (0: no cap). The default keeps the
+# coupled mode inside the band; --coupled changes it (a stiffer coupling, heavier parts).
+COUPLED = (0.05, 0.5, 1.3, 3.5, 0.7 * F_HI)
+
+
+def draw_effect(rng, kind, m, coupled=COUPLED):
     w0 = 2 * math.pi * m["f0_hz"]
     w_hi = 2 * math.pi * F_HI
     if kind == "none":
         return {}
     if kind == "coupled_inertia":
         at = "rotor" if rng.uniform() < 0.5 else "shaft"
-        mu = log_uniform(rng, 0.05, 0.5)
+        mu_lo, mu_hi, f2_lo, f2_hi, cap_hz = coupled
+        mu = log_uniform(rng, mu_lo, mu_hi)
         j2 = mu * m["J"]
-        # Uncoupled J2-on-k2 frequency 1.3-3.5 f0: the coupled mode rings inside the band.
-        f2 = min(rng.uniform(1.3, 3.5) * m["f0_hz"], 0.7 * F_HI)
+        # Uncoupled J2-on-k2 frequency (default 1.3-3.5 f0: the coupled mode rings in the band).
+        f2 = rng.uniform(f2_lo, f2_hi) * m["f0_hz"]
+        f2 = min(f2, cap_hz) if cap_hz > 0 else f2
         k2 = j2 * (2 * math.pi * f2) ** 2
         q2 = rng.uniform(15.0, 80.0)
         return {"at": at, "J2": j2, "k2": k2, "c2": math.sqrt(k2 * j2) / q2, "mass_ratio": mu,
@@ -214,7 +223,7 @@ def write_csv(path, f, z, sigma=None):
             out.write(row + "\n")
 
 
-def generate(out_dir, cases, seed, s_lo, s_hi, plan=None):
+def generate(out_dir, cases, seed, s_lo, s_hi, plan=None, coupled=COUPLED):
     os.makedirs(out_dir, exist_ok=True)
     rng = np.random.default_rng(seed)
     f = lines()
@@ -222,7 +231,7 @@ def generate(out_dir, cases, seed, s_lo, s_hi, plan=None):
     for c in range(cases):
         kind = (plan or PLAN)[c % len(plan or PLAN)]
         m = draw_motor(rng)
-        p = draw_effect(rng, kind, m)
+        p = draw_effect(rng, kind, m, coupled)
         z0 = impedance(m, f)
         z1 = impedance(m, f, kind, p)
         v_amp = 1.0
@@ -254,17 +263,28 @@ def generate(out_dir, cases, seed, s_lo, s_hi, plan=None):
 
 
 def truth_beats_fixture(base, t, eol, extra):
-    """chi2 of the best fixture spring minus chi2 of the true model (both sum 2 |r|^2)."""
+    """The best fixture spring's cost minus the true model's, both as `eol gap` scores a fit.
+
+    cost = sum rho(|r|^2), rho(u) = (nu + 2) ln(1 + 2 u / nu) (-2 ln L of the Student t for a
+    sigma^2 on nu degrees of freedom; 2 u, the chi2, when nu = 0), with r in the residual form
+    the report used: (Z_meas - Z) / sigma, or (1/Z_meas - 1/Z) |Z_meas|^2 / sigma when it
+    took the admittance form (the current channel's noise dominates)."""
     data = np.loadtxt(base + "-meas.csv", delimiter=",", skiprows=2)
     f, z, sigma = data[:, 0], data[:, 1] + 1j * data[:, 2], data[:, 3]
-    chi2_true = np.sum(2 * np.abs(z - impedance(t["motor"], f, t["effect"], t["params"])) ** 2 /
-                       sigma ** 2)
     cmd = [eol, "gap", "--sim", base + "-sim.csv", "--measured", base + "-meas.csv", "--json",
            "--effects", "fixture_compliance", "--no-pairs"] + extra
     p = subprocess.run(cmd, capture_output=True, text=True, check=True)
-    fits = [r for r in json.loads(p.stdout)["ranking"] if r["effect"] == "fixture_compliance"]
-    chi2_fixture = 2 * len(f) * fits[0]["gap_after"] ** 2
-    return chi2_fixture - chi2_true
+    report = json.loads(p.stdout)
+    z_true = impedance(t["motor"], f, t["effect"], t["params"])
+    if report["residual_form"] == "admittance":
+        r = (1.0 / z - 1.0 / z_true) * np.abs(z) ** 2 / sigma
+    else:
+        r = (z - z_true) / sigma
+    nu = float(report.get("sigma_dof") or 0.0)
+    u = np.abs(r) ** 2
+    cost_true = np.sum((nu + 2) * np.log1p(2 * u / nu)) if nu > 0 else np.sum(2 * u)
+    fits = [r for r in report["ranking"] if r["effect"] == "fixture_compliance"]
+    return fits[0]["cost"] - cost_true
 
 
 def score(out_dir, eol, extra):
@@ -283,15 +303,19 @@ def score(out_dir, eol, extra):
             answer = json.loads(p.stdout)["effect"]
         ok = answer in EXPECTED[t["effect"]]
         sub = t["effect"] + ("(" + t["params"]["at"] + ")" if "at" in t["params"] else "")
-        separable = t["separable"]
+        separable, margin = t["separable"], float("nan")
         if t["effect"] == "coupled_inertia" and separable:
-            separable = bool(truth_beats_fixture(base, t, eol, extra) >= 10.0)
-        rows.append((t["case"], sub, t["effect"], separable, t["strength"], answer, ok))
+            margin = truth_beats_fixture(base, t, eol, extra)
+            separable = bool(margin >= 10.0)
+        rows.append((t["case"], sub, t["effect"], separable, t["strength"], answer, ok, margin))
     elapsed = time.time() - t0
-    print("%-9s %-24s %5s %8s  %-40s %s" % ("case", "hidden", "sep", "S", "answer", "ok"))
+    # margin: for a coupled inertia, the best fixture spring's cost minus the truth's.
+    print("%-9s %-24s %5s %8s %7s  %-40s %s" % ("case", "hidden", "sep", "S", "margin", "answer",
+                                                "ok"))
     for r in rows:
-        print("%-9s %-24s %5s %8.1f  %-40s %s" % (r[0], r[1], r[3], r[4], r[5],
-                                                   "yes" if r[6] else "NO"))
+        margin = "" if math.isnan(r[7]) else "%.1f" % r[7]
+        print("%-9s %-24s %5s %8.1f %7s  %-40s %s" % (r[0], r[1], r[3], r[4], margin, r[5],
+                                                       "yes" if r[6] else "NO"))
     print("\nper hidden effect (separable cases named / separable; all cases named / all):")
     summary = {}
     for kind in sorted({r[2] for r in rows}):
@@ -306,7 +330,7 @@ def score(out_dir, eol, extra):
           (named, len(sep), 100.0 * named / max(1, len(sep)), elapsed))
     result = {"separable_named": named, "separable": len(sep), "per_effect": summary,
               "rows": [{"case": r[0], "hidden": r[1], "separable": r[3], "answer": r[5],
-                        "ok": r[6]} for r in rows]}
+                        "ok": r[6], "margin": None if math.isnan(r[7]) else r[7]} for r in rows]}
     with open(os.path.join(out_dir, "score.json"), "w") as out:
         json.dump(result, out, indent=1)
     return result
@@ -321,6 +345,9 @@ def main():
     ap.add_argument("--s-hi", type=float, default=150.0)
     ap.add_argument("--plan", default="",
                     help="comma-separated hidden effects, cycled over the cases (default: PLAN)")
+    ap.add_argument("--coupled", default=",".join("%g" % v for v in COUPLED),
+                    help="coupled inertia draw: mu_lo,mu_hi,f2_lo,f2_hi (times f0),cap_hz "
+                         "(0: none); default %(default)s")
     ap.add_argument("--score", action="store_true", help="run `eol gap` on the cases")
     ap.add_argument("--eol", default="build/eol")
     ap.add_argument("extra", nargs="*", help="extra `eol gap` arguments (after --)")
@@ -332,7 +359,15 @@ def main():
         for p in plan:
             if p not in EXPECTED:
                 ap.error("--plan: unknown effect '%s' (known: %s)" % (p, ", ".join(EXPECTED)))
-        t = generate(a.out, a.cases, a.seed, a.s_lo, a.s_hi, plan)
+        try:
+            coupled = tuple(float(v) for v in a.coupled.split(","))
+        except ValueError:
+            coupled = ()
+        if len(coupled) != 5 or not (0 < coupled[0] <= coupled[1] and
+                                     0 < coupled[2] <= coupled[3] and coupled[4] >= 0):
+            ap.error("--coupled: want mu_lo,mu_hi,f2_lo,f2_hi,cap_hz with 0 < lo <= hi and "
+                     "cap_hz >= 0, got '%s'" % a.coupled)
+        t = generate(a.out, a.cases, a.seed, a.s_lo, a.s_hi, plan, coupled)
         print("%d cases written to %s" % (len(t), a.out))
     return 0
 
