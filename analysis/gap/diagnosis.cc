@@ -428,7 +428,8 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
       continue;
     const EffectFit fit = fitter.FitKinds({kind}, {}, all, o.max_iterations);
     if (fit.effects.empty()) continue;
-    single_fit[kind] = fit.effects.front();
+    // Pairs start from the lowest-cost basin: the two effects together fit there.
+    single_fit[kind] = fit.lowest_cost.empty() ? fit.effects.front() : fit.lowest_cost.front();
     singles.push_back(Rank(fitter, fit));
   }
   std::sort(singles.begin(), singles.end(), BetterRank);

@@ -209,6 +209,9 @@ double PriorWidth(const Layout& layout, const std::vector<AppliedEffect>& at, st
   return (ps.hi - ps.lo) / ps.scale;
 }
 
+// A bounded parameter whose share of its range is within this of either end is at its bound.
+constexpr double kInteriorShare = 1e-3;
+
 // sum_i max(0, ln(lambda_i / 2 pi)) over the eigenvalues of W A W (effect_fit.h).
 double OccamPenalty(const Layout& layout, const std::vector<AppliedEffect>& at,
                     const Eigen::MatrixXd& information) {
@@ -685,6 +688,27 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
       if (!IsPlausible(Spec(e.kind), e, &why)) return false;
     return f.converged;
   };
+  // Off its bounds: every bounded parameter away from both ends of its range. At a bound the
+  // logistic map saturates, the information there is no curvature of the likelihood and the
+  // Laplace evidence's Occam penalty comes out near zero: such a corner may win on cost, not on
+  // an evidence it does not have.
+  auto interior = [&](const EffectFit& f) {
+    for (const AppliedEffect& e : f.effects) {
+      const EffectSpec spec = Spec(e.kind);
+      for (std::size_t p = 0; p < e.params.size() && p < spec.params.size(); ++p) {
+        if (!spec.params[p].bounded) continue;
+        const double u = BoundedShare(spec.params[p], e.params[p]);
+        if (!(u > kInteriorShare && u < 1.0 - kInteriorShare)) return false;
+      }
+    }
+    return true;
+  };
+  // Each start's optimum is one basin of the likelihood. The answer is the basin with the best
+  // evidence (cost + Occam), which is not always the lowest cost: a narrow basin whose mode
+  // fits a few noisy lines pays for pinning its parameters, a broad one that explains the same
+  // shift of the first mode with parameters the data leave open does not. The lowest-cost fit
+  // is the reference; an interior basin replaces it only with a better evidence.
+  std::vector<EffectFit> fits;
   EffectFit best;
   best.chi2 = best.cost = std::numeric_limits<double>::infinity();
   bool best_admissible = false;
@@ -693,10 +717,20 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
     if (!std::isfinite(f.cost)) continue;
     const bool ok = admissible(f);
     if ((ok && !best_admissible) || (ok == best_admissible && f.cost < best.cost)) {
-      best = std::move(f);
+      best = f;
       best_admissible = ok;
     }
+    if (ok && interior(f)) fits.push_back(std::move(f));
   }
+  if (!best_admissible) return best;
+  std::vector<AppliedEffect> lowest_cost = best.effects;
+  bool replaced = false;
+  for (EffectFit& f : fits)
+    if (f.cost + f.occam < best.cost + best.occam) {
+      best = std::move(f);
+      replaced = true;
+    }
+  if (replaced) best.lowest_cost = std::move(lowest_cost);
   return best;
 }
 

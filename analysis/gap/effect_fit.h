@@ -25,6 +25,9 @@
 // they leave as open as its prior pays nothing (where BIC charges every parameter ln(2K)):
 // an effect whose shape predicts a relation (a coupled inertia keeps the peak height while it
 // lowers f0 and raises Q) is not charged for parameters the data do not need.
+// Of the local optima the starts reach, an effect is scored in the one of best evidence (a
+// narrow basin that fits a few noisy lines pays for pinning its parameters); only optima off
+// every bound compete on it, as Laplace sees no curvature where the logistic map saturates.
 // Parameters are fitted as ln(value) (positive, wide-ranging ones) or value / scale, with
 // analysis::MinimizeLeastSquares (fit/least_squares.h: MINPACK Levenberg-Marquardt) on
 // forward-difference Jacobians; the covariance (Jr^T Jr)^-1 at the optimum, from a central-
@@ -86,6 +89,9 @@ struct EffectFit {
   int n_params = 0;
   bool converged = false;
   int iterations = 0;
+  // FitKinds: the lowest-cost optimum's effects, kept when the answer is another basin with a
+  // better evidence (empty otherwise); pairs start from it, where the fit of both is.
+  std::vector<AppliedEffect> lowest_cost;
 };
 
 class EffectFitter {
@@ -127,7 +133,9 @@ class EffectFitter {
   // The best of the fits started from Starts(kind) for each kind in `kinds`, the kinds
   // fitted jointly; for a pair the second kind's starts are taken on top of `seeds` (the
   // kinds' single fits, same order as kinds) and vice versa. Best: the lowest cost among the
-  // plausible (IsPlausible) converged fits; the lowest cost of all only when none is.
+  // plausible (IsPlausible) converged fits; the lowest cost of all only when none is. An
+  // interior optimum (no bounded parameter at a bound) with a better evidence (cost + occam)
+  // replaces the lowest-cost one, which is then kept in lowest_cost.
   EffectFit FitKinds(const std::vector<EffectKind>& kinds, const std::vector<AppliedEffect>& seeds,
                      const LineMask& mask, int max_iterations) const;
 
