@@ -75,6 +75,8 @@ json GapReportJson(const GapReport& r) {
   json names = json::array();
   for (const auto& e : g.winner) names.push_back(analysis::ToString(e.kind));
   j["effects"] = names;
+  j["rival"] = g.rival;
+  j["rival_score_gap"] = g.rival.empty() ? json(nullptr) : Num(g.rival_score_gap);
   const analysis::RankedEffect* w = Winner(g);
   j["params"] = w ? ParamsValue(w->params) : json::object();
   j["gap_before"] = Num(g.gap_before);
@@ -254,6 +256,9 @@ std::string GapReportText(const GapReport& r) {
          << Fmt("%.3f", f.gap_after_refit) << " (calibration, not an unmodelled effect)\n";
   }
   os << "WHICH        " << g.effect << "\n";
+  if (!g.rival.empty())
+    os << "  rival      " << g.rival << ", evidence within " << Fmt("%.1f", g.rival_score_gap)
+       << " of the winner's: the data hardly tell the two apart\n";
   if (const analysis::RankedEffect* w = Winner(g)) {
     for (const auto& p : w->params) os << "               " << ParamText(p) << "\n";
   }

@@ -5,6 +5,9 @@
 //   effect              the winner: an effect name, "a+b" for a pair, "none" (consistent with
 //                       the noise) or "unexplained" (not noise, but no candidate explains it)
 //   effects             the winner's effect names (empty for none / unexplained)
+//   rival, rival_score_gap  another effect (as many members) whose evidence is within 4.6 of
+//                       the winner's (score minus the winner's): the data hardly tell them
+//                       apart; "" and null when there is none
 //   params              the winner's parameters {name: value} (fitted, then derived)
 //   gap_before, gap_after        g = sqrt(mean |H_meas - H_model|^2 / sigma^2) over all lines
 //   chi2_before, chi2_after, residuals (2K), noise_z_before, noise_z_after (noise test z,

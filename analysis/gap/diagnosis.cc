@@ -362,6 +362,8 @@ bool GapOptions::IsValid(std::string* why) const {
   if (!(min_score_gain >= 0.0)) return fail("min_score_gain must not be negative");
   if (!(noise_z_max > 0.0)) return fail("noise_z_max must be positive");
   if (!(max_sigma_scale >= 1.0)) return fail("max_sigma_scale must be at least 1");
+  if (!(rival_margin >= 0.0 && std::isfinite(rival_margin)))
+    return fail("rival_margin must be finite and not negative");
   if (pair_candidates < 2) return fail("pair_candidates must be at least 2");
   if (max_iterations < 1) return fail("max_iterations must be at least 1");
   return true;
@@ -504,6 +506,18 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
   } else {
     s.effect = winner.effect;
     s.winner = winner.effects;
+    // The rival: the best other plausible candidate of the winner's size that is an effect too
+    // (its BIC passes), within rival_margin of the winner's evidence.
+    for (const RankedEffect& r : s.ranking) {
+      if (!r.plausible || r.effect == winner.effect || r.effects.size() != winner.effects.size() ||
+          r.bic > none.bic - o.min_score_gain)
+        continue;
+      if (r.score - winner.score < o.rival_margin) {
+        s.rival = r.effect;
+        s.rival_score_gap = std::max(0.0, r.score - winner.score);
+      }
+      break;
+    }
   }
   s.chi2_after = winner.effect == "none" ? s.chi2_before : winner.chi2;
   s.gap_after = std::sqrt(s.chi2_after / s.residuals);
@@ -544,6 +558,9 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
        << s.heldout.gap_after << ")";
     if (s.noise_z_after > o.noise_z_max || !s.where_after.empty())
       os << "; a significant residual remains";
+    if (!s.rival.empty())
+      os << "; the data hardly tell it from " << s.rival << " (evidence within "
+         << s.rival_score_gap << ")";
   }
   s.message = os.str();
   s.usable = true;

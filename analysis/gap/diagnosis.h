@@ -63,6 +63,11 @@ struct GapOptions {
   // "none" (the sigma scale is reported) even when the noise test rejects: a sigma mis-scaled
   // by a few percent (a calibration, a dof not given) is not a model gap.
   double max_sigma_scale = 1.1;
+  // A rival: another effect (as many members as the winner) that also passes the BIC test and
+  // whose evidence (score) is within this of the winner's: -2 ln of an evidence ratio of 10.
+  // The report names it: the data hardly tell the two apart (a fixture spring and a weak second
+  // inertia both lower the first mode; a miss of the one for the other is the information's).
+  double rival_margin = 4.6;
   bool try_pairs = true;
   int pair_candidates = 6;
   int max_iterations = 200;
@@ -139,6 +144,8 @@ struct GapSummary {
   std::string message;
   std::string effect = "none";        // winner, "none" or "unexplained"
   std::vector<AppliedEffect> winner;  // empty for none / unexplained
+  std::string rival;                  // GapOptions::rival_margin; "" when none
+  double rival_score_gap = 0.0;       // its score minus the winner's (>= 0)
   double gap_before = 0.0, gap_after = 0.0;
   double chi2_before = 0.0, chi2_after = 0.0;
   int residuals = 0;                                 // 2K

@@ -25,14 +25,14 @@ struct BlindCase {
   analysis::GapUnit unit;
 };
 
-BlindCase Load() {
+BlindCase Load(const std::string& name) {
   BlindCase c;
-  const analysis::Frf sim = io::ReadFrfCsv(kDir + "case-050-sim.csv.gz");
+  const analysis::Frf sim = io::ReadFrfCsv(kDir + name + "-sim.csv.gz");
   const analysis::CalibrationSummary cal = analysis::CalibrateNominal(sim, {});
   EXPECT_TRUE(cal.usable) << cal.message;
   c.nominal = cal.nominal;
-  const analysis::Frf meas = io::ReadFrfCsv(kDir + "case-050-meas.csv.gz");
-  c.unit.name = "case-050";
+  const analysis::Frf meas = io::ReadFrfCsv(kDir + name + "-meas.csv.gz");
+  c.unit.name = name;
   c.unit.freq_hz = meas.freq_hz;
   c.unit.value = meas.value;
   c.unit.sigma = meas.sigma;
@@ -47,7 +47,7 @@ double Share(const analysis::EffectParamSpec& p, double v) {
 }
 
 TEST(GapBasin, CoupledInertiaIsScoredInItsBasinOfBestEvidence) {
-  const BlindCase c = Load();
+  const BlindCase c = Load("case-050");
   ASSERT_EQ(c.unit.size(), 781u);
   EXPECT_TRUE(c.unit.admittance);  // the current's noise dominates in this case
   const analysis::EffectFitter fitter(c.nominal, {c.unit});
@@ -82,6 +82,32 @@ TEST(GapBasin, CoupledInertiaIsScoredInItsBasinOfBestEvidence) {
     if (r.effect == "fixture_compliance") fixture = r.score;
   }
   EXPECT_LT(coupled, fixture);
+  // 10 apart in evidence: no rival named.
+  EXPECT_EQ(s.rival, "") << s.message;
+}
+
+// When two effects explain the data about equally (case-056: the spring fits 0.3 worse than
+// the truth), the report says so: the winner, and the rival within 4.6 in evidence.
+TEST(GapBasin, AnEqualRivalIsNamed) {
+  const BlindCase c = Load("case-056");
+  analysis::GapOptions o;
+  o.heldout = false;
+  const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
+  ASSERT_TRUE(s.usable) << s.message;
+  ASSERT_TRUE(s.effect == "coupled_inertia" || s.effect == "fixture_compliance") << s.message;
+  const std::string other =
+      s.effect == "coupled_inertia" ? "fixture_compliance" : "coupled_inertia";
+  EXPECT_EQ(s.rival, other) << s.message;
+  EXPECT_GE(s.rival_score_gap, 0.0);
+  EXPECT_LT(s.rival_score_gap, o.rival_margin);
+  EXPECT_NE(s.message.find("hardly tell it from " + other), std::string::npos) << s.message;
+  // A margin of 0 names no rival; a negative one is refused.
+  o.rival_margin = 0.0;
+  EXPECT_EQ(analysis::DiagnoseGap(c.nominal, {c.unit}, o).rival, "");
+  o.rival_margin = -1.0;
+  const analysis::GapSummary bad = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
+  EXPECT_FALSE(bad.usable);
+  EXPECT_NE(bad.message.find("rival_margin"), std::string::npos) << bad.message;
 }
 
 }  // namespace
