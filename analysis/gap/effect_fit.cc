@@ -709,28 +709,30 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
   // shift of the first mode with parameters the data leave open does not. The lowest-cost fit
   // is the reference; an interior basin replaces it only with a better evidence.
   std::vector<EffectFit> fits;
-  EffectFit best;
-  best.chi2 = best.cost = std::numeric_limits<double>::infinity();
-  bool best_admissible = false;
+  std::vector<char> ok;
   for (const auto& s : starts) {
     EffectFit f = Fit(s, mask, max_iterations);
     if (!std::isfinite(f.cost)) continue;
-    const bool ok = admissible(f);
-    if ((ok && !best_admissible) || (ok == best_admissible && f.cost < best.cost)) {
-      best = f;
-      best_admissible = ok;
-    }
-    if (ok && interior(f)) fits.push_back(std::move(f));
+    ok.push_back(admissible(f));
+    fits.push_back(std::move(f));
   }
-  if (!best_admissible) return best;
-  std::vector<AppliedEffect> lowest_cost = best.effects;
-  bool replaced = false;
-  for (EffectFit& f : fits)
-    if (f.cost + f.occam < best.cost + best.occam) {
-      best = std::move(f);
-      replaced = true;
-    }
-  if (replaced) best.lowest_cost = std::move(lowest_cost);
+  if (fits.empty()) {
+    EffectFit none;
+    none.chi2 = none.cost = std::numeric_limits<double>::infinity();
+    return none;
+  }
+  std::size_t lowest = 0;
+  for (std::size_t i = 1; i < fits.size(); ++i)
+    if ((ok[i] && !ok[lowest]) || (ok[i] == ok[lowest] && fits[i].cost < fits[lowest].cost))
+      lowest = i;
+  if (!ok[lowest]) return std::move(fits[lowest]);
+  std::size_t chosen = lowest;
+  for (std::size_t i = 0; i < fits.size(); ++i)
+    if (ok[i] && interior(fits[i]) &&
+        fits[i].cost + fits[i].occam < fits[chosen].cost + fits[chosen].occam)
+      chosen = i;
+  EffectFit best = std::move(fits[chosen]);
+  if (chosen != lowest) best.lowest_cost = fits[lowest].effects;
   return best;
 }
 
