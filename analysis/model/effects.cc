@@ -182,7 +182,7 @@ EffectSpec DescribeEffect(EffectKind kind, const NominalNetwork& n, double f_lo,
     case EffectKind::kFractionalInductance:
       s.equation =
           "Z = Z0 + inductance_share L (w_m^(1 - order) (j w)^order - s), w_m = 2 pi match_hz";
-      s.params = {{"inductance_share", "1", 0.0, 0.95, true, 0.1},
+      s.params = {{"inductance_share", "1", 0.0, 1.0, false, 0.1, true},
                   {"order", "1", 0.3, 0.98, false, 0.1},
                   {"match_hz", "Hz", 0.1 * f_lo, 10.0 * f_hi, true, std::sqrt(f_lo * f_hi), true}};
       break;

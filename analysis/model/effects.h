@@ -41,8 +41,10 @@
 //                       the L2-R2 branch has one corner. L (1 - b), K and n are three free
 //                       numbers (a measured curve fixes all three over a wide band); f_m only
 //                       names K in a unit that reads as a share. The selection between them is by
-//                       evidence (both have two parameters). 0 <= b <= 0.95, 0.3 <= n <= 0.98, f_m
-//                       in [0.1 f_lo, 10 f_hi].
+//                       evidence (both have two parameters). 0 <= b <= 1 (b = 1: the whole
+//                       inductance is the semi-inductance, Z_L = K (j w)^n, as in a voice coil;
+//                       b is fitted on a logistic map so it may sit at 1), 0.3 <= n <= 0.98,
+//                       f_m in [0.1 f_lo, 10 f_hi].
 //   skin_effect         skin_r_rise_at_1khz a: skin/proximity effect below the skin-depth
 //                       transition, R(f) = R (1 + a (f / 1 kHz)^2). 0 <= a <= 3.
 //   fixture_compliance  k_fixture_ratio kappa = k_fixture / k_nominal, fixture_loss_factor eta:

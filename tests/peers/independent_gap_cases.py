@@ -20,7 +20,8 @@ Hidden effects (the measured unit has them, the simulation does not):
       Zm += 1 / (1 / (k2/s + c2) + 1 / (s J2))
   coupled_inertia (shaft): the same branch at the shaft-end node (added to k_f/s + c_f)
   fractional_inductance: part of L is a lossy (semi-)inductance,
-      s L -> s L (1 - a) + a L w_ref^(1-n) (j w)^n, 0.5 < n < 0.8 (same |Z_L| at w_ref)
+      s L -> s L (1 - a) + a L w_ref^(1-n) (j w)^n, 0.5 < n < 0.8 (same |Z_L| at w_ref),
+      a in 0.05-0.3 (--fractional a_lo,a_hi; 1,1: the whole winding is K (j w)^n)
   eddy_branch: s L -> s (L - L2) + s L2 R2 / (s L2 + R2)   (L at low frequency)
   channel_delay: Z -> Z exp(-s tau)
   stray_capacitance: Z -> Z / (1 + s C Z)
@@ -42,7 +43,8 @@ at least 10 (the diagnosis' min_score_gain) below that fit's. A coupled mode at 
 the fixture spring fits as well as the truth: no rule can name it then.
 
 Usage:
-  independent_gap_cases.py --out DIR [--cases 70] [--seed 1]
+  independent_gap_cases.py --out DIR [--cases 70] [--seed 1] [--plan E1,E2,...]
+                           [--coupled mu_lo,mu_hi,f2_lo,f2_hi,cap_hz] [--fractional a_lo,a_hi]
   independent_gap_cases.py --out DIR --score --eol build/eol [-- extra eol gap arguments]
 """
 import argparse
@@ -151,9 +153,12 @@ def impedance(m, f, effect=None, p=None):
 # uniform in [f2_lo, f2_hi] times f0 and at most cap_hz (0: no cap). The default keeps the
 # coupled mode inside the band; --coupled changes it (a stiffer coupling, heavier parts).
 COUPLED = (0.05, 0.5, 1.3, 3.5, 0.7 * F_HI)
+# The fractional inductance's share a of L, uniform in [a_lo, a_hi]; a = 1 is a winding whose
+# whole inductance is the semi-inductance K (j w)^n (--fractional 1,1).
+FRACTIONAL = (0.05, 0.3)
 
 
-def draw_effect(rng, kind, m, coupled=COUPLED):
+def draw_effect(rng, kind, m, coupled=COUPLED, fractional=FRACTIONAL):
     w0 = 2 * math.pi * m["f0_hz"]
     w_hi = 2 * math.pi * F_HI
     if kind == "none":
@@ -171,7 +176,7 @@ def draw_effect(rng, kind, m, coupled=COUPLED):
         return {"at": at, "J2": j2, "k2": k2, "c2": math.sqrt(k2 * j2) / q2, "mass_ratio": mu,
                 "f2_hz": f2, "q2": q2}
     if kind == "fractional_inductance":
-        return {"a": rng.uniform(0.05, 0.3), "n": rng.uniform(0.5, 0.8),
+        return {"a": rng.uniform(fractional[0], fractional[1]), "n": rng.uniform(0.5, 0.8),
                 "w_ref": 2 * math.pi * math.sqrt(F_LO * F_HI)}
     if kind == "eddy_branch":
         l2 = rng.uniform(0.05, 0.4) * m["L"]
@@ -223,7 +228,8 @@ def write_csv(path, f, z, sigma=None):
             out.write(row + "\n")
 
 
-def generate(out_dir, cases, seed, s_lo, s_hi, plan=None, coupled=COUPLED):
+def generate(out_dir, cases, seed, s_lo, s_hi, plan=None, coupled=COUPLED,
+             fractional=FRACTIONAL):
     os.makedirs(out_dir, exist_ok=True)
     rng = np.random.default_rng(seed)
     f = lines()
@@ -231,7 +237,7 @@ def generate(out_dir, cases, seed, s_lo, s_hi, plan=None, coupled=COUPLED):
     for c in range(cases):
         kind = (plan or PLAN)[c % len(plan or PLAN)]
         m = draw_motor(rng)
-        p = draw_effect(rng, kind, m, coupled)
+        p = draw_effect(rng, kind, m, coupled, fractional)
         z0 = impedance(m, f)
         z1 = impedance(m, f, kind, p)
         v_amp = 1.0
@@ -348,6 +354,9 @@ def main():
     ap.add_argument("--coupled", default=",".join("%g" % v for v in COUPLED),
                     help="coupled inertia draw: mu_lo,mu_hi,f2_lo,f2_hi (times f0),cap_hz "
                          "(0: none); default %(default)s")
+    ap.add_argument("--fractional", default=",".join("%g" % v for v in FRACTIONAL),
+                    help="fractional inductance's share of L: a_lo,a_hi in (0, 1]; "
+                         "default %(default)s")
     ap.add_argument("--score", action="store_true", help="run `eol gap` on the cases")
     ap.add_argument("--eol", default="build/eol")
     ap.add_argument("extra", nargs="*", help="extra `eol gap` arguments (after --)")
@@ -367,7 +376,14 @@ def main():
                                      0 < coupled[2] <= coupled[3] and coupled[4] >= 0):
             ap.error("--coupled: want mu_lo,mu_hi,f2_lo,f2_hi,cap_hz with 0 < lo <= hi and "
                      "cap_hz >= 0, got '%s'" % a.coupled)
-        t = generate(a.out, a.cases, a.seed, a.s_lo, a.s_hi, plan, coupled)
+        try:
+            fractional = tuple(float(v) for v in a.fractional.split(","))
+        except ValueError:
+            fractional = ()
+        if len(fractional) != 2 or not 0 < fractional[0] <= fractional[1] <= 1:
+            ap.error("--fractional: want a_lo,a_hi with 0 < a_lo <= a_hi <= 1, got '%s'"
+                     % a.fractional)
+        t = generate(a.out, a.cases, a.seed, a.s_lo, a.s_hi, plan, coupled, fractional)
         print("%d cases written to %s" % (len(t), a.out))
     return 0
 

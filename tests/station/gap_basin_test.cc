@@ -5,9 +5,12 @@
 // evidence; the fit answers the interior basin with the better evidence, keeps the lowest-cost
 // one for the pairs, and the diagnosis then names the coupled inertia (with the lowest-cost
 // basin it named the fixture spring).
+// And a winding whose whole inductance is a semi-inductance (tests/data/gap-independent-semi-
+// inductance): the fractional inductance's share sits at its bound of 1, a plausible answer.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "analysis/gap/calibration.h"
@@ -18,20 +21,21 @@
 namespace eol {
 namespace {
 
-const std::string kDir = std::string(EOL_TEST_DATA_DIR) + "/gap-independent-coupled/";
+const std::string kCoupled = std::string(EOL_TEST_DATA_DIR) + "/gap-independent-coupled/";
+const std::string kSemi = std::string(EOL_TEST_DATA_DIR) + "/gap-independent-semi-inductance/";
 
 struct BlindCase {
   analysis::NominalNetwork nominal;
   analysis::GapUnit unit;
 };
 
-BlindCase Load(const std::string& name) {
+BlindCase Load(const std::string& name, const std::string& dir = kCoupled) {
   BlindCase c;
-  const analysis::Frf sim = io::ReadFrfCsv(kDir + name + "-sim.csv.gz");
+  const analysis::Frf sim = io::ReadFrfCsv(dir + name + "-sim.csv.gz");
   const analysis::CalibrationSummary cal = analysis::CalibrateNominal(sim, {});
   EXPECT_TRUE(cal.usable) << cal.message;
   c.nominal = cal.nominal;
-  const analysis::Frf meas = io::ReadFrfCsv(kDir + name + "-meas.csv.gz");
+  const analysis::Frf meas = io::ReadFrfCsv(dir + name + "-meas.csv.gz");
   c.unit.name = name;
   c.unit.freq_hz = meas.freq_hz;
   c.unit.value = meas.value;
@@ -108,6 +112,35 @@ TEST(GapBasin, AnEqualRivalIsNamed) {
   const analysis::GapSummary bad = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
   EXPECT_FALSE(bad.usable);
   EXPECT_NE(bad.message.find("rival_margin"), std::string::npos) << bad.message;
+}
+
+// The truth: Z_L = L w_ref^(1 - n) (j w)^n, n = 0.5146, w_ref = 2 pi 316.2 Hz, no pure L left.
+TEST(GapBasin, AWholeSemiInductanceSitsAtTheShareBoundOfOne) {
+  const BlindCase c = Load("case-000", kSemi);
+  ASSERT_EQ(c.unit.size(), 781u);
+  const analysis::EffectFitter fitter(c.nominal, {c.unit});
+  const analysis::EffectFit fit =
+      fitter.FitKinds({analysis::EffectKind::kFractionalInductance}, {}, {}, 200);
+  ASSERT_EQ(fit.effects.size(), 1u);
+  const analysis::EffectSpec spec = fitter.Spec(analysis::EffectKind::kFractionalInductance);
+  std::string why;
+  EXPECT_TRUE(analysis::IsPlausible(spec, fit.effects[0], &why)) << why;
+  const double share = fit.effects[0].params[0], order = fit.effects[0].params[1];
+  const double match_hz = fit.effects[0].params[2];
+  EXPECT_GT(share, 0.97);
+  EXPECT_LE(share, 1.0);
+  EXPECT_NEAR(order, 0.5146, 0.06);
+  // |Z_L| of the fitted semi-inductance at the truth's reference: L w_ref (the truth's).
+  const double l = c.nominal.motional.l_h, w_ref = 2.0 * std::numbers::pi * 316.23;
+  const double w_m = 2.0 * std::numbers::pi * match_hz;
+  const double fitted = share * l * std::pow(w_m, 1.0 - order) * std::pow(w_ref, order);
+  EXPECT_NEAR(fitted / (l * w_ref), 1.0, 0.1);
+
+  analysis::GapOptions o;
+  o.heldout = false;
+  const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
+  ASSERT_TRUE(s.usable) << s.message;
+  EXPECT_EQ(s.effect, "fractional_inductance") << s.message;
 }
 
 }  // namespace
