@@ -91,6 +91,16 @@ analysis::CalibrationSummary CalibrateToSimulation(const io::GapInput& sim, doub
   return analysis::CalibrateNominal(sim.frf, o);
 }
 
+namespace {
+
+// Degrees of freedom of a measured unit's sigma^2 (GapRunOptions::sigma_dof).
+double UnitSigmaDof(const io::GapInput& m, const GapRunOptions& o) {
+  if (m.sigma_estimated) return 0.0;
+  return o.sigma_dof > 0.0 ? o.sigma_dof : m.sigma_dof * (2 * o.sigma_pool + 1);
+}
+
+}  // namespace
+
 void ReadGapInputs(const std::string& simulation, const std::vector<std::string>& measured,
                    const GapRunOptions& o, GapReport* r) {
   r->quantity = o.io.quantity;
@@ -101,6 +111,9 @@ void ReadGapInputs(const std::string& simulation, const std::vector<std::string>
     io::GapInput m = io::ReadGapMeasurement(path, o.io);
     KeepBand(&m.frf, o.f_lo_hz, o.f_hi_hz);
     if (m.frf.size() < 10) throw io::FileError(path, 0, 0, "fewer than 10 lines in the band");
+    // The report's: the option's, else the smallest of the files' (each unit's is in its note).
+    const double dof = UnitSigmaDof(m, o);
+    if (dof > 0.0 && (r->sigma_dof == 0.0 || dof < r->sigma_dof)) r->sigma_dof = dof;
     r->measured.push_back(std::move(m));
   }
   if (r->measured.empty()) throw std::invalid_argument("gap: no measured unit");
@@ -133,7 +146,7 @@ void DiagnoseGapReport(const GapRunOptions& o, GapReport* r) {
     u.freq_hz = m.frf.freq_hz;
     u.value = m.frf.value;
     u.sigma = m.sigma_estimated ? m.frf.sigma : analysis::PoolLineSigma(m.frf, o.sigma_pool);
-    u.sigma_dof = m.sigma_estimated ? 0.0 : o.sigma_dof;
+    u.sigma_dof = UnitSigmaDof(m, o);
     units.push_back(std::move(u));
   }
   analysis::GapOptions go;

@@ -32,7 +32,9 @@ struct GapRunOptions {
   // Pools each line's relative variance over +-N lines (files whose sigma rests on few periods).
   int sigma_pool = 0;
   // Degrees of freedom of each measured line's sigma^2 (2 (P - 1) from P periods, times the
-  // lines pooled); 0: sigma exact. A unit whose sigma was estimated by the reader takes 0.
+  // lines pooled); 0: the measured file's own (its sigma_dof column, or the periodic
+  // estimator's for a raw recording, times 2 sigma_pool + 1), else sigma exact. A unit whose
+  // sigma was estimated by the reader takes 0.
   double sigma_dof = 0.0;
   double inertia_kg_m2 = 0.0;                 // J_r given; 0: the simulation's, else the fallback
   double fallback_inertia_kg_m2 = 0.0;        // impedance only: the recipe's rotor inertia

@@ -2,8 +2,8 @@
 
 #include <cmath>
 #include <fstream>
-#include <locale>
 #include <numbers>
+#include <sstream>
 
 #include "drivers/io/text_table.h"
 
@@ -39,7 +39,7 @@ std::vector<std::pair<std::string_view, std::size_t>> SplitWords(std::string_vie
 
 }  // namespace
 
-analysis::Frf ReadFrfCsv(const std::string& path) {
+analysis::Frf ReadFrfCsv(const std::string& path, double* sigma_dof) {
   const CsvTable t = ReadCsvTable(path);
   analysis::Frf frf;
   frf.method = "file";
@@ -58,7 +58,10 @@ analysis::Frf ReadFrfCsv(const std::string& path) {
                     "f_hz,re,im[,sigma] (header: " +
                         have + ")");
   }
-  const std::size_t cf = t.Find("f_hz"), cs = t.Find(sigma_name);
+  const std::size_t cf = t.Find("f_hz"), cs = t.Find(sigma_name), cd = t.Find("sigma_dof");
+  if (cd != std::string::npos && cs == std::string::npos)
+    throw FileError(path, 1, 0,
+                    std::string("a sigma_dof column needs the ") + sigma_name + " column");
   const auto& f = t.columns[cf];
   const auto& re = t.Column(re_name);
   const auto& im = t.Column(im_name);
@@ -75,21 +78,39 @@ analysis::Frf ReadFrfCsv(const std::string& path) {
       if (!(s > 0.0)) throw t.ErrorAt(r, cs, "sigma must be positive");
       frf.sigma.push_back(s);
     }
+    if (cd != std::string::npos) {
+      const double d = t.columns[cd][r];
+      if (d != 0.0 && !(d > 4.0)) throw t.ErrorAt(r, cd, "must be above 4 (or 0: sigma exact)");
+      if (r > 0 && d != t.columns[cd][0]) {
+        std::ostringstream first;
+        first << t.columns[cd][0];
+        throw t.ErrorAt(r, cd,
+                        "must be the same on every line (the first line has " + first.str() + ")");
+      }
+    }
   }
+  if (sigma_dof) *sigma_dof = cd != std::string::npos && t.rows() > 0 ? t.columns[cd][0] : 0.0;
   return frf;
 }
 
-void WriteFrfCsv(const std::string& path, const analysis::Frf& frf) {
+void WriteFrfCsv(const std::string& path, const analysis::Frf& frf, double sigma_dof) {
   std::string why;
   if (!frf.Validate(&why)) throw FileError(path, 0, 0, "refusing to write an invalid FRF: " + why);
+  if (!(sigma_dof == 0.0 || sigma_dof > 4.0))
+    throw FileError(path, 0, 0,
+                    "refusing to write a sigma_dof of " + std::to_string(sigma_dof) +
+                        ": it must be above 4 (or 0: sigma exact)");
+  const bool dof = frf.has_sigma() && sigma_dof > 0.0;
   std::ofstream out = OpenForWriting(path);
   const bool z = frf.quantity == analysis::Quantity::kImpedanceOhm;
   out << (z ? "f_hz,re_ohm,im_ohm" : "f_hz,re,im");
   if (frf.has_sigma()) out << (z ? ",sigma_ohm" : ",sigma");
+  if (dof) out << ",sigma_dof";
   out << '\n';
   for (std::size_t k = 0; k < frf.size(); ++k) {
     out << frf.freq_hz[k] << ',' << frf.value[k].real() << ',' << frf.value[k].imag();
     if (frf.has_sigma()) out << ',' << frf.sigma[k];
+    if (dof) out << ',' << sigma_dof;
     out << '\n';
   }
   Finish(out, path);

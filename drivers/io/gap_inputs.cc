@@ -68,10 +68,15 @@ GapInput ReadFrfFile(const std::string& path, Quantity quantity) {
     in.frf = ReadZma(path);
   } else {
     in.kind = "frf-csv";
-    in.frf = ReadFrfCsv(path);
+    in.frf = ReadFrfCsv(path, &in.sigma_dof);
   }
   CheckQuantity(in.frf, quantity, path);
   in.note = in.kind + ", " + Describe(in.frf);
+  if (in.sigma_dof > 0.0) {
+    std::ostringstream os;
+    os << "; sigma^2 on " << in.sigma_dof << " degrees of freedom (sigma_dof column)";
+    in.note += os.str();
+  }
   return in;
 }
 
@@ -179,6 +184,7 @@ GapInput ReadRecording(const std::string& path, const GapInputOptions& o) {
   in.source = path;
   in.kind = "recording";
   in.frf = est.frf;
+  in.sigma_dof = 2.0 * est.noise_dof;
   std::ostringstream os;
   os << "raw recording (" << in_name << " -> " << out_name << ", " << fs << " Hz, period " << period
      << " samples), " << lines_note << "; " << est.message;
@@ -268,6 +274,7 @@ GapInput ReadGapMeasurement(const std::string& path, const GapInputOptions& o) {
     if (in.frf.size() < 5) throw FileError(path, 0, 0, "too few lines to estimate the noise");
     in.frf.sigma = analysis::EstimateLineSigma(in.frf);
     in.sigma_estimated = true;
+    in.sigma_dof = 0.0;
     in.note +=
         "; no sigma in the file: noise estimated from the line-to-line scatter "
         "(second differences, running median over 51 lines)";

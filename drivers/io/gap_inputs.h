@@ -14,7 +14,8 @@
 //       M = g / (s + a). Unknown keys are errors (io::ConfigError naming the JSON path).
 // Measurement (ReadGapMeasurement), by content:
 //   - an FRF file as above; without sigma the noise is estimated from the line-to-line scatter
-//     (analysis/gap/noise.h) and the note says so;
+//     (analysis/gap/noise.h) and the note says so; a sigma_dof column (frf_files.h) gives the
+//     degrees of freedom of the file's sigma^2;
 //   - a raw periodic recording, CSV with a t_s column (plain or .gz; text_table.h rules): the
 //     input and output columns (defaults: impedance i_a -> u_v, Z = U / I; mobility
 //     iq_a -> theta_motor_rad, H = j w Theta / I) through the periodic errors-in-variables
@@ -23,7 +24,8 @@
 //     periods) over which the input repeats (relative difference of consecutive periods
 //     below 0.1 and within twice the best). Excited lines come from lines_file, else from
 //     "<stem>-excited-lines-hz.txt" beside the recording (stem: the name up to its first
-//     '.'), else are the bins whose input amplitude reaches 0.1 of the largest.
+//     '.'), else are the bins whose input amplitude reaches 0.1 of the largest. sigma^2 then
+//     has the estimator's 2 (P - 1) (2 h + 1) degrees of freedom (periodic_frf.h).
 // Every error is a FileError or io::ConfigError naming the file (and line, or JSON path).
 #pragma once
 
@@ -50,6 +52,9 @@ struct GapInput {
   std::string kind;    // "frf-csv", "zma", "recording", "motor-json", "rigid-shaft-json"
   std::string note;    // how it was read (for the report)
   bool sigma_estimated = false;
+  // Degrees of freedom of each line's sigma^2: the file's sigma_dof column or the periodic
+  // estimator's; 0 when sigma is exact, unknown, or estimated by the reader.
+  double sigma_dof = 0.0;
   // Simulations given as models: the exact nominal when the model is one (rigid shaft), and
   // the rotor inertia when the model knows it (0 otherwise).
   std::optional<analysis::NominalNetwork> model;

@@ -168,7 +168,8 @@ void AddGapCommand(CLI::App& app) {
   cmd->add_option("--sigma-periods", a->sigma_periods,
                   "The measured files' sigma comes from this many periods: each sigma^2 has "
                   "2 (P - 1) degrees of freedom and the residual is tested as F, not chi2 "
-                  "(default: sigma exact)")
+                  "(default: the file's sigma_dof column, a raw recording's periodic estimate, "
+                  "else sigma exact)")
       ->check(CLI::Range(4, 100000));
   cmd->add_option("--sigma-dof", a->sigma_dof,
                   "Degrees of freedom of each line's sigma^2 in the measured files (above 4; "

@@ -111,7 +111,7 @@ int RunSimulate(const SimulateArgs& a) {
         analysis::EstimatePeriodicFrf(rec, ex.lines, recipe.analysis.frf);
     if (!frf.usable)
       throw std::runtime_error("the simulated recording gives no FRF: " + frf.message);
-    io::WriteFrfCsv(a.out, frf.frf);
+    io::WriteFrfCsv(a.out, frf.frf, 2.0 * frf.noise_dof);  // sigma^2's degrees of freedom
     wrote = "FRF of " + std::to_string(frf.frf.size()) + " lines";
   }
   if (a.json) {

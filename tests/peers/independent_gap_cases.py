@@ -5,7 +5,7 @@ Each case is a random clamped motor (the paper's network, NOTES.md 1-2), one hid
 none, and a periodic multisine measurement with noise on both channels, written as
   case-NNN-sim.csv   the nominal's impedance, noise-free (f_hz,re_ohm,im_ohm)
   case-NNN-meas.csv  the measured impedance with sigma from the periods (f_hz,re_ohm,im_ohm,
-                     sigma_ohm)
+                     sigma_ohm,sigma_dof: sigma^2 on 2 (P - 1) = 14 degrees of freedom)
 plus truth.json (the effect, its parameters, the strength S, the sigma degrees of freedom).
 
 Physics (s = j w). Mechanical impedances are torque / angular velocity (N m s/rad):
@@ -220,11 +220,13 @@ def measure(rng, z_true, noise_u, noise_i, v_amp):
 def write_csv(path, f, z, sigma=None):
     with open(path, "w") as out:
         out.write("# written by tests/peers/independent_gap_cases.py\n")
-        out.write("f_hz,re_ohm,im_ohm" + (",sigma_ohm" if sigma is not None else "") + "\n")
+        # sigma_dof: each line's sigma^2 rests on 2 (P - 1) degrees of freedom.
+        out.write("f_hz,re_ohm,im_ohm" + (",sigma_ohm,sigma_dof" if sigma is not None else "") +
+                  "\n")
         for k in range(len(f)):
             row = "%.6f,%.12e,%.12e" % (f[k], z[k].real, z[k].imag)
             if sigma is not None:
-                row += ",%.6e" % sigma[k]
+                row += ",%.6e,%d" % (sigma[k], 2 * (PERIODS - 1))
             out.write(row + "\n")
 
 

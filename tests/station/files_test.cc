@@ -93,6 +93,40 @@ TEST(FrfCsvTest, GarbageNamesFileLineAndColumn) {
   EXPECT_CONTAINS(ErrorOf([&] { ReadFrfCsv(dir / "missing.csv"); }), "missing.csv: cannot open");
 }
 
+// sigma_dof: the degrees of freedom of an estimated sigma^2 travel with the file.
+TEST(FrfCsvTest, SigmaDofRoundTripsAndIsChecked) {
+  testing::TempDir dir;
+  const std::string p = dir / "z.csv";
+  WriteFrfCsv(p, SomeFrf(analysis::Quantity::kImpedanceOhm, true), 14.0);
+  double dof = -1.0;
+  EXPECT_EQ(ReadFrfCsv(p, &dof).sigma.size(), 5u);
+  EXPECT_EQ(dof, 14.0);
+  WriteFrfCsv(p, SomeFrf(analysis::Quantity::kImpedanceOhm, true));  // exact: no column
+  ReadFrfCsv(p, &dof);
+  EXPECT_EQ(dof, 0.0);
+  WriteFrfCsv(p, SomeFrf(analysis::Quantity::kImpedanceOhm, false), 14.0);  // no sigma: none
+  std::ifstream in(p);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "f_hz,re_ohm,im_ohm");
+  EXPECT_CONTAINS(
+      ErrorOf([&] { WriteFrfCsv(p, SomeFrf(analysis::Quantity::kImpedanceOhm, true), 3.0); }),
+      "a sigma_dof of 3.000000: it must be above 4");
+
+  Write(p, "f_hz,re_ohm,im_ohm,sigma_ohm,sigma_dof\n100,1,2,0.1,14\n101,1,2,0.1,22\n");
+  EXPECT_EQ(ErrorOf([&] { ReadFrfCsv(p); }),
+            p + ":3:13: sigma_dof: must be the same on every line (the first line has 14)");
+  Write(p, "f_hz,re_ohm,im_ohm,sigma_ohm,sigma_dof\n100,1,2,0.1,3\n");
+  EXPECT_EQ(ErrorOf([&] { ReadFrfCsv(p); }),
+            p + ":2:13: sigma_dof: must be above 4 (or 0: sigma exact)");
+  Write(p, "f_hz,re_ohm,im_ohm,sigma_dof\n100,1,2,14\n");
+  EXPECT_EQ(ErrorOf([&] { ReadFrfCsv(p); }),
+            p + ":1: a sigma_dof column needs the sigma_ohm column");
+  Write(p, "f_hz,re_ohm,im_ohm,sigma_ohm,sigma_dof\n100,1,2,0.1,0\n101,1,2,0.1,0\n");
+  ReadFrfCsv(p, &dof);
+  EXPECT_EQ(dof, 0.0);
+}
+
 TEST(FrfCsvTest, ReadsGzip) {
   testing::TempDir dir;
   const std::string p = dir / "z.csv.gz";

@@ -49,6 +49,36 @@ class GapCli : public ::testing::Test {
   TempDir dir_;
 };
 
+// The degrees of freedom of the file's sigma (its sigma_dof column) decide how the residual is
+// tested: a blind case of the independent generator with no effect and sigma from 8 periods
+// (tests/data/gap-independent-none) is `unexplained` when that sigma is taken as exact (g
+// 1.117, a wide band) and `none` with the column, as with --sigma-periods 8.
+TEST_F(GapCli, TheFilesSigmaDofColumnTestsTheResidualAsF) {
+  const std::string data = std::string(EOL_TEST_DATA_DIR) + "/gap-independent-none/";
+  const std::string sim = data + "case-058-sim.csv.gz", plain = data + "case-058-meas.csv.gz";
+  io::WriteFrfCsv(dir_ / "dof.csv", io::ReadFrfCsv(plain), 14.0);
+  const EolRun exact = Eol(
+      {"gap", "--sim", sim, "--measured", plain, "--json-out", dir_ / "exact.json", "--no-pairs"});
+  ASSERT_EQ(exact.code, 0) << exact.output;
+  EXPECT_EQ(ReadJson(dir_ / "exact.json")["effect"], "unexplained") << exact.output;
+  EXPECT_EQ(ReadJson(dir_ / "exact.json")["sigma_dof"], 0.0);
+
+  const EolRun column = Eol({"gap", "--sim", sim, "--measured", dir_ / "dof.csv", "--json-out",
+                             dir_ / "column.json", "--no-pairs"});
+  ASSERT_EQ(column.code, 0) << column.output;
+  const nlohmann::json j = ReadJson(dir_ / "column.json");
+  EXPECT_EQ(j["effect"], "none") << column.output;
+  EXPECT_EQ(j["sigma_dof"], 14.0);
+  EXPECT_NE(j["measurements"][0]["note"].get<std::string>().find("14 degrees of freedom"),
+            std::string::npos)
+      << j["measurements"][0]["note"];
+  // The option overrides the column: 4 periods (6 degrees of freedom) on it.
+  const EolRun option = Eol({"gap", "--sim", sim, "--measured", dir_ / "dof.csv", "--json-out",
+                             dir_ / "option.json", "--no-pairs", "--sigma-periods", "4"});
+  ASSERT_EQ(option.code, 0) << option.output;
+  EXPECT_EQ(ReadJson(dir_ / "option.json")["sigma_dof"], 6.0);
+}
+
 TEST_F(GapCli, JsonHasTheStableNames) {
   io::WriteFrfCsv(dir_ / "meas.csv",
                   GapMeasured({{analysis::EffectKind::kChannelDelay, {6e-6}}}, 3));
