@@ -2,6 +2,7 @@
 
 #include <stdlib.h>  // mkdtemp
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <complex>
@@ -154,6 +155,16 @@ void DiagnoseGapReport(const GapRunOptions& o, GapReport* r) {
   go.effects = o.effects;
   r->gap = analysis::DiagnoseGap(r->calibration.nominal, units, go);
   if (!r->gap.usable) throw GapNotUsable(r->gap.message);
+  // A residual a little above the files' sigma with nothing to explain it: the usual cause is
+  // a sigma estimated from few periods and taken as exact (8 periods: E|r|^2 = 14 / 12).
+  const bool exact_from_files = std::all_of(
+      r->measured.begin(), r->measured.end(),
+      [&](const io::GapInput& m) { return !m.sigma_estimated && UnitSigmaDof(m, o) == 0.0; });
+  if (r->gap.effect == "unexplained" && exact_from_files && r->gap.sigma_scale < 1.5)
+    r->gap.message +=
+        "; the measured files' sigma was taken as exact: if it was estimated from a few "
+        "periods, give its degrees of freedom (--sigma-periods P, --sigma-dof N or a "
+        "sigma_dof column)";
   analysis::CalibrationOptions co;
   r->features.clear();
   for (const analysis::GapUnit& u : units)

@@ -62,6 +62,8 @@ TEST_F(GapCli, TheFilesSigmaDofColumnTestsTheResidualAsF) {
   ASSERT_EQ(exact.code, 0) << exact.output;
   EXPECT_EQ(ReadJson(dir_ / "exact.json")["effect"], "unexplained") << exact.output;
   EXPECT_EQ(ReadJson(dir_ / "exact.json")["sigma_dof"], 0.0);
+  EXPECT_NE(exact.output.find("give its degrees of freedom (--sigma-periods P"), std::string::npos)
+      << exact.output;
 
   const EolRun column = Eol({"gap", "--sim", sim, "--measured", dir_ / "dof.csv", "--json-out",
                              dir_ / "column.json", "--no-pairs"});
