@@ -49,11 +49,21 @@ class QcApi : public ::testing::Test {
     http_->set_read_timeout(120, 0);
   }
 
-  // Runs a test of `serial` and waits for its verdict.
+  // Runs a test of `serial` and waits for its verdict. The previous test's record is stored
+  // before the station is idle again (it unclamps and publishes after), so a start may meet
+  // 409 busy for a moment: it is retried.
   std::string Test(const std::string& serial) {
-    const auto res = http_->Post("/api/tests", Bearer(kOperator),
-                                 nlohmann::json{{"serial", serial}}.dump(), "application/json");
-    if (!res || res->status != 202) return "not started";
+    auto start = [&] {
+      return http_->Post("/api/tests", Bearer(kOperator), nlohmann::json{{"serial", serial}}.dump(),
+                         "application/json");
+    };
+    httplib::Result res = start();
+    for (int i = 0; i < 200 && res && res->status == 409; ++i) {
+      std::this_thread::sleep_for(50ms);
+      res = start();
+    }
+    if (!res) return "not started: no answer";
+    if (res->status != 202) return "not started: " + std::to_string(res->status) + " " + res->body;
     for (int i = 0; i < 600; ++i) {
       const auto unit = http_->Get(("/api/units/" + serial).c_str());
       if (unit && unit->status == 200) {
