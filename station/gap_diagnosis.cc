@@ -96,7 +96,7 @@ namespace {
 
 // Degrees of freedom of a measured unit's sigma^2 (GapRunOptions::sigma_dof).
 double UnitSigmaDof(const io::GapInput& m, const GapRunOptions& o) {
-  if (m.sigma_estimated) return 0.0;
+  if (m.sigma_estimated || o.sigma_exact) return 0.0;
   return o.sigma_dof > 0.0 ? o.sigma_dof : m.sigma_dof * (2 * o.sigma_pool + 1);
 }
 
@@ -106,7 +106,7 @@ void ReadGapInputs(const std::string& simulation, const std::vector<std::string>
                    const GapRunOptions& o, GapReport* r) {
   r->quantity = o.io.quantity;
   r->sigma_pool = o.sigma_pool;
-  r->sigma_dof = o.sigma_dof;
+  r->sigma_dof = o.sigma_exact ? 0.0 : o.sigma_dof;
   r->measured.clear();
   for (const std::string& path : measured) {
     io::GapInput m = io::ReadGapMeasurement(path, o.io);
@@ -164,7 +164,7 @@ void DiagnoseGapReport(const GapRunOptions& o, GapReport* r) {
     r->gap.message +=
         "; the measured files' sigma was taken as exact: if it was estimated from a few "
         "periods, give its degrees of freedom (--sigma-periods P, --sigma-dof N or a "
-        "sigma_dof column)";
+        "sigma_dof column; a sigma with too little scatter to read them from reads as exact)";
   analysis::CalibrationOptions co;
   r->features.clear();
   for (const analysis::GapUnit& u : units)

@@ -32,11 +32,12 @@ struct GapRunOptions {
   // Pools each line's relative variance over +-N lines (files whose sigma rests on few periods).
   int sigma_pool = 0;
   // Degrees of freedom of each measured line's sigma^2 (2 (P - 1) from P periods, times the
-  // lines pooled); 0: the measured file's own (its sigma_dof column, or the periodic
-  // estimator's for a raw recording, times 2 sigma_pool + 1), else sigma exact. A unit whose
-  // sigma was estimated by the reader takes 0.
+  // lines pooled); 0: the measured file's own (its sigma_dof column, the periodic estimator's
+  // for a raw recording, else read from the scatter of sigma itself: io::GapInput::sigma_dof),
+  // times 2 sigma_pool + 1. A unit whose sigma was estimated by the reader takes 0.
   double sigma_dof = 0.0;
-  double inertia_kg_m2 = 0.0;                 // J_r given; 0: the simulation's, else the fallback
+  bool sigma_exact = false;    // the files' sigma is exact (a noise model's): 0 for every unit
+  double inertia_kg_m2 = 0.0;  // J_r given; 0: the simulation's, else the fallback
   double fallback_inertia_kg_m2 = 0.0;        // impedance only: the recipe's rotor inertia
   std::vector<analysis::EffectKind> effects;  // only these; empty: every effect
   bool try_pairs = true;

@@ -49,4 +49,45 @@ std::vector<double> PoolLineSigma(const Frf& h, int half_width) {
   return out;
 }
 
+double Trigamma(double x) {
+  // psi'(x) = psi'(x + 1) + 1 / x^2 up to x >= 10, then the asymptotic series.
+  double sum = 0.0;
+  while (x < 10.0) {
+    sum += 1.0 / (x * x);
+    x += 1.0;
+  }
+  const double r = 1.0 / x, r2 = r * r;
+  return sum + r + 0.5 * r2 +
+         r * r2 * (1.0 / 6.0 - r2 * (1.0 / 30.0 - r2 * (1.0 / 42.0 - r2 / 30.0)));
+}
+
+double EstimateSigmaDof(std::span<const double> sigma, double max_dof) {
+  const std::size_t n = sigma.size();
+  if (n < 20) return 0.0;
+  for (double s : sigma)
+    if (!(s > 0.0) || !std::isfinite(s)) return 0.0;
+  std::vector<double> d2;
+  d2.reserve(n - 2);
+  for (std::size_t k = 1; k + 1 < n; ++k)
+    d2.push_back(2.0 *
+                 (std::log(sigma[k - 1]) - 2.0 * std::log(sigma[k]) + std::log(sigma[k + 1])));
+  auto median = [](std::vector<double> v) {
+    const auto mid = v.begin() + static_cast<long>(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+  };
+  const double centre = median(d2);
+  for (double& d : d2) d = std::abs(d - centre);
+  const double spread = 1.4826 * median(d2);
+  const double trigamma = spread * spread / 6.0;
+  if (!(trigamma > Trigamma(0.5 * max_dof))) return 0.0;
+  // Trigamma falls monotonically: bisect nu on a log scale.
+  double lo = std::log(0.1), hi = std::log(max_dof);
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (Trigamma(0.5 * std::exp(mid)) > trigamma ? lo : hi) = mid;
+  }
+  return std::max(kMinEstimatedSigmaDof, std::exp(0.5 * (lo + hi)));
+}
+
 }  // namespace eol::analysis

@@ -14,8 +14,20 @@
 // normalised residual is heavy-tailed. The relative variance sigma_k^2 / |H_k|^2 is averaged
 // over 2 half_width + 1 lines and converted back, which multiplies the degrees of freedom by
 // the window while following |H| through a resonance.
+//
+// Degrees of freedom of a sigma that does not say (a file with sigma but no sigma_dof column):
+// a variance estimated from a few periods is sigma_k^2 chi2_nu / nu, so x_k = ln sigma_hat_k^2
+// scatters about the smooth ln sigma_k^2 with variance psi'(nu / 2) (psi': trigamma), and the
+// second difference x_{k-1} - 2 x_k + x_{k+1}, which cancels any curve locally linear over three
+// lines, has variance 6 psi'(nu / 2). Its robust variance (1.4826 MAD)^2 over the lines gives
+// nu. The scatter of the sigma itself does not depend on the residual, so an effect in the
+// data does not lower the estimate. On 70 files of sigma from 8 periods (nu = 14) of the
+// independent generator: median 13.5; where the noise per period is near the signal (the
+// period means then carry noise too) it reads 2-9. A sigma with no scatter (a model's, a
+// smoothed one) reads as exact.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "analysis/frf.h"
@@ -28,5 +40,14 @@ std::vector<double> EstimateLineSigma(const Frf& h, int half_window = 25);
 
 // h.sigma pooled as above (half_width 0 returns it unchanged). h must have sigma.
 std::vector<double> PoolLineSigma(const Frf& h, int half_width);
+
+// nu of sigma's scatter (above), at least kMinEstimatedSigmaDof; 0 (exact) when the scatter
+// is below what nu = max_dof gives, or with fewer than 20 lines or a sigma that is not
+// positive and finite everywhere.
+inline constexpr double kMinEstimatedSigmaDof = 5.0;
+double EstimateSigmaDof(std::span<const double> sigma, double max_dof = 1000.0);
+
+// psi'(x), the trigamma function, x > 0.
+double Trigamma(double x);
 
 }  // namespace eol::analysis

@@ -278,6 +278,18 @@ GapInput ReadGapMeasurement(const std::string& path, const GapInputOptions& o) {
     in.note +=
         "; no sigma in the file: noise estimated from the line-to-line scatter "
         "(second differences, running median over 51 lines)";
+  } else if (in.kind != "recording" && in.sigma_dof == 0.0) {
+    // A file's sigma without its degrees of freedom: read them from sigma's own scatter
+    // (analysis/gap/noise.h); a sigma without scatter stays exact.
+    in.sigma_dof = analysis::EstimateSigmaDof(in.frf.sigma);
+    std::ostringstream os;
+    if (in.sigma_dof > 0.0)
+      os << "; sigma^2 on " << std::lround(in.sigma_dof)
+         << " degrees of freedom, estimated from sigma's line-to-line scatter (no sigma_dof "
+            "column)";
+    else
+      os << "; sigma taken as exact (no sigma_dof column, no scatter in sigma)";
+    in.note += os.str();
   }
   return in;
 }

@@ -37,6 +37,7 @@ struct GapArgs {
   int sigma_pool = 0;
   double sigma_dof = 0.0;
   int sigma_periods = 0;
+  bool sigma_exact = false;
   double period_s = 0.0;
   std::string input_column, output_column, lines_file;
   std::vector<std::string> effects;
@@ -66,6 +67,7 @@ int RunGap(const GapArgs& a) {
   // lines multiplies them.
   const double dof = a.sigma_dof > 0.0 ? a.sigma_dof : 2.0 * std::max(a.sigma_periods - 1, 0);
   o.sigma_dof = dof * (2 * a.sigma_pool + 1);
+  o.sigma_exact = a.sigma_exact;
   o.inertia_kg_m2 = a.inertia_kg_m2;
   o.try_pairs = !a.no_pairs;
   for (const std::string& name : a.effects) {
@@ -169,12 +171,17 @@ void AddGapCommand(CLI::App& app) {
                   "The measured files' sigma comes from this many periods: each sigma^2 has "
                   "2 (P - 1) degrees of freedom and the residual is tested as F, not chi2 "
                   "(default: the file's sigma_dof column, a raw recording's periodic estimate, "
-                  "else sigma exact)")
+                  "else read from the line-to-line scatter of sigma itself)")
       ->check(CLI::Range(4, 100000));
-  cmd->add_option("--sigma-dof", a->sigma_dof,
-                  "Degrees of freedom of each line's sigma^2 in the measured files (above 4; "
-                  "overrides --sigma-periods)")
-      ->check(CLI::Range(4.000001, 1e12));
+  auto* dof = cmd->add_option("--sigma-dof", a->sigma_dof,
+                              "Degrees of freedom of each line's sigma^2 in the measured files "
+                              "(above 4; overrides --sigma-periods)")
+                  ->check(CLI::Range(4.000001, 1e12));
+  cmd->add_flag("--sigma-exact", a->sigma_exact,
+                "The measured files' sigma is exact (a noise model's): the residual is tested as "
+                "chi2 whatever sigma's scatter")
+      ->excludes(dof)
+      ->excludes("--sigma-periods");
   cmd->add_option("--period-s", a->period_s,
                   "Raw recordings: the excitation period (default: detect)")
       ->check(CLI::NonNegativeNumber);

@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <random>
+#include <span>
 
 #include "analysis/gap/calibration.h"
 #include "analysis/gap/noise.h"
@@ -83,6 +86,42 @@ TEST(GapResidual, NoiseEstimateAndPooling) {
   for (std::size_t k = 10; k + 10 < h.size(); ++k)
     EXPECT_NEAR(pooled[k] / truth[k], std::sqrt((1.0 + 2.25) / 2.0), 0.1) << k;
   EXPECT_EQ(PoolLineSigma(h, 0), h.sigma);
+}
+
+TEST(GapResidual, TrigammaKnownValues) {
+  const double pi2 = std::numbers::pi * std::numbers::pi;
+  EXPECT_NEAR(Trigamma(1.0), pi2 / 6.0, 1e-10);
+  EXPECT_NEAR(Trigamma(0.5), pi2 / 2.0, 1e-10);
+  EXPECT_NEAR(Trigamma(7.0), pi2 / 6.0 - (1.0 + 1.0 / 4 + 1.0 / 9 + 1.0 / 16 + 1.0 / 25 + 1.0 / 36),
+              1e-10);
+  EXPECT_NEAR(Trigamma(500.0),
+              1.0 / 500.0 + 0.5 / (500.0 * 500.0) + 1.0 / (6.0 * 500.0 * 500.0 * 500.0), 1e-14);
+}
+
+// sigma^2 = sigma_k^2 chi2_nu / nu on a sigma_k that follows a resonance: nu read back from
+// the scatter; a sigma without scatter reads as exact; too few lines or a bad value: exact.
+TEST(GapResidual, SigmasDegreesOfFreedomFromItsScatter) {
+  MotionalImpedance m{0.5, 2e-3, 0.51, 390.0, 50.0};
+  const Frf h = m.Evaluate(Freqs(781));
+  std::mt19937_64 rng(5);
+  for (double nu : {6.0, 14.0, 66.0}) {
+    std::chi_squared_distribution<double> chi2(nu);
+    std::vector<double> smooth, sigma;
+    for (std::size_t k = 0; k < h.size(); ++k) {
+      smooth.push_back(1e-3 * std::abs(h.value[k]));
+      sigma.push_back(smooth.back() * std::sqrt(chi2(rng) / nu));
+    }
+    EXPECT_NEAR(EstimateSigmaDof(sigma), nu, 0.2 * nu) << nu;
+    EXPECT_EQ(EstimateSigmaDof(smooth), 0.0);
+    sigma[100] = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_EQ(EstimateSigmaDof(sigma), 0.0);
+    EXPECT_EQ(EstimateSigmaDof(std::span<const double>(sigma).first(19)), 0.0);
+  }
+  // Scatter that says fewer than 5 degrees of freedom: 5, the least the F test is written for.
+  std::vector<double> wild;
+  std::chi_squared_distribution<double> chi1(1.0);
+  for (int k = 0; k < 200; ++k) wild.push_back(std::sqrt(chi1(rng)));
+  EXPECT_EQ(EstimateSigmaDof(wild), kMinEstimatedSigmaDof);
 }
 
 TEST(GapCalibration, RigidShaftAndMotionalNominalsAreRecovered) {

@@ -49,16 +49,18 @@ class GapCli : public ::testing::Test {
   TempDir dir_;
 };
 
-// The degrees of freedom of the file's sigma (its sigma_dof column) decide how the residual is
-// tested: a blind case of the independent generator with no effect and sigma from 8 periods
-// (tests/data/gap-independent-none) is `unexplained` when that sigma is taken as exact (g
-// 1.117, a wide band) and `none` with the column, as with --sigma-periods 8.
-TEST_F(GapCli, TheFilesSigmaDofColumnTestsTheResidualAsF) {
+// The degrees of freedom of the file's sigma decide how the residual is tested: a blind case of
+// the independent generator with no effect and sigma from 8 periods (14 degrees of freedom,
+// tests/data/gap-independent-none) is `unexplained` when that sigma is taken as exact (g 1.117,
+// a wide band) and `none` with its sigma_dof column, with the degrees of freedom read from
+// sigma's own scatter when the file has no column (as a blind harness gives it), and with
+// --sigma-periods 8.
+TEST_F(GapCli, TheSigmasDegreesOfFreedomTestTheResidualAsF) {
   const std::string data = std::string(EOL_TEST_DATA_DIR) + "/gap-independent-none/";
   const std::string sim = data + "case-058-sim.csv.gz", plain = data + "case-058-meas.csv.gz";
   io::WriteFrfCsv(dir_ / "dof.csv", io::ReadFrfCsv(plain), 14.0);
-  const EolRun exact = Eol(
-      {"gap", "--sim", sim, "--measured", plain, "--json-out", dir_ / "exact.json", "--no-pairs"});
+  const EolRun exact = Eol({"gap", "--sim", sim, "--measured", plain, "--json-out",
+                            dir_ / "exact.json", "--no-pairs", "--sigma-exact"});
   ASSERT_EQ(exact.code, 0) << exact.output;
   EXPECT_EQ(ReadJson(dir_ / "exact.json")["effect"], "unexplained") << exact.output;
   EXPECT_EQ(ReadJson(dir_ / "exact.json")["sigma_dof"], 0.0);
@@ -74,11 +76,28 @@ TEST_F(GapCli, TheFilesSigmaDofColumnTestsTheResidualAsF) {
   EXPECT_NE(j["measurements"][0]["note"].get<std::string>().find("14 degrees of freedom"),
             std::string::npos)
       << j["measurements"][0]["note"];
+
+  // No column, no option: read from the scatter of sigma (14 true; 781 lines read it to about
+  // 10 %).
+  const EolRun scatter = Eol({"gap", "--sim", sim, "--measured", plain, "--json-out",
+                              dir_ / "scatter.json", "--no-pairs"});
+  ASSERT_EQ(scatter.code, 0) << scatter.output;
+  const nlohmann::json k = ReadJson(dir_ / "scatter.json");
+  EXPECT_EQ(k["effect"], "none") << scatter.output;
+  EXPECT_NEAR(k["sigma_dof"].get<double>(), 14.0, 3.0);
+  EXPECT_NE(k["measurements"][0]["note"].get<std::string>().find("estimated from sigma's"),
+            std::string::npos)
+      << k["measurements"][0]["note"];
+
   // The option overrides the column: 4 periods (6 degrees of freedom) on it.
   const EolRun option = Eol({"gap", "--sim", sim, "--measured", dir_ / "dof.csv", "--json-out",
                              dir_ / "option.json", "--no-pairs", "--sigma-periods", "4"});
   ASSERT_EQ(option.code, 0) << option.output;
   EXPECT_EQ(ReadJson(dir_ / "option.json")["sigma_dof"], 6.0);
+  const EolRun both =
+      Eol({"gap", "--sim", sim, "--measured", plain, "--sigma-exact", "--sigma-periods", "4"});
+  EXPECT_NE(both.code, 0);
+  EXPECT_NE(both.output.find("excludes"), std::string::npos) << both.output;
 }
 
 TEST_F(GapCli, JsonHasTheStableNames) {
