@@ -196,7 +196,8 @@ json GapReportJson(const GapReport& r) {
   j["score_rule"] =
       "cost = -2 ln L of the normalised residual (chi2, or the Student t's for sigma on few "
       "degrees of freedom); an effect is there when its BIC = cost + p ln(2K) is at least 10 "
-      "below none's; which one: the lowest score = cost + Laplace Occam penalty";
+      "below none's; which one: the lowest score = cost + Laplace Occam penalty - 2 ln(the "
+      "effect's prior odds, analysis/gap/diagnosis.h GapOptions::prior_odds)";
   j["residual_form"] = g.residual_form;
   j["message"] = g.message;
   return j;
@@ -262,7 +263,8 @@ std::string GapReportText(const GapReport& r) {
   if (const analysis::RankedEffect* w = Winner(g)) {
     for (const auto& p : w->params) os << "               " << ParamText(p) << "\n";
   }
-  os << "  ranking (score = evidence: cost + Occam; an effect needs its BIC 10 below none's; "
+  os << "  ranking (score = evidence: cost + Occam - 2 ln prior odds; an effect needs its BIC 10 "
+        "below none's; "
      << g.residual_form << " residual):\n";
   int rank = 0;
   for (const auto& e : g.ranking) {

@@ -227,7 +227,7 @@ GapBenchCase RunCase(const GapBenchOptions& o, const Excitation& ex, int index,
     c.oracle_separable = true;
   } else {
     const EffectFit truth_fit = fitter.Fit(hidden, {}, o.gap.max_iterations);
-    double truth_score = truth_fit.cost + truth_fit.occam;
+    double truth_score = truth_fit.cost + truth_fit.occam + PriorPenalty(hidden, o.gap);
     double best_other = fitter.Cost({}, {});  // "none"
     for (const RankedEffect& r : s.ranking) {
       if (r.effects.size() != 1) continue;

@@ -24,9 +24,9 @@
 //   top-1        diagnosed name == truth (a pair or "unexplained" is wrong);
 //   oracle       a case is separable when an oracle that knows the true family and starts
 //                its fit at the true parameters finds it scores (the diagnosis' score: cost
-//                + Occam penalty, effect_fit.h; "none": its cost) at least oracle_margin
-//                below every other plausible single effect the diagnosis fitted and below
-//                "none". Every "none" case counts as separable (the diagnosis must never
+//                + Occam penalty - 2 ln prior odds, diagnosis.h; "none": its cost) at least
+//                oracle_margin below every other plausible single effect the diagnosis fitted and
+//                below "none". Every "none" case counts as separable (the diagnosis must never
 //                invent an effect from noise), so top-1 on separable cases is strict there;
 //   band         the most significant reported band overlaps the lines where the hidden effect
 //                acts (|dH_k| / sigma_k at least a quarter of its maximum);

@@ -111,14 +111,14 @@ double FirstModeHz(const NominalNetwork& n, std::span<const AppliedEffect> effec
 // Rp refitted (the calibration of GapSplit), not a mode of another part.
 constexpr double kModeSeparation = 0.04;
 
-RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit) {
+RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit, const GapOptions& o) {
   RankedEffect r;
   r.effects = fit.effects;
   r.effect = JoinNames(fit.effects);
   r.chi2 = fit.chi2;
   r.cost = fit.cost;
   r.bic = fit.cost + fit.n_params * std::log(std::max(fit.residuals, 1));
-  r.score = fit.cost + fit.occam;
+  r.score = fit.cost + fit.occam + PriorPenalty(fit.effects, o);
   r.gap_after = fit.residuals > 0 ? std::sqrt(fit.chi2 / fit.residuals) : 0.0;
   r.converged = fit.converged;
   for (std::size_t e = 0; e < fit.effects.size(); ++e) {
@@ -364,6 +364,8 @@ bool GapOptions::IsValid(std::string* why) const {
   if (!(max_sigma_scale >= 1.0)) return fail("max_sigma_scale must be at least 1");
   if (!(rival_margin >= 0.0 && std::isfinite(rival_margin)))
     return fail("rival_margin must be finite and not negative");
+  for (const auto& [kind, odds] : prior_odds)
+    if (!(odds > 0.0 && std::isfinite(odds))) return fail("prior_odds must be positive and finite");
   if (pair_candidates < 2) return fail("pair_candidates must be at least 2");
   if (max_iterations < 1) return fail("max_iterations must be at least 1");
   return true;
@@ -376,6 +378,14 @@ std::vector<double> NormalisedResidual(const NominalNetwork& nominal,
   for (std::size_t k = 0; k < unit.size(); ++k)
     r[k] = std::abs(LineResidual(unit, k, EvaluateNetwork(nominal, effects, unit.freq_hz[k])));
   return r;
+}
+
+double PriorPenalty(std::span<const AppliedEffect> effects, const GapOptions& o) {
+  double penalty = 0.0;
+  for (const AppliedEffect& e : effects)
+    for (const auto& [kind, odds] : o.prior_odds)
+      if (kind == e.kind) penalty -= 2.0 * std::log(odds);
+  return penalty;
 }
 
 GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>& units,
@@ -432,7 +442,7 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
     if (fit.effects.empty()) continue;
     // Pairs start from the lowest-cost basin: the two effects together fit there.
     single_fit[kind] = fit.lowest_cost.empty() ? fit.effects.front() : fit.lowest_cost.front();
-    singles.push_back(Rank(fitter, fit));
+    singles.push_back(Rank(fitter, fit, o));
   }
   std::sort(singles.begin(), singles.end(), BetterRank);
   RankedEffect none;
@@ -473,7 +483,7 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
       for (const auto& [a, b] : pairs) {
         const EffectFit fit =
             fitter.FitKinds({a, b}, {single_fit[a], single_fit[b]}, all, o.max_iterations);
-        if (fit.effects.size() == 2) pair_ranks.push_back(Rank(fitter, fit));
+        if (fit.effects.size() == 2) pair_ranks.push_back(Rank(fitter, fit, o));
       }
       std::sort(pair_ranks.begin(), pair_ranks.end(), BetterRank);
       // Each member significant on its own: against each member's single fit in sample, and
