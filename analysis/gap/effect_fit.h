@@ -20,8 +20,9 @@
 // Evidence (Laplace): -2 ln p(data | effect) ~ cost + occam, with
 //   occam = sum_i max(0, ln(lambda_i / 2 pi)),  lambda_i the eigenvalues of W A W,
 // A = J^T J the information in theta at the optimum and W the prior widths of the thetas
-// (uniform in ln(value) over the plausibility bounds for log-scaled parameters, in value for
-// the others). A parameter the data pin down pays ln of (prior width / posterior width)^2; one
+// (uniform in ln(value) over the plausibility bounds for log-scaled parameters, in ln |value|
+// over six decades, each sign half, for signed scales such as a delay, in value for the
+// others). A parameter the data pin down pays ln of (prior width / posterior width)^2; one
 // they leave as open as its prior pays nothing (where BIC charges every parameter ln(2K)):
 // an effect whose shape predicts a relation (a coupled inertia keeps the peak height while it
 // lowers f0 and raises Q) is not charged for parameters the data do not need.

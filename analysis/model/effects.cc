@@ -139,12 +139,12 @@ EffectSpec DescribeEffect(EffectKind kind, const NominalNetwork& n, double f_lo,
   switch (kind) {
     case EffectKind::kSeriesResistance:
       s.equation = "Z = Z0 + resistance_ohm";
-      s.params = {{"resistance_ohm", "ohm", -0.5 * r, 2.0 * r, false, 0.01 * r}};
+      s.params = {{"resistance_ohm", "ohm", -0.5 * r, 2.0 * r, false, 0.01 * r, false, true}};
       break;
     case EffectKind::kChannelDelay: {
       s.equation = "Z = Z0 exp(-j w delay_s)";
       const double tau_max = 0.25 / f_hi;
-      s.params = {{"delay_s", "s", -tau_max, tau_max, false, 0.01 / w_hi}};
+      s.params = {{"delay_s", "s", -tau_max, tau_max, false, 0.01 / w_hi, false, true}};
       break;
     }
     case EffectKind::kStrayCapacitance: {

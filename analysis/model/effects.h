@@ -167,6 +167,11 @@ struct EffectParamSpec {
   // ln(hi / lo)): a parameter that must stay inside its bounds and may sit at one, as a
   // coupling that is rigid over the band (overrides scale).
   bool bounded = false;
+  // A signed scale (a delay, a resistance step): the evidence's prior (effect_fit.h) is
+  // log-uniform in |value| over six decades below the larger bound, each sign half, as for the
+  // log-scaled parameters, instead of uniform over [lo, hi], which charges a small value
+  // ln((hi - lo) / |value|)^2 more than a log-scaled one of the same size.
+  bool signed_log_prior = false;
 };
 
 struct EffectSpec {

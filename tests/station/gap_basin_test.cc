@@ -149,6 +149,34 @@ TEST(GapBasin, PriorOddsDecideANearTieForTheCoupledInertia) {
   EXPECT_NE(bad.message.find("prior_odds"), std::string::npos) << bad.message;
 }
 
+// A delay of 9 ns on a winding of small R (tests/data/gap-independent-delay): it raises Re Z as
+// w^2 tau L, as a skin effect does, and fits 11 better. A delay is a signed scale: on a prior
+// uniform over +-125 us its Occam penalty was 25.5 against the skin effect's 10.4 (log-uniform)
+// and the skin effect was named; on a log-uniform prior in |tau| the two one-parameter
+// penalties are alike and the delay is named.
+TEST(GapBasin, ASmallDelayIsChargedOnALogPriorLikeTheSkinEffect) {
+  const BlindCase c = Load("case-019", std::string(EOL_TEST_DATA_DIR) + "/gap-independent-delay/");
+  analysis::GapOptions o;
+  o.heldout = false;
+  const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
+  ASSERT_TRUE(s.usable) << s.message;
+  EXPECT_EQ(s.effect, "channel_delay") << s.message;
+  double delay_occam = NAN, skin_occam = NAN, delay_cost = NAN, skin_cost = NAN;
+  for (const analysis::RankedEffect& r : s.ranking) {
+    if (r.effect == "channel_delay") {
+      delay_occam = r.score - r.cost;
+      delay_cost = r.cost;
+      EXPECT_NEAR(r.params[0].value, 9.02e-9, 2e-9);
+    }
+    if (r.effect == "skin_effect") {
+      skin_occam = r.score - r.cost;
+      skin_cost = r.cost;
+    }
+  }
+  EXPECT_LT(delay_cost, skin_cost - 5.0);
+  EXPECT_LT(std::abs(delay_occam - skin_occam), 5.0) << delay_occam << " " << skin_occam;
+}
+
 // The truth: Z_L = L w_ref^(1 - n) (j w)^n, n = 0.5146, w_ref = 2 pi 316.2 Hz, no pure L left.
 TEST(GapBasin, AWholeSemiInductanceSitsAtTheShareBoundOfOne) {
   const BlindCase c = Load("case-000", kSemi);
