@@ -45,6 +45,14 @@ BlindCase Load(const std::string& name, const std::string& dir = kCoupled) {
   return c;
 }
 
+// The ranking's entry for `effect` (the test fails when there is none).
+analysis::RankedEffect Ranked(const analysis::GapSummary& s, const std::string& effect) {
+  for (const analysis::RankedEffect& r : s.ranking)
+    if (r.effect == effect) return r;
+  ADD_FAILURE() << effect << " not ranked";
+  return {};
+}
+
 // Share of the parameter's (log-)range, as the fit's logistic map sees it.
 double Share(const analysis::EffectParamSpec& p, double v) {
   return p.log_scale ? std::log(v / p.lo) / std::log(p.hi / p.lo) : (v - p.lo) / (p.hi - p.lo);
@@ -80,12 +88,7 @@ TEST(GapBasin, CoupledInertiaIsScoredInItsBasinOfBestEvidence) {
   const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
   ASSERT_TRUE(s.usable) << s.message;
   EXPECT_EQ(s.effect, "coupled_inertia") << s.message;
-  double coupled = NAN, fixture = NAN;
-  for (const analysis::RankedEffect& r : s.ranking) {
-    if (r.effect == "coupled_inertia") coupled = r.score;
-    if (r.effect == "fixture_compliance") fixture = r.score;
-  }
-  EXPECT_LT(coupled, fixture);
+  EXPECT_LT(Ranked(s, "coupled_inertia").score, Ranked(s, "fixture_compliance").score);
   // 10 apart in evidence: no rival named.
   EXPECT_EQ(s.rival, "") << s.message;
 }
@@ -136,12 +139,7 @@ TEST(GapBasin, PriorOddsDecideANearTieForTheCoupledInertia) {
   ASSERT_TRUE(even.usable) << even.message;
   EXPECT_EQ(even.effect, "fixture_compliance") << even.message;
   EXPECT_EQ(even.rival, "coupled_inertia") << even.message;
-  double coupled_cost = NAN, fixture_cost = NAN;
-  for (const analysis::RankedEffect& r : even.ranking) {
-    if (r.effect == "coupled_inertia") coupled_cost = r.cost;
-    if (r.effect == "fixture_compliance") fixture_cost = r.cost;
-  }
-  EXPECT_LT(coupled_cost, fixture_cost);
+  EXPECT_LT(Ranked(even, "coupled_inertia").cost, Ranked(even, "fixture_compliance").cost);
 
   o.prior_odds = {{analysis::EffectKind::kCoupledInertia, 0.0}};
   const analysis::GapSummary bad = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
@@ -161,19 +159,12 @@ TEST(GapBasin, ASmallDelayIsChargedOnALogPriorLikeTheSkinEffect) {
   const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
   ASSERT_TRUE(s.usable) << s.message;
   EXPECT_EQ(s.effect, "channel_delay") << s.message;
-  double delay_occam = NAN, skin_occam = NAN, delay_cost = NAN, skin_cost = NAN;
-  for (const analysis::RankedEffect& r : s.ranking) {
-    if (r.effect == "channel_delay") {
-      delay_occam = r.score - r.cost;
-      delay_cost = r.cost;
-      EXPECT_NEAR(r.params[0].value, 9.02e-9, 2e-9);
-    }
-    if (r.effect == "skin_effect") {
-      skin_occam = r.score - r.cost;
-      skin_cost = r.cost;
-    }
-  }
-  EXPECT_LT(delay_cost, skin_cost - 5.0);
+  const analysis::RankedEffect delay = Ranked(s, "channel_delay");
+  const analysis::RankedEffect skin = Ranked(s, "skin_effect");
+  ASSERT_FALSE(delay.params.empty());
+  EXPECT_NEAR(delay.params[0].value, 9.02e-9, 2e-9);
+  EXPECT_LT(delay.cost, skin.cost - 5.0);
+  const double delay_occam = delay.score - delay.cost, skin_occam = skin.score - skin.cost;
   EXPECT_LT(std::abs(delay_occam - skin_occam), 5.0) << delay_occam << " " << skin_occam;
 }
 
