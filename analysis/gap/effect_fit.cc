@@ -195,6 +195,9 @@ void DifferenceJacobian(const std::function<void(const Eigen::VectorXd&, Eigen::
   }
 }
 
+// A scale's prior reaches this far below its bound (six decades).
+constexpr double kPriorFloor = 1e-6;
+
 // The prior width of each theta: uniform in ln(value) over [lo, hi] for a log-scaled
 // parameter (lo = 0 taken as 1e-6 hi), uniform in ln |value| over six decades below the larger
 // bound, each sign half, for a signed scale (EffectParamSpec::signed_log_prior), uniform in
@@ -208,9 +211,10 @@ double PriorWidth(const Layout& layout, const std::vector<AppliedEffect>& at, st
   if (ps.bounded) return (ps.hi - ps.lo) / slope;
   if (ps.signed_log_prior) {
     const double top = std::max(std::abs(ps.lo), std::abs(ps.hi));
-    return 2.0 * std::log(1e6) * std::max(std::abs(at[e].params[p]), 1e-6 * top) / ps.scale;
+    return -2.0 * std::log(kPriorFloor) * std::max(std::abs(at[e].params[p]), kPriorFloor * top) /
+           ps.scale;
   }
-  if (ps.log_scale) return std::log(ps.hi / std::max(ps.lo, 1e-6 * ps.hi));
+  if (ps.log_scale) return std::log(ps.hi / std::max(ps.lo, kPriorFloor * ps.hi));
   return (ps.hi - ps.lo) / ps.scale;
 }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "analysis/qc/statistics.h"
+
 namespace eol::analysis {
 
 std::vector<double> EstimateLineSigma(const Frf& h, int half_window) {
@@ -71,14 +73,9 @@ double EstimateSigmaDof(std::span<const double> sigma, double max_dof) {
   for (std::size_t k = 1; k + 1 < n; ++k)
     d2.push_back(2.0 *
                  (std::log(sigma[k - 1]) - 2.0 * std::log(sigma[k]) + std::log(sigma[k + 1])));
-  auto median = [](std::vector<double> v) {
-    const auto mid = v.begin() + static_cast<long>(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
-  };
-  const double centre = median(d2);
+  const double centre = Median(d2);
   for (double& d : d2) d = std::abs(d - centre);
-  const double spread = 1.4826 * median(d2);
+  const double spread = 1.4826 * Median(d2);
   const double trigamma = spread * spread / 6.0;
   if (!(trigamma > Trigamma(0.5 * max_dof))) return 0.0;
   // Trigamma falls monotonically: bisect nu on a log scale.
