@@ -198,17 +198,14 @@ void DifferenceJacobian(const std::function<void(const Eigen::VectorXd&, Eigen::
 // A scale's prior reaches this far below its bound (six decades).
 constexpr double kPriorFloor = 1e-6;
 
-// The prior width of each theta: uniform in ln(value) over [lo, hi] for a log-scaled
-// parameter (lo = 0 taken as 1e-6 hi), uniform in ln |value| over six decades below the larger
-// bound, each sign half, for a signed scale (EffectParamSpec::signed_log_prior), uniform in
-// value otherwise (in theta units at the point for a bounded one).
+// The prior width of each unbounded theta: uniform in ln(value) over [lo, hi] for a
+// log-scaled parameter (lo = 0 taken as 1e-6 hi), uniform in ln |value| over six decades below
+// the larger bound, each sign half, for a signed scale (EffectParamSpec::signed_log_prior),
+// uniform in value otherwise. (A bounded one's prior is its share of the range:
+// BoundedPenalty.)
 double PriorWidth(const Layout& layout, const std::vector<AppliedEffect>& at, std::size_t e,
                   std::size_t p) {
   const EffectParamSpec& ps = layout.specs[e].params[p];
-  const double slope = std::max(layout.Slope(at, e, p), 1e-300);
-  if (ps.bounded && ps.log_scale)
-    return std::log(ps.hi / ps.lo) * std::max(at[e].params[p], 1e-300) / slope;
-  if (ps.bounded) return (ps.hi - ps.lo) / slope;
   if (ps.signed_log_prior) {
     const double top = std::max(std::abs(ps.lo), std::abs(ps.hi));
     return -2.0 * std::log(kPriorFloor) * std::max(std::abs(at[e].params[p]), kPriorFloor * top) /
@@ -218,23 +215,115 @@ double PriorWidth(const Layout& layout, const std::vector<AppliedEffect>& at, st
   return (ps.hi - ps.lo) / ps.scale;
 }
 
-// A bounded parameter whose share of its range is within this of either end is at its bound.
-constexpr double kInteriorShare = 1e-3;
+// True when theta i is a bounded parameter (fitted on the logistic map of its range).
+bool IsBounded(const Layout& layout, long index) {
+  long i = 0;
+  for (const EffectSpec& spec : layout.specs)
+    for (const EffectParamSpec& ps : spec.params)
+      if (i++ == index) return ps.bounded;
+  return false;
+}
 
-// sum_i max(0, ln(lambda_i / 2 pi)) over the eigenvalues of W A W (effect_fit.h).
+// sum_i max(0, ln(lambda_i / 2 pi)) over the eigenvalues of W A W (effect_fit.h), on the
+// unbounded parameters (the bounded ones: BoundedPenalty).
 double OccamPenalty(const Layout& layout, const std::vector<AppliedEffect>& at,
                     const Eigen::MatrixXd& information) {
-  const long n = information.rows();
-  Eigen::VectorXd w(n);
+  std::vector<long> keep;
+  std::vector<double> widths;
   long i = 0;
   for (std::size_t e = 0; e < at.size(); ++e)
-    for (std::size_t p = 0; p < at[e].params.size(); ++p, ++i) w(i) = PriorWidth(layout, at, e, p);
-  const Eigen::MatrixXd scaled = w.asDiagonal() * information * w.asDiagonal();
+    for (std::size_t p = 0; p < at[e].params.size(); ++p, ++i)
+      if (!IsBounded(layout, i)) {
+        keep.push_back(i);
+        widths.push_back(PriorWidth(layout, at, e, p));
+      }
+  const long n = static_cast<long>(keep.size());
+  if (n == 0) return 0.0;
+  Eigen::MatrixXd sub(n, n);
+  for (long a = 0; a < n; ++a)
+    for (long b = 0; b < n; ++b) sub(a, b) = information(keep[a], keep[b]);
+  const Eigen::VectorXd w = Eigen::Map<const Eigen::VectorXd>(widths.data(), n);
+  const Eigen::MatrixXd scaled = w.asDiagonal() * sub * w.asDiagonal();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scaled, Eigen::EigenvaluesOnly);
   double penalty = 0.0;
   for (long k = 0; k < n; ++k)
     penalty += std::max(0.0, std::log(eig.eigenvalues()(k) / (2.0 * std::numbers::pi)));
   return std::isfinite(penalty) ? penalty : std::numeric_limits<double>::infinity();
+}
+
+// An orthonormal basis of the Jacobian's columns `cols` (singular values below 1e-9 of the
+// largest dropped: a parameter the data do not see).
+Eigen::MatrixXd ColumnBasis(const Eigen::MatrixXd& jac, const std::vector<long>& cols) {
+  if (cols.empty()) return Eigen::MatrixXd(jac.rows(), 0);
+  Eigen::MatrixXd m(jac.rows(), static_cast<long>(cols.size()));
+  for (std::size_t k = 0; k < cols.size(); ++k) m.col(static_cast<long>(k)) = jac.col(cols[k]);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(m, Eigen::ComputeThinU);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  long rank = 0;
+  while (rank < sv.size() && sv(rank) > 1e-9 * sv(0)) ++rank;
+  return svd.matrixU().leftCols(rank);
+}
+
+// -2 ln of the likelihood's mean over one bounded parameter's prior (uniform in its share u of
+// the range: ln(value) for a log-scaled one), by the trapezoid rule on a grid log-spaced in
+// the distance from the optimum u0 (1e-6 to 1 of the range, both sides, clipped to [0, 1]).
+// At each u the parameters spanned by `follow` (an orthonormal basis of their Jacobian
+// columns) follow to first order: the residual's part along them is removed.
+double BoundedMarginal(
+    const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>& residual,
+    const Eigen::VectorXd& theta, long index, const Eigen::MatrixXd& follow,
+    double cost_at_optimum) {
+  const double u0 = 1.0 / (1.0 + std::exp(-theta(index)));
+  Eigen::VectorXd t = theta;
+  Eigen::VectorXd r;
+  auto likelihood = [&](double u) {
+    const double uc = std::clamp(u, 1e-12, 1.0 - 1e-12);
+    t(index) = std::log(uc / (1.0 - uc));
+    residual(t, &r);
+    if (follow.cols() > 0) r -= follow * (follow.transpose() * r);
+    const double delta = r.squaredNorm() - cost_at_optimum;
+    return std::isfinite(delta) ? std::exp(-0.5 * std::clamp(delta, -40.0, 1400.0)) : 0.0;
+  };
+  constexpr int kSteps = 36;
+  std::vector<double> us = {0.0, 1.0, u0};
+  for (int k = 0; k <= kSteps; ++k) {
+    const double d = 1e-6 * std::pow(1e6, static_cast<double>(k) / kSteps);
+    if (u0 - d > 0.0) us.push_back(u0 - d);
+    if (u0 + d < 1.0) us.push_back(u0 + d);
+  }
+  std::sort(us.begin(), us.end());
+  double mean = 0.0, l_prev = likelihood(us[0]);
+  for (std::size_t k = 1; k < us.size(); ++k) {
+    const double l = likelihood(us[k]);
+    mean += 0.5 * (l + l_prev) * (us[k] - us[k - 1]);
+    l_prev = l;
+  }
+  if (!(mean > 0.0)) return 2.0 * 700.0;
+  return -2.0 * std::log(mean);
+}
+
+// The evidence's penalty for the bounded parameters (fitted on the logistic map, where a
+// parameter may sit at a bound and the likelihood be flat over part of its range: Laplace sees
+// no curvature there, and a coupling rigid over the band or f2 anywhere above it would pay
+// nothing for the share of its prior the data exclude). Each is integrated over its prior
+// numerically, in turn, as the chain rule has it: the k-th with the unbounded parameters and
+// the bounded ones after it following (BoundedMarginal), so a valley the data leave open (a
+// rigid J2 at the rotor, or a heavier one at a node) is integrated along, not across. For a
+// Gaussian likelihood inside the range this is Laplace's ln(lambda / 2 pi) per parameter.
+double BoundedPenalty(const Layout& layout,
+                      const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>& residual,
+                      const Eigen::VectorXd& theta, const Eigen::MatrixXd& jac,
+                      double cost_at_optimum) {
+  std::vector<long> bounded, unbounded;
+  for (long i = 0; i < theta.size(); ++i) (IsBounded(layout, i) ? bounded : unbounded).push_back(i);
+  double penalty = 0.0;
+  for (std::size_t k = 0; k < bounded.size(); ++k) {
+    std::vector<long> follow = unbounded;
+    follow.insert(follow.end(), bounded.begin() + static_cast<long>(k) + 1, bounded.end());
+    penalty += std::max(0.0, BoundedMarginal(residual, theta, bounded[k], ColumnBasis(jac, follow),
+                                             cost_at_optimum));
+  }
+  return penalty;
 }
 
 }  // namespace
@@ -452,6 +541,9 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
           if (++taken == 2) break;
         }
       }
+      // And the added inertia itself (J2 rigid on the rotor over the band), whose basin a
+      // narrow mode fitted to a few noisy lines may outscore on cost but not on evidence.
+      out.push_back({mu_rigid, 19.0 * f_hi_, 30.0, 0.0});
       std::sort(out.begin(), out.end(), [&](const auto& a, const auto& b) {
         auto red = [&](const std::vector<double>& p) {
           for (const Candidate& cand : c)
@@ -567,6 +659,7 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   const Eigen::MatrixXd information = jac.transpose() * jac;
   if (InvertInformation(information, &inverse)) cov = inverse;
   out.occam = OccamPenalty(layout, out.effects, information);
+  out.occam += BoundedPenalty(layout, problem.residual, theta, jac, out.cost);
   int i = 0;
   out.sigma.resize(out.effects.size());
   for (std::size_t e = 0; e < out.effects.size(); ++e)
@@ -697,26 +790,11 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
       if (!IsPlausible(Spec(e.kind), e, &why)) return false;
     return f.converged;
   };
-  // Off its bounds: every bounded parameter away from both ends of its range. At a bound the
-  // logistic map saturates, the information there is no curvature of the likelihood and the
-  // Laplace evidence's Occam penalty comes out near zero: such a corner may win on cost, not on
-  // an evidence it does not have.
-  auto interior = [&](const EffectFit& f) {
-    for (const AppliedEffect& e : f.effects) {
-      const EffectSpec spec = Spec(e.kind);
-      for (std::size_t p = 0; p < e.params.size() && p < spec.params.size(); ++p) {
-        if (!spec.params[p].bounded) continue;
-        const double u = BoundedShare(spec.params[p], e.params[p]);
-        if (!(u > kInteriorShare && u < 1.0 - kInteriorShare)) return false;
-      }
-    }
-    return true;
-  };
   // Each start's optimum is one basin of the likelihood. The answer is the basin with the best
   // evidence (cost + Occam), which is not always the lowest cost: a narrow basin whose mode
   // fits a few noisy lines pays for pinning its parameters, a broad one that explains the same
-  // shift of the first mode with parameters the data leave open does not. The lowest-cost fit
-  // is the reference; an interior basin replaces it only with a better evidence.
+  // shift of the first mode with parameters the data leave open does not. Bounded parameters at a
+  // bound compete too: their evidence integrates the likelihood over their prior (effect_fit.h).
   std::vector<EffectFit> fits;
   std::vector<char> ok;
   for (const auto& s : starts) {
@@ -737,9 +815,7 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
   if (!ok[lowest]) return std::move(fits[lowest]);
   std::size_t chosen = lowest;
   for (std::size_t i = 0; i < fits.size(); ++i)
-    if (ok[i] && interior(fits[i]) &&
-        fits[i].cost + fits[i].occam < fits[chosen].cost + fits[chosen].occam)
-      chosen = i;
+    if (ok[i] && fits[i].cost + fits[i].occam < fits[chosen].cost + fits[chosen].occam) chosen = i;
   EffectFit best = std::move(fits[chosen]);
   if (chosen != lowest) best.lowest_cost = fits[lowest].effects;
   return best;

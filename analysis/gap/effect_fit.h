@@ -17,7 +17,7 @@
 // buying a narrow mode; nu = 0 (exact sigma) gives rho = 2 u, the chi2. The fits minimise
 // the cost (Levenberg-Marquardt on the residual scaled by sqrt(rho(u) / u)), and the model
 // selection (diagnosis.h) scores it.
-// Evidence (Laplace): -2 ln p(data | effect) ~ cost + occam, with
+// Evidence: -2 ln p(data | effect) ~ cost + occam. For the unbounded parameters (Laplace)
 //   occam = sum_i max(0, ln(lambda_i / 2 pi)),  lambda_i the eigenvalues of W A W,
 // A = J^T J the information in theta at the optimum and W the prior widths of the thetas
 // (uniform in ln(value) over the plausibility bounds for log-scaled parameters, in ln |value|
@@ -26,9 +26,17 @@
 // they leave as open as its prior pays nothing (where BIC charges every parameter ln(2K)):
 // an effect whose shape predicts a relation (a coupled inertia keeps the peak height while it
 // lowers f0 and raises Q) is not charged for parameters the data do not need.
+// A bounded parameter (fitted on the logistic map of its range, EffectParamSpec::bounded) may
+// sit at a bound or have a likelihood flat over part of its range (a coupling rigid over the
+// band: f2 anywhere above it), where Laplace sees no curvature and would charge nothing for
+// the part of the prior the data exclude. Each is integrated over its prior (uniform in its
+// share of the range) numerically instead, -2 ln of the likelihood's mean, in turn as the
+// chain rule has it: the unbounded parameters and the bounded ones after it follow to first
+// order (the residual's part along their Jacobian columns is removed), so a valley the data
+// leave open (a rigid J2 at the rotor, or a heavier one at a node) is integrated along. For a
+// Gaussian likelihood inside the range it is Laplace's ln(lambda / 2 pi).
 // Of the local optima the starts reach, an effect is scored in the one of best evidence (a
-// narrow basin that fits a few noisy lines pays for pinning its parameters); only optima off
-// every bound compete on it, as Laplace sees no curvature where the logistic map saturates.
+// narrow basin that fits a few noisy lines pays for pinning its parameters).
 // Parameters are fitted as ln(value) (positive, wide-ranging ones) or value / scale, with
 // analysis::MinimizeLeastSquares (fit/least_squares.h: MINPACK Levenberg-Marquardt) on
 // forward-difference Jacobians; the covariance (Jr^T Jr)^-1 at the optimum, from a central-
@@ -133,10 +141,10 @@ class EffectFitter {
 
   // The best of the fits started from Starts(kind) for each kind in `kinds`, the kinds
   // fitted jointly; for a pair the second kind's starts are taken on top of `seeds` (the
-  // kinds' single fits, same order as kinds) and vice versa. Best: the lowest cost among the
-  // plausible (IsPlausible) converged fits; the lowest cost of all only when none is. An
-  // interior optimum (no bounded parameter at a bound) with a better evidence (cost + occam)
-  // replaces the lowest-cost one, which is then kept in lowest_cost.
+  // kinds' single fits, same order as kinds) and vice versa. Best: of the plausible
+  // (IsPlausible) converged fits the one of best evidence (cost + occam); when that is not the
+  // lowest-cost one, the lowest-cost one is kept in lowest_cost. The lowest cost of all only
+  // when no fit is plausible and converged.
   EffectFit FitKinds(const std::vector<EffectKind>& kinds, const std::vector<AppliedEffect>& seeds,
                      const LineMask& mask, int max_iterations) const;
 
