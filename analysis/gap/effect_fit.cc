@@ -251,37 +251,79 @@ double OccamPenalty(const Layout& layout, const std::vector<AppliedEffect>& at,
   return std::isfinite(penalty) ? penalty : std::numeric_limits<double>::infinity();
 }
 
-// An orthonormal basis of the Jacobian's columns `cols` (singular values below 1e-9 of the
-// largest dropped: a parameter the data do not see).
-Eigen::MatrixXd ColumnBasis(const Eigen::MatrixXd& jac, const std::vector<long>& cols) {
-  if (cols.empty()) return Eigen::MatrixXd(jac.rows(), 0);
-  Eigen::MatrixXd m(jac.rows(), static_cast<long>(cols.size()));
-  for (std::size_t k = 0; k < cols.size(); ++k) m.col(static_cast<long>(k)) = jac.col(cols[k]);
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(m, Eigen::ComputeThinU);
-  const Eigen::VectorXd& sv = svd.singularValues();
-  long rank = 0;
-  while (rank < sv.size() && sv(rank) > 1e-9 * sv(0)) ++rank;
-  return svd.matrixU().leftCols(rank);
+using ResidualFn = std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>;
+
+double Logistic(double t) { return 1.0 / (1.0 + std::exp(-t)); }
+double Logit(double u) {
+  const double uc = std::clamp(u, 1e-12, 1.0 - 1e-12);
+  return std::log(uc / (1.0 - uc));
 }
+
+// The parameters that follow a bounded one while it is integrated over (BoundedMarginal): the
+// Jacobian of the residual at the optimum in their own coordinates (a bounded one's share u
+// of its range, by a one-sided difference into the range; an unbounded one's theta, the
+// optimum's central difference), and a Gauss-Newton step from it.
+struct Followers {
+  std::vector<long> index;
+  std::vector<char> bounded;
+  Eigen::MatrixXd jac;
+
+  Followers(const Layout& layout, const ResidualFn& residual, const Eigen::VectorXd& theta,
+            const Eigen::MatrixXd& theta_jac, const Eigen::VectorXd& r0, std::vector<long> which)
+      : index(std::move(which)) {
+    jac.resize(r0.size(), static_cast<long>(index.size()));
+    Eigen::VectorXd r;
+    for (std::size_t k = 0; k < index.size(); ++k) {
+      const long i = index[k];
+      bounded.push_back(IsBounded(layout, i));
+      if (!bounded.back()) {
+        jac.col(static_cast<long>(k)) = theta_jac.col(i);
+        continue;
+      }
+      const double u = Logistic(theta(i));
+      const double h = u + 1e-4 <= 1.0 ? 1e-4 : -1e-4;
+      Eigen::VectorXd t = theta;
+      t(i) = Logit(u + h);
+      residual(t, &r);
+      jac.col(static_cast<long>(k)) = (r - r0) / h;
+    }
+  }
+
+  // theta moved by the least-squares step that undoes dr (bounded ones kept in their range).
+  Eigen::VectorXd Follow(const Eigen::VectorXd& theta, const Eigen::VectorXd& dr) const {
+    Eigen::VectorXd t = theta;
+    if (index.empty()) return t;
+    const Eigen::VectorXd step = jac.completeOrthogonalDecomposition().solve(-dr);
+    for (std::size_t k = 0; k < index.size(); ++k) {
+      const long i = index[k];
+      const double d = step(static_cast<long>(k));
+      if (!std::isfinite(d)) continue;
+      t(i) = bounded[k] ? Logit(std::clamp(Logistic(theta(i)) + d, 0.0, 1.0)) : theta(i) + d;
+    }
+    return t;
+  }
+};
 
 // -2 ln of the likelihood's mean over one bounded parameter's prior (uniform in its share u of
 // the range: ln(value) for a log-scaled one), by the trapezoid rule on a grid log-spaced in
 // the distance from the optimum u0 (1e-6 to 1 of the range, both sides, clipped to [0, 1]).
-// At each u the parameters spanned by `follow` (an orthonormal basis of their Jacobian
-// columns) follow to first order: the residual's part along them is removed.
-double BoundedMarginal(
-    const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>& residual,
-    const Eigen::VectorXd& theta, long index, const Eigen::MatrixXd& follow,
-    double cost_at_optimum) {
-  const double u0 = 1.0 / (1.0 + std::exp(-theta(index)));
+// At each u the followers take one Gauss-Newton step within their ranges, and the likelihood
+// is the better of the two points, each evaluated in full.
+double BoundedMarginal(const ResidualFn& residual, const Eigen::VectorXd& theta, long index,
+                       const Followers& followers, const Eigen::VectorXd& r0,
+                       double cost_at_optimum) {
+  const double u0 = Logistic(theta(index));
   Eigen::VectorXd t = theta;
-  Eigen::VectorXd r;
+  Eigen::VectorXd r, rf;
   auto likelihood = [&](double u) {
-    const double uc = std::clamp(u, 1e-12, 1.0 - 1e-12);
-    t(index) = std::log(uc / (1.0 - uc));
+    t(index) = Logit(u);
     residual(t, &r);
-    if (follow.cols() > 0) r -= follow * (follow.transpose() * r);
-    const double delta = r.squaredNorm() - cost_at_optimum;
+    double cost = r.squaredNorm();
+    if (!followers.index.empty()) {
+      residual(followers.Follow(t, r - r0), &rf);
+      if (rf.squaredNorm() < cost) cost = rf.squaredNorm();
+    }
+    const double delta = cost - cost_at_optimum;
     return std::isfinite(delta) ? std::exp(-0.5 * std::clamp(delta, -40.0, 1400.0)) : 0.0;
   };
   constexpr int kSteps = 36;
@@ -308,20 +350,24 @@ double BoundedMarginal(
 // nothing for the share of its prior the data exclude). Each is integrated over its prior
 // numerically, in turn, as the chain rule has it: the k-th with the unbounded parameters and
 // the bounded ones after it following (BoundedMarginal), so a valley the data leave open (a
-// rigid J2 at the rotor, or a heavier one at a node) is integrated along, not across. For a
-// Gaussian likelihood inside the range this is Laplace's ln(lambda / 2 pi) per parameter.
-double BoundedPenalty(const Layout& layout,
-                      const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>& residual,
+// rigid J2 at the rotor, or a heavier one at a node) is integrated along, not across, as far
+// as the followers' ranges reach. For a Gaussian likelihood inside the range this is
+// Laplace's ln(lambda / 2 pi) per parameter.
+double BoundedPenalty(const Layout& layout, const ResidualFn& residual,
                       const Eigen::VectorXd& theta, const Eigen::MatrixXd& jac,
                       double cost_at_optimum) {
   std::vector<long> bounded, unbounded;
   for (long i = 0; i < theta.size(); ++i) (IsBounded(layout, i) ? bounded : unbounded).push_back(i);
+  if (bounded.empty()) return 0.0;
+  Eigen::VectorXd r0;
+  residual(theta, &r0);
   double penalty = 0.0;
   for (std::size_t k = 0; k < bounded.size(); ++k) {
     std::vector<long> follow = unbounded;
     follow.insert(follow.end(), bounded.begin() + static_cast<long>(k) + 1, bounded.end());
-    penalty += std::max(0.0, BoundedMarginal(residual, theta, bounded[k], ColumnBasis(jac, follow),
-                                             cost_at_optimum));
+    const Followers followers(layout, residual, theta, jac, r0, std::move(follow));
+    penalty +=
+        std::max(0.0, BoundedMarginal(residual, theta, bounded[k], followers, r0, cost_at_optimum));
   }
   return penalty;
 }
