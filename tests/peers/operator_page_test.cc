@@ -21,6 +21,7 @@
 #include "../support/child_process.h"
 #include "../support/gap_units.h"
 #include "../support/station_ready.h"
+#include "../support/stored_test.h"
 #include "drivers/io/frf_files.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
@@ -35,6 +36,7 @@ using eol::testing::ChildProcess;
 const std::string kBrowserDir = std::string(EOL_SOURCE_DIR) + "/tests/peers/browser";
 
 using eol::testing::PortFromReadyLine;
+using eol::testing::RunStoredTest;
 
 std::string NodeBinary() {
   for (const char* p : {"/usr/local/bin/node", "/usr/bin/node", "/usr/bin/nodejs"})
@@ -91,30 +93,6 @@ std::unique_ptr<ChildProcess> StartPageStation(const eol::testing::TempDir& dir,
       << station->output();
   *port = PortFromReadyLine(station->output());
   return station;
-}
-
-// Starts a test of `serial` over the API and returns its stored summary once finished (null
-// when it was not started or not stored within 30 s). The previous test is stored before the
-// station is idle again (it unclamps after), so a start that meets 409 busy is retried.
-nlohmann::json RunStoredTest(httplib::Client& http, const std::string& serial) {
-  auto start = [&] {
-    return http.Post("/api/tests", nlohmann::json{{"serial", serial}}.dump(), "application/json");
-  };
-  auto res = start();
-  for (int i = 0; i < 200 && res && res->status == 409; ++i) {
-    std::this_thread::sleep_for(50ms);
-    res = start();
-  }
-  if (!res || res->status != 202) return nullptr;
-  for (int i = 0; i < 600; ++i) {
-    res = http.Get("/api/units/" + serial);
-    if (res && res->status == 200) {
-      const auto tests = nlohmann::json::parse(res->body)["tests"];
-      if (!tests.empty() && !tests[0]["finished_at"].get<std::string>().empty()) return tests[0];
-    }
-    std::this_thread::sleep_for(50ms);
-  }
-  return nullptr;
 }
 
 TEST(OperatorPage, ShowsVerdictCurveAndFollowsTestsLive) {

@@ -12,6 +12,7 @@
 
 #include "tests/support/child_process.h"
 #include "tests/support/station_ready.h"
+#include "tests/support/stored_test.h"
 #include "tests/support/token_station.h"
 
 namespace eol {
@@ -49,31 +50,11 @@ class QcApi : public ::testing::Test {
     http_->set_read_timeout(120, 0);
   }
 
-  // Runs a test of `serial` and waits for its verdict. The previous test's record is stored
-  // before the station is idle again (it unclamps and publishes after), so a start may meet
-  // 409 busy for a moment: it is retried.
+  // Runs a test of `serial` and returns its stored outcome, or why there is none.
   std::string Test(const std::string& serial) {
-    auto start = [&] {
-      return http_->Post("/api/tests", Bearer(kOperator), nlohmann::json{{"serial", serial}}.dump(),
-                         "application/json");
-    };
-    httplib::Result res = start();
-    for (int i = 0; i < 200 && res && res->status == 409; ++i) {
-      std::this_thread::sleep_for(50ms);
-      res = start();
-    }
-    if (!res) return "not started: no answer";
-    if (res->status != 202) return "not started: " + std::to_string(res->status) + " " + res->body;
-    for (int i = 0; i < 600; ++i) {
-      const auto unit = http_->Get(("/api/units/" + serial).c_str());
-      if (unit && unit->status == 200) {
-        const auto tests = nlohmann::json::parse(unit->body)["tests"];
-        if (!tests.empty() && !tests.front()["finished_at"].get<std::string>().empty())
-          return tests.front()["outcome"];
-      }
-      std::this_thread::sleep_for(50ms);
-    }
-    return "timeout";
+    std::string why;
+    const nlohmann::json t = eol::testing::RunStoredTest(*http_, serial, Bearer(kOperator), &why);
+    return t.is_null() ? why : t["outcome"].get<std::string>();
   }
 
   eol::testing::TempDir dir_;
