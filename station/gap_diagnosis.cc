@@ -110,6 +110,13 @@ void ReadGapInputs(const std::string& simulation, const std::vector<std::string>
   r->measured.clear();
   for (const std::string& path : measured) {
     io::GapInput m = io::ReadGapMeasurement(path, o.io);
+    // The file's own degrees of freedom (column, periodic estimate or scatter, in the note)
+    // give way to the options'; the note says which one the fit uses.
+    if (!m.sigma_estimated && o.sigma_exact)
+      m.note += "; sigma taken as exact (--sigma-exact)";
+    else if (!m.sigma_estimated && o.sigma_dof > 0.0)
+      m.note += "; sigma^2 on " + std::to_string(std::lround(o.sigma_dof)) +
+                " degrees of freedom as the options give (used instead)";
     KeepBand(&m.frf, o.f_lo_hz, o.f_hi_hz);
     if (m.frf.size() < 10) throw io::FileError(path, 0, 0, "fewer than 10 lines in the band");
     // The report's: the option's, else the smallest of the files' (each unit's is in its note).

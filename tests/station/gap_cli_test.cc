@@ -94,6 +94,11 @@ TEST_F(GapCli, TheSigmasDegreesOfFreedomTestTheResidualAsF) {
                              dir_ / "option.json", "--no-pairs", "--sigma-periods", "4"});
   ASSERT_EQ(option.code, 0) << option.output;
   EXPECT_EQ(ReadJson(dir_ / "option.json")["sigma_dof"], 6.0);
+  // and the unit's note says which degrees of freedom the fit uses.
+  EXPECT_NE(ReadJson(dir_ / "option.json")["measurements"][0]["note"].get<std::string>().find(
+                "sigma^2 on 6 degrees of freedom as the options give"),
+            std::string::npos)
+      << ReadJson(dir_ / "option.json")["measurements"][0]["note"];
   const EolRun both =
       Eol({"gap", "--sim", sim, "--measured", plain, "--sigma-exact", "--sigma-periods", "4"});
   EXPECT_NE(both.code, 0);
