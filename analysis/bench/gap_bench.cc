@@ -85,8 +85,8 @@ AppliedEffect DrawEffect(EffectKind kind, const NominalNetwork& n, const std::ve
       hi = spec.params[0].hi;
       break;
     case EffectKind::kLossyInductance: {
-      const double wc = 2.0 * std::numbers::pi * LogUniform(rng, 0.5 * f_lo, 5.0 * f_hi);
-      make = [wc](double l2) { return std::vector<double>{l2, wc * l2}; };
+      const double fc = LogUniform(rng, 0.5 * f_lo, 5.0 * f_hi);
+      make = [fc](double l2) { return std::vector<double>{l2, fc}; };
       log = true;
       lo = 1e-9 * m.l_h;
       hi = spec.params[0].hi;

@@ -479,8 +479,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
         const double wc = TwoPi() * fc;
         const double l2 = Amplitude(
             l, Shape(l, [&](double f, Cplx) { return -s_of(f) * s_of(f) / (s_of(f) + wc); }), &red);
-        if (l2 > 0.0)
-          c.push_back({red, {std::min(l2, 0.8 * m.l_h), wc * std::min(l2, 0.8 * m.l_h)}});
+        if (l2 > 0.0) c.push_back({red, {std::min(l2, 0.8 * m.l_h), fc}});
       }
       if (c.empty()) c.push_back({0.0, {spec.params[0].scale, spec.params[1].scale}});
       return Best(c, 2);

@@ -29,10 +29,10 @@
 //   stray_capacitance   capacitance_f C: winding and cable capacitance across the terminals;
 //                       Im Z grows faster than w L. 0 < C, self-resonance 1/(2 pi sqrt(L C))
 //                       at least 1.2 f_hi.
-//   lossy_inductance    l2_h, r2_ohm: eddy currents as an L2-R2 branch (the inductance is L at
-//                       low frequency and L - L2 far above the corner R2 / (2 pi L2), where the
-//                       resistance has risen by R2). 0 < L2 <= 0.9 L; corner in
-//                       [0.1 f_lo, 100 f_hi].
+//   lossy_inductance    l2_h, corner_hz: eddy currents as an L2-R2 branch (the inductance is L
+//                       at low frequency and L - L2 far above the corner R2 / (2 pi L2), where
+//                       the resistance has risen by R2). 0 < L2 <= 0.9 L; corner fitted
+//                       within [0.1 f_lo, 100 f_hi] (bounded).
 //   fractional_inductance  inductance_share b, order n, match_hz f_m: eddy currents in
 //                       laminations as a fractional-order (semi-)inductance
 //                       Z_L = s L (1 - b) + K (j w)^n, K = b L w_m^(1 - n): the share b of L
@@ -215,7 +215,7 @@ double FixtureLossKeepingQ(double kappa, double q);
 // Quantities derived from fitted parameters for reports (name, unit, value):
 //   fixture_compliance: k_fixture_nm_per_rad (when J is known), f_loaded_hz;
 //   coupled_inertia:    j2_kg_m2, k2_nm_per_rad (when J is known);
-//   lossy_inductance:   corner_hz.
+//   lossy_inductance:   r2_ohm.
 struct DerivedParam {
   std::string name;
   std::string unit;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "analysis/gap/diagnosis.h"
@@ -92,14 +93,15 @@ TEST_P(RecoverEffect, NamesItAndFindsItsParameters) {
 
 INSTANTIATE_TEST_SUITE_P(
     EachEffect, RecoverEffect,
-    ::testing::Values(Case{EffectKind::kSeriesResistance, {0.02}, false},
-                      Case{EffectKind::kChannelDelay, {4e-6}, false},
-                      Case{EffectKind::kStrayCapacitance, {2e-7}, false},
-                      Case{EffectKind::kLossyInductance, {1e-4, 2.0}, false},
-                      Case{EffectKind::kSkinEffect, {0.1}, false},
-                      Case{EffectKind::kFixtureCompliance, {0.44, 0.03}, true},
-                      Case{EffectKind::kSecondMode, {560.0, 60.0, 0.05}, false},
-                      Case{EffectKind::kAdhesiveCreep, {0.05}, false}),
+    ::testing::Values(
+        Case{EffectKind::kSeriesResistance, {0.02}, false},
+        Case{EffectKind::kChannelDelay, {4e-6}, false},
+        Case{EffectKind::kStrayCapacitance, {2e-7}, false},
+        Case{EffectKind::kLossyInductance, {1e-4, 2.0 / (2.0 * std::numbers::pi * 1e-4)}, false},
+        Case{EffectKind::kSkinEffect, {0.1}, false},
+        Case{EffectKind::kFixtureCompliance, {0.44, 0.03}, true},
+        Case{EffectKind::kSecondMode, {560.0, 60.0, 0.05}, false},
+        Case{EffectKind::kAdhesiveCreep, {0.05}, false}),
     [](const ::testing::TestParamInfo<Case>& i) { return std::string(ToString(i.param.kind)); });
 
 TEST(GapDiagnosis, PureNoiseIsNone) {

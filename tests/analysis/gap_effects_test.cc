@@ -42,7 +42,7 @@ TEST(GapEffects, NeutralParametersGiveTheNominal) {
   const std::vector<AppliedEffect> neutral = {{EffectKind::kSeriesResistance, {0.0}},
                                               {EffectKind::kChannelDelay, {0.0}},
                                               {EffectKind::kStrayCapacitance, {0.0}},
-                                              {EffectKind::kLossyInductance, {1e-15, 1.0}},
+                                              {EffectKind::kLossyInductance, {1e-15, 1e3}},
                                               {EffectKind::kSkinEffect, {0.0}},
                                               {EffectKind::kFixtureCompliance, {1e15, 0.0}},
                                               {EffectKind::kSecondMode, {500.0, 30.0, 0.0}},
@@ -72,8 +72,8 @@ TEST(GapEffects, ElectricalEffectsFollowTheirEquations) {
               1e-12);
   EXPECT_NEAR(std::abs(eval(EffectKind::kStrayCapacitance, {1e-7}) - z0 / (1.0 + s * 1e-7 * z0)),
               0.0, 1e-12);
-  const double l2 = 2e-4, r2 = 3.0;
-  EXPECT_NEAR(std::abs(eval(EffectKind::kLossyInductance, {l2, r2}) -
+  const double l2 = 2e-4, r2 = 3.0, corner = r2 / (2.0 * std::numbers::pi * l2);
+  EXPECT_NEAR(std::abs(eval(EffectKind::kLossyInductance, {l2, corner}) -
                        (z0 - s * l2 + s * l2 * r2 / (s * l2 + r2))),
               0.0, 1e-12);
   EXPECT_NEAR(
@@ -84,7 +84,7 @@ TEST(GapEffects, ElectricalEffectsFollowTheirEquations) {
                        (z0 + 0.1 / (1.0 + 40.0 * (s / w2 + w2 / s)))),
               0.0, 1e-12);
   // Lossy inductance: the inductance falls and the resistance rises above the corner.
-  const Cplx lossy = eval(EffectKind::kLossyInductance, {l2, r2});
+  const Cplx lossy = eval(EffectKind::kLossyInductance, {l2, corner});
   EXPECT_GT(lossy.real(), z0.real());
   EXPECT_LT(lossy.imag(), z0.imag());
 }
@@ -135,10 +135,13 @@ TEST(GapEffects, PlausibilityBoundsNameTheParameter) {
   EXPECT_EQ(stray.params[0].name, "capacitance_f");
   EXPECT_FALSE(IsPlausible(stray, {EffectKind::kStrayCapacitance, {1e-3}}, &why));
   const EffectSpec eddy = DescribeEffect(EffectKind::kLossyInductance, n, 200.0, 800.0);
-  // Corner 1 Hz: far below the band, an eddy branch cannot be told from a smaller L.
-  EXPECT_FALSE(IsPlausible(
-      eddy, {EffectKind::kLossyInductance, {1e-4, 2.0 * std::numbers::pi * 1e-4}}, &why));
-  EXPECT_NE(why.find("corner"), std::string::npos) << why;
+  // Corner 1 Hz: far below the band, an eddy branch cannot be told from a smaller L (the
+  // fit's bound keeps it at 0.1 f_lo or above).
+  EXPECT_EQ(eddy.params[1].name, "corner_hz");
+  EXPECT_DOUBLE_EQ(eddy.params[1].lo, 20.0);
+  EXPECT_TRUE(eddy.params[1].bounded);
+  EXPECT_FALSE(IsPlausible(eddy, {EffectKind::kLossyInductance, {1e-4, 1.0}}, &why));
+  EXPECT_NE(why.find("corner_hz"), std::string::npos) << why;
   NominalNetwork m;
   m.quantity = Quantity::kMobility;
   m.rigid = {100.0, 10.0};
