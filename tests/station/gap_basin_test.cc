@@ -47,6 +47,13 @@ BlindCase Load(const std::string& name, const std::string& dir = kCoupled) {
   return c;
 }
 
+// The diagnosis with its default options, without the held-out split (not what these test).
+analysis::GapSummary Diagnose(const BlindCase& c) {
+  analysis::GapOptions o;
+  o.heldout = false;
+  return analysis::DiagnoseGap(c.nominal, {c.unit}, o);
+}
+
 // The ranking's entry for `effect` (the test fails when there is none).
 analysis::RankedEffect Ranked(const analysis::GapSummary& s, const std::string& effect) {
   for (const analysis::RankedEffect& r : s.ranking)
@@ -199,9 +206,7 @@ TEST(GapBasin, ARigidCouplingCompetesAtItsBound) {
 // afterwards, the fit ran to R2 = 0, was rejected, and a channel delay was named.)
 TEST(GapBasin, AnEddyCornerBelowTheBandSitsAtItsBound) {
   const BlindCase c = Load("seed51-case-063", kEddy);
-  analysis::GapOptions o;
-  o.heldout = false;
-  const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
+  const analysis::GapSummary s = Diagnose(c);
   ASSERT_TRUE(s.usable) << s.message;
   EXPECT_EQ(s.effect, "lossy_inductance") << s.message;
   const analysis::RankedEffect lossy = Ranked(s, "lossy_inductance");
@@ -223,9 +228,7 @@ TEST(GapBasin, AnEddyCornerBelowTheBandSitsAtItsBound) {
 // penalties are alike and the delay is named.
 TEST(GapBasin, ASmallDelayIsChargedOnALogPriorLikeTheSkinEffect) {
   const BlindCase c = Load("case-019", std::string(EOL_TEST_DATA_DIR) + "/gap-independent-delay/");
-  analysis::GapOptions o;
-  o.heldout = false;
-  const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
+  const analysis::GapSummary s = Diagnose(c);
   ASSERT_TRUE(s.usable) << s.message;
   EXPECT_EQ(s.effect, "channel_delay") << s.message;
   const analysis::RankedEffect delay = Ranked(s, "channel_delay");
