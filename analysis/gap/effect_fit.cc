@@ -95,6 +95,14 @@ double FromShare(const EffectParamSpec& ps, double u) {
   return ps.lo + u * (ps.hi - ps.lo);
 }
 
+// The logistic map a bounded parameter's share u of its range is fitted on, and back (u kept
+// within 1e-12 of either end).
+double Logistic(double t) { return 1.0 / (1.0 + std::exp(-t)); }
+double Logit(double u) {
+  const double uc = std::clamp(u, 1e-12, 1.0 - 1e-12);
+  return std::log(uc / (1.0 - uc));
+}
+
 // theta <-> natural parameters of a list of effects.
 struct Layout {
   std::vector<EffectSpec> specs;
@@ -113,8 +121,7 @@ struct Layout {
         const EffectParamSpec& ps = specs[e].params[p];
         const double v = effects[e].params[p];
         if (ps.bounded) {
-          const double u = std::clamp(BoundedShare(ps, v), 1e-6, 1.0 - 1e-6);
-          t(i) = std::log(u / (1.0 - u));
+          t(i) = Logit(std::clamp(BoundedShare(ps, v), 1e-6, 1.0 - 1e-6));
         } else {
           t(i) = ps.log_scale ? std::log(std::max(v, 1e-9 * ps.scale)) : v / ps.scale;
         }
@@ -128,7 +135,7 @@ struct Layout {
       for (std::size_t p = 0; p < out[e].params.size(); ++p, ++i) {
         const EffectParamSpec& ps = specs[e].params[p];
         if (ps.bounded)
-          out[e].params[p] = FromShare(ps, 1.0 / (1.0 + std::exp(-t(i))));
+          out[e].params[p] = FromShare(ps, Logistic(t(i)));
         else
           out[e].params[p] = ps.log_scale ? std::exp(t(i)) : t(i) * ps.scale;
       }
@@ -233,7 +240,7 @@ double OccamPenalty(const Layout& layout, const std::vector<AppliedEffect>& at,
   long i = 0;
   for (std::size_t e = 0; e < at.size(); ++e)
     for (std::size_t p = 0; p < at[e].params.size(); ++p, ++i)
-      if (!IsBounded(layout, i)) {
+      if (!layout.specs[e].params[p].bounded) {
         keep.push_back(i);
         widths.push_back(PriorWidth(layout, at, e, p));
       }
@@ -253,47 +260,49 @@ double OccamPenalty(const Layout& layout, const std::vector<AppliedEffect>& at,
 
 using ResidualFn = std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>;
 
-double Logistic(double t) { return 1.0 / (1.0 + std::exp(-t)); }
-double Logit(double u) {
-  const double uc = std::clamp(u, 1e-12, 1.0 - 1e-12);
-  return std::log(uc / (1.0 - uc));
+// The Jacobian of the residual at the optimum, each parameter in its own coordinate: a bounded
+// one's share u of its range (a one-sided difference into the range), an unbounded one's theta
+// (the optimum's central difference, `theta_jac`).
+Eigen::MatrixXd OwnCoordinateJacobian(const Layout& layout, const ResidualFn& residual,
+                                      const Eigen::VectorXd& theta,
+                                      const Eigen::MatrixXd& theta_jac, const Eigen::VectorXd& r0) {
+  Eigen::MatrixXd jac = theta_jac;
+  Eigen::VectorXd r;
+  for (long i = 0; i < theta.size(); ++i) {
+    if (!IsBounded(layout, i)) continue;
+    const double u = Logistic(theta(i));
+    const double h = u + 1e-4 <= 1.0 ? 1e-4 : -1e-4;
+    Eigen::VectorXd t = theta;
+    t(i) = Logit(u + h);
+    residual(t, &r);
+    jac.col(i) = (r - r0) / h;
+  }
+  return jac;
 }
 
-// The parameters that follow a bounded one while it is integrated over (BoundedMarginal): the
-// Jacobian of the residual at the optimum in their own coordinates (a bounded one's share u
-// of its range, by a one-sided difference into the range; an unbounded one's theta, the
-// optimum's central difference), and a Gauss-Newton step from it.
+// The parameters that follow a bounded one while it is integrated over (BoundedMarginal):
+// their columns of the own-coordinate Jacobian (OwnCoordinateJacobian), decomposed once, and
+// the Gauss-Newton step from it.
 struct Followers {
   std::vector<long> index;
   std::vector<char> bounded;
-  Eigen::MatrixXd jac;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> solver;
 
-  Followers(const Layout& layout, const ResidualFn& residual, const Eigen::VectorXd& theta,
-            const Eigen::MatrixXd& theta_jac, const Eigen::VectorXd& r0, std::vector<long> which)
+  Followers(const Layout& layout, const Eigen::MatrixXd& own_jac, std::vector<long> which)
       : index(std::move(which)) {
-    jac.resize(r0.size(), static_cast<long>(index.size()));
-    Eigen::VectorXd r;
+    Eigen::MatrixXd jac(own_jac.rows(), static_cast<long>(index.size()));
     for (std::size_t k = 0; k < index.size(); ++k) {
-      const long i = index[k];
-      bounded.push_back(IsBounded(layout, i));
-      if (!bounded.back()) {
-        jac.col(static_cast<long>(k)) = theta_jac.col(i);
-        continue;
-      }
-      const double u = Logistic(theta(i));
-      const double h = u + 1e-4 <= 1.0 ? 1e-4 : -1e-4;
-      Eigen::VectorXd t = theta;
-      t(i) = Logit(u + h);
-      residual(t, &r);
-      jac.col(static_cast<long>(k)) = (r - r0) / h;
+      bounded.push_back(IsBounded(layout, index[k]));
+      jac.col(static_cast<long>(k)) = own_jac.col(index[k]);
     }
+    if (!index.empty()) solver.compute(jac);
   }
 
   // theta moved by the least-squares step that undoes dr (bounded ones kept in their range).
   Eigen::VectorXd Follow(const Eigen::VectorXd& theta, const Eigen::VectorXd& dr) const {
     Eigen::VectorXd t = theta;
     if (index.empty()) return t;
-    const Eigen::VectorXd step = jac.completeOrthogonalDecomposition().solve(-dr);
+    const Eigen::VectorXd step = solver.solve(-dr);
     for (std::size_t k = 0; k < index.size(); ++k) {
       const long i = index[k];
       const double d = step(static_cast<long>(k));
@@ -353,19 +362,20 @@ double BoundedMarginal(const ResidualFn& residual, const Eigen::VectorXd& theta,
 // rigid J2 at the rotor, or a heavier one at a node) is integrated along, not across, as far
 // as the followers' ranges reach. For a Gaussian likelihood inside the range this is
 // Laplace's ln(lambda / 2 pi) per parameter.
+// r0: the residual at the optimum theta; jac: its central-difference Jacobian in theta.
 double BoundedPenalty(const Layout& layout, const ResidualFn& residual,
-                      const Eigen::VectorXd& theta, const Eigen::MatrixXd& jac,
-                      double cost_at_optimum) {
+                      const Eigen::VectorXd& theta, const Eigen::VectorXd& r0,
+                      const Eigen::MatrixXd& jac) {
   std::vector<long> bounded, unbounded;
   for (long i = 0; i < theta.size(); ++i) (IsBounded(layout, i) ? bounded : unbounded).push_back(i);
   if (bounded.empty()) return 0.0;
-  Eigen::VectorXd r0;
-  residual(theta, &r0);
+  const double cost_at_optimum = r0.squaredNorm();
+  const Eigen::MatrixXd own_jac = OwnCoordinateJacobian(layout, residual, theta, jac, r0);
   double penalty = 0.0;
   for (std::size_t k = 0; k < bounded.size(); ++k) {
     std::vector<long> follow = unbounded;
     follow.insert(follow.end(), bounded.begin() + static_cast<long>(k) + 1, bounded.end());
-    const Followers followers(layout, residual, theta, jac, r0, std::move(follow));
+    const Followers followers(layout, own_jac, std::move(follow));
     penalty +=
         std::max(0.0, BoundedMarginal(residual, theta, bounded[k], followers, r0, cost_at_optimum));
   }
@@ -704,7 +714,7 @@ EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineM
   const Eigen::MatrixXd information = jac.transpose() * jac;
   if (InvertInformation(information, &inverse)) cov = inverse;
   out.occam = OccamPenalty(layout, out.effects, information);
-  out.occam += BoundedPenalty(layout, problem.residual, theta, jac, out.cost);
+  out.occam += BoundedPenalty(layout, problem.residual, theta, r, jac);
   int i = 0;
   out.sigma.resize(out.effects.size());
   for (std::size_t e = 0; e < out.effects.size(); ++e)

@@ -31,10 +31,11 @@
 // band: f2 anywhere above it), where Laplace sees no curvature and would charge nothing for
 // the part of the prior the data exclude. Each is integrated over its prior (uniform in its
 // share of the range) numerically instead, -2 ln of the likelihood's mean, in turn as the
-// chain rule has it: the unbounded parameters and the bounded ones after it follow to first
-// order (the residual's part along their Jacobian columns is removed), so a valley the data
-// leave open (a rigid J2 at the rotor, or a heavier one at a node) is integrated along. For a
-// Gaussian likelihood inside the range it is Laplace's ln(lambda / 2 pi).
+// chain rule has it: the unbounded parameters and the bounded ones after it follow (one
+// Gauss-Newton step within their ranges, the better of the two points evaluated in full), so a
+// valley the data leave open (a rigid J2 at the rotor, or a heavier one at a node) is
+// integrated along. For a Gaussian likelihood inside the range it is Laplace's
+// ln(lambda / 2 pi).
 // Of the local optima the starts reach, an effect is scored in the one of best evidence (a
 // narrow basin that fits a few noisy lines pays for pinning its parameters).
 // Parameters are fitted as ln(value) (positive, wide-ranging ones) or value / scale, with
