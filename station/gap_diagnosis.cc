@@ -154,6 +154,7 @@ void DiagnoseGapReport(const GapRunOptions& o, GapReport* r) {
     u.freq_hz = m.frf.freq_hz;
     u.value = m.frf.value;
     u.sigma = m.sigma_estimated ? m.frf.sigma : analysis::PoolLineSigma(m.frf, o.sigma_pool);
+    u.sigma_smooth = m.sigma_estimated || o.sigma_pool > 0;
     u.sigma_dof = UnitSigmaDof(m, o);
     units.push_back(std::move(u));
   }

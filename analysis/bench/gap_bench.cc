@@ -201,6 +201,7 @@ GapBenchCase RunCase(const GapBenchOptions& o, const Excitation& ex, int index,
   u.freq_hz = meas.frf.freq_hz;
   u.value = meas.frf.value;
   u.sigma = PoolLineSigma(meas.frf, o.sigma_pool);
+  u.sigma_smooth = o.sigma_pool > 0;
   const GapSummary s = DiagnoseGap(cal.nominal, {u}, o.gap);
   if (detail) *detail = s;
   if (!s.usable) {

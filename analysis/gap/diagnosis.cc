@@ -407,9 +407,10 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
   std::vector<GapUnit> formed = units;
   int admittance = 0;
   for (GapUnit& u : formed) {
-    u.admittance = nominal.quantity == Quantity::kImpedanceOhm &&
-                   (o.residual_form == ResidualForm::kAdmittance ||
-                    (o.residual_form == ResidualForm::kAuto && CurrentNoiseDominates(u)));
+    u.admittance =
+        nominal.quantity == Quantity::kImpedanceOhm &&
+        (o.residual_form == ResidualForm::kAdmittance ||
+         (o.residual_form == ResidualForm::kAuto && !u.sigma_smooth && CurrentNoiseDominates(u)));
     admittance += u.admittance ? 1 : 0;
   }
   s.residual_form = admittance == 0                                 ? "impedance"

@@ -54,7 +54,8 @@ enum class ResidualForm { kAuto, kImpedance, kAdmittance };
 struct GapOptions {
   BandSearchOptions bands;
   // kAuto: admittance for a unit whose noise is the current's (CurrentNoiseDominates,
-  // effect_fit.h), else impedance. Mobility is always fitted as measured.
+  // effect_fit.h) and whose sigma is the line's own (not GapUnit::sigma_smooth), else
+  // impedance. Mobility is always fitted as measured.
   ResidualForm residual_form = ResidualForm::kAuto;
   double min_score_gain = 10.0;  // BIC units
   // chi2 test of "consistent with the noise": z at most this. High (near the band threshold)

@@ -72,6 +72,10 @@ struct GapUnit {
   // times the lines pooled; 0 when sigma is known exactly.
   double sigma_dof = 0.0;
   bool admittance = false;  // residual form (above); impedance quantity only
+  // sigma does not depend on the line's own noise draw (estimated from the line-to-line
+  // scatter, or pooled over neighbours: noise.h): the impedance form is unbiased for it, and
+  // the admittance form's |H_meas|^2 would bring the draw back; DiagnoseGap keeps impedance.
+  bool sigma_smooth = false;
 
   std::size_t size() const { return freq_hz.size(); }
 };

@@ -6,14 +6,23 @@
 // locally linear over three lines. The relative form rho_k = |d_k|^2 / (6 |H_k|^2) is
 // median-filtered over 2 half_window + 1 lines (robust to the few lines where a sharp peak
 // is not locally linear) and converted back: sigma_k^2 = |H_k|^2 median(rho) / ln 2 (the
-// median of an exponential variable is ln 2 times its mean). This assumes the noise is
+// median of an exponential variable is ln 2 times its mean), |H_k| taken from the line's
+// neighbours (NeighbourMagnitude), not from the line itself. This assumes the noise is
 // proportional to |H| locally (a noise floor that is smooth relative to the response).
+//
+// Why the neighbours: a sigma proportional to the line's own |H_k| depends on the line's noise
+// draw. A line whose noise pulled |H| low gets a small sigma and a large weight, so every fit
+// leans toward a lower |H|, most where the noise is large; in the admittance form (effect_fit.h)
+// toward a lower |1/H|, which an added capacitance jwC mimics at high frequency. On 70 files of
+// the independent generator stripped of their sigma (seed 1, tests/peers/
+// independent_gap_cases.py) the line's own |H_k| had 5 of the 65 separable cases answered
+// as a pair with stray_capacitance (56 of 65 named); from the neighbours, none (60 of 65).
 //
 // Pooling (sigma from few periods): a variance estimated from P periods has about
 // 2 (P - 1) degrees of freedom, so 1/sigma_hat^2 is biased up (by 1.5 for P = 4) and the
 // normalised residual is heavy-tailed. The relative variance sigma_k^2 / |H_k|^2 is averaged
 // over 2 half_width + 1 lines and converted back, which multiplies the degrees of freedom by
-// the window while following |H| through a resonance.
+// the window while following |H| through a resonance (|H_k| from the neighbours, as above).
 //
 // Degrees of freedom of a sigma that does not say (a file with sigma but no sigma_dof column):
 // a variance estimated from a few periods is sigma_k^2 chi2_nu / nu, so x_k = ln sigma_hat_k^2
@@ -34,8 +43,15 @@
 
 namespace eol::analysis {
 
+// |H_k| of every line from its neighbours alone: |a| of the least-squares a + c x^2 through
+// the lines k +- 1 .. k +- m (x the offset in lines, m = half_width, fewer near the ends; the
+// mean of the two when m = 1; |H_k| itself at the end lines). Independent of line k's noise,
+// exact for a curve locally quadratic over the window; its own noise variance is sigma^2 / 2
+// for m = 3 (weights (7 - x^2) / 14).
+std::vector<double> NeighbourMagnitude(const Frf& h, int half_width = 3);
+
 // sigma for every line of h (at least 5 lines, roughly uniform spacing). The two end lines
-// take their neighbour's value.
+// take their neighbour's relative value.
 std::vector<double> EstimateLineSigma(const Frf& h, int half_window = 25);
 
 // h.sigma pooled as above (half_width 0 returns it unchanged). h must have sigma.

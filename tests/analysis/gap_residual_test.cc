@@ -88,6 +88,60 @@ TEST(GapResidual, NoiseEstimateAndPooling) {
   EXPECT_EQ(PoolLineSigma(h, 0), h.sigma);
 }
 
+TEST(GapResidual, NeighbourMagnitudeIsExactForAQuadraticAndLeavesTheLineOut) {
+  Frf h;
+  h.freq_hz = Freqs(12);
+  for (double f : h.freq_hz) {
+    const double x = f - 205.0;
+    h.value.push_back({3.0 + 0.2 * x + 0.05 * x * x, 1.0 - 0.1 * x});
+  }
+  const std::vector<double> exact = NeighbourMagnitude(h);
+  for (std::size_t k = 1; k + 1 < h.size(); ++k)
+    if (k >= 2 && k + 2 < h.size()) EXPECT_NEAR(exact[k], std::abs(h.value[k]), 1e-9) << k;
+  // A spike on line 6 moves its neighbours' estimates, not its own.
+  Frf spiked = h;
+  spiked.value[6] += 100.0;
+  const std::vector<double> mag = NeighbourMagnitude(spiked);
+  EXPECT_DOUBLE_EQ(mag[6], exact[6]);
+  EXPECT_GT(std::abs(mag[5] - exact[5]), 10.0);
+  EXPECT_DOUBLE_EQ(mag[0], std::abs(spiked.value[0]));  // the end lines: their own
+}
+
+// The estimated sigma must not follow the line's own noise draw: with sigma proportional to
+// the line's |H_k|, the lines whose noise pulled |H| low weigh most and the 1/sigma^2-weighted
+// mean of the relative error along H is about -eps^2 (-0.09 here, ten standard errors).
+TEST(GapResidual, EstimatedSigmaDoesNotWeighTheLinesByTheirOwnNoise) {
+  MotionalImpedance m{0.5, 2e-3, 0.51, 390.0, 50.0};
+  const Frf clean = m.Evaluate(Freqs(601));
+  Frf h = clean;
+  std::mt19937_64 rng(11);
+  const double eps = 0.3;
+  std::normal_distribution<double> g(0.0, eps * std::sqrt(0.5));
+  for (auto& v : h.value) v += std::abs(v) * std::complex<double>(g(rng), g(rng));
+  const std::vector<double> est = EstimateLineSigma(h);
+  double num = 0.0, den = 0.0;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    const double along = std::real((h.value[k] - clean.value[k]) / clean.value[k]);
+    const double w = std::norm(clean.value[k]) / (est[k] * est[k]);
+    num += w * along;
+    den += w;
+  }
+  const double standard_error = eps * std::sqrt(0.5 / static_cast<double>(h.size()));
+  EXPECT_LT(std::abs(num / den), 3.0 * standard_error) << num / den;
+  // Pooling converts back the same way.
+  h.sigma.assign(h.size(), 0.0);
+  for (std::size_t k = 0; k < h.size(); ++k) h.sigma[k] = eps * std::abs(h.value[k]);
+  const std::vector<double> pooled = PoolLineSigma(h, 5);
+  num = den = 0.0;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    const double along = std::real((h.value[k] - clean.value[k]) / clean.value[k]);
+    const double w = std::norm(clean.value[k]) / (pooled[k] * pooled[k]);
+    num += w * along;
+    den += w;
+  }
+  EXPECT_LT(std::abs(num / den), 3.0 * standard_error) << num / den;
+}
+
 TEST(GapResidual, TrigammaKnownValues) {
   const double pi2 = std::numbers::pi * std::numbers::pi;
   EXPECT_NEAR(Trigamma(1.0), pi2 / 6.0, 1e-10);
