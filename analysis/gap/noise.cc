@@ -8,23 +8,19 @@
 
 namespace eol::analysis {
 
-std::vector<double> NeighbourMagnitude(const Frf& h, int half_width) {
+std::vector<double> NeighbourMagnitude(const Frf& h, std::span<const double> rel_var,
+                                       int half_width) {
   const std::size_t n = h.size();
   std::vector<double> out(n);
   for (std::size_t k = 0; k < n; ++k) {
+    out[k] = std::abs(h.value[k]);
     // The widest symmetric window that fits, at most half_width lines each side.
     const std::size_t m =
         std::min({static_cast<std::size_t>(std::max(0, half_width)), k, n - 1 - k});
-    if (m == 0) {
-      out[k] = std::abs(h.value[k]);
-      continue;
-    }
-    if (m == 1) {
-      out[k] = std::abs(0.5 * (h.value[k - 1] + h.value[k + 1]));
-      continue;
-    }
+    if (m == 0) continue;
     // Least squares a + c x^2 through offsets +-1..+-m: a = sum w(x) H(x),
-    // w(x) = (S4 - S2 x^2) / (N S4 - S2^2), N = 2m, S2 = sum x^2, S4 = sum x^4.
+    // w(x) = (S4 - S2 x^2) / (N S4 - S2^2), N = 2m, S2 = sum x^2, S4 = sum x^4 (m = 1: the
+    // mean of the two).
     double s2 = 0.0, s4 = 0.0;
     for (std::size_t x = 1; x <= m; ++x) {
       const double x2 = static_cast<double>(x * x);
@@ -33,12 +29,18 @@ std::vector<double> NeighbourMagnitude(const Frf& h, int half_width) {
     }
     const double den = 2.0 * static_cast<double>(m) * s4 - s2 * s2;
     std::complex<double> a = 0.0;
+    double w2 = 0.0;  // sum of the squared weights: a's noise variance over sigma^2
     for (std::size_t x = 1; x <= m; ++x) {
-      const double w = (s4 - s2 * static_cast<double>(x * x)) / den;
+      const double w = m == 1 ? 0.5 : (s4 - s2 * static_cast<double>(x * x)) / den;
       a += w * (h.value[k - x] + h.value[k + x]);
+      w2 += 2.0 * w * w;
     }
-    // Neighbours that cancel (a pathological curve): the line's own magnitude.
-    out[k] = std::abs(a) > 0.0 ? std::abs(a) : std::abs(h.value[k]);
+    // Kept only where the neighbours predict the line within its noise: E|H_k - a|^2 =
+    // (1 + w2) sigma_k^2, and beyond 9 times that (probability e^-9 for noise) the curve is
+    // not locally quadratic at the line (a mode or notch a few lines wide, a glitch).
+    const double rel = k < rel_var.size() ? rel_var[k] : 0.0;
+    if (std::norm(h.value[k] - a) > 9.0 * (1.0 + w2) * rel * std::norm(h.value[k])) continue;
+    if (std::abs(a) > 0.0) out[k] = std::abs(a);
   }
   return out;
 }
@@ -56,16 +58,17 @@ std::vector<double> EstimateLineSigma(const Frf& h, int half_window) {
   rho[0] = rho[1];
   rho[n - 1] = rho[n - 2];
   const int w = std::max(1, half_window);
-  const std::vector<double> mag = NeighbourMagnitude(h);
-  std::vector<double> window;
+  std::vector<double> rel(n), window;
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t lo = k > static_cast<std::size_t>(w) ? k - static_cast<std::size_t>(w) : 0;
     const std::size_t hi = std::min(n - 1, k + static_cast<std::size_t>(w));
     window.assign(rho.begin() + static_cast<long>(lo), rho.begin() + static_cast<long>(hi) + 1);
     const auto mid = window.begin() + static_cast<long>(window.size() / 2);
     std::nth_element(window.begin(), mid, window.end());
-    sigma[k] = mag[k] * std::sqrt(*mid / std::numbers::ln2);
+    rel[k] = *mid / std::numbers::ln2;
   }
+  const std::vector<double> mag = NeighbourMagnitude(h, rel);
+  for (std::size_t k = 0; k < n; ++k) sigma[k] = mag[k] * std::sqrt(rel[k]);
   return sigma;
 }
 
@@ -75,16 +78,18 @@ std::vector<double> PoolLineSigma(const Frf& h, int half_width) {
   std::vector<double> rel(n);
   for (std::size_t k = 0; k < n; ++k)
     rel[k] = h.sigma[k] * h.sigma[k] / std::max(std::norm(h.value[k]), 1e-300);
-  std::vector<double> out(n);
-  const std::vector<double> mag = NeighbourMagnitude(h);
+  std::vector<double> pooled(n);
   const std::size_t w = static_cast<std::size_t>(half_width);
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t lo = k > w ? k - w : 0;
     const std::size_t hi = std::min(n - 1, k + w);
     double sum = 0.0;
     for (std::size_t j = lo; j <= hi; ++j) sum += rel[j];
-    out[k] = mag[k] * std::sqrt(sum / static_cast<double>(hi - lo + 1));
+    pooled[k] = sum / static_cast<double>(hi - lo + 1);
   }
+  const std::vector<double> mag = NeighbourMagnitude(h, pooled);
+  std::vector<double> out(n);
+  for (std::size_t k = 0; k < n; ++k) out[k] = mag[k] * std::sqrt(pooled[k]);
   return out;
 }
 

@@ -15,8 +15,8 @@
 // leans toward a lower |H|, most where the noise is large; in the admittance form (effect_fit.h)
 // toward a lower |1/H|, which an added capacitance jwC mimics at high frequency. On 70 files of
 // the independent generator stripped of their sigma (seed 1, tests/peers/
-// independent_gap_cases.py) the line's own |H_k| had 5 of the 65 separable cases answered
-// as a pair with stray_capacitance (56 of 65 named); from the neighbours, none (60 of 65).
+// independent_gap_cases.py) the line's own |H_k| had 5 of the 59 separable cases answered
+// as a pair with stray_capacitance (53 of 59 named); from the neighbours, none (57 of 59).
 //
 // Pooling (sigma from few periods): a variance estimated from P periods has about
 // 2 (P - 1) degrees of freedom, so 1/sigma_hat^2 is biased up (by 1.5 for P = 4) and the
@@ -47,8 +47,12 @@ namespace eol::analysis {
 // the lines k +- 1 .. k +- m (x the offset in lines, m = half_width, fewer near the ends; the
 // mean of the two when m = 1; |H_k| itself at the end lines). Independent of line k's noise,
 // exact for a curve locally quadratic over the window; its own noise variance is sigma^2 / 2
-// for m = 3 (weights (7 - x^2) / 14).
-std::vector<double> NeighbourMagnitude(const Frf& h, int half_width = 3);
+// for m = 3 (weights (7 - x^2) / 14). Where the neighbours miss the line by more than its
+// noise allows (|H_k - a|^2 above 9 times its expectation (1 + sum w^2) rel_var_k |H_k|^2,
+// rel_var_k = sigma_k^2 / |H_k|^2: a mode or notch a few lines wide, a glitch), the line's own
+// |H_k|: the neighbours' value would put a tiny sigma on a narrow peak.
+std::vector<double> NeighbourMagnitude(const Frf& h, std::span<const double> rel_var,
+                                       int half_width = 3);
 
 // sigma for every line of h (at least 5 lines, roughly uniform spacing). The two end lines
 // take their neighbour's relative value.

@@ -195,23 +195,28 @@ def cmd_derive(args):
     }, indent=1))
 
 
-def neighbour_magnitude(z, half_width=3):
+def neighbour_magnitude(z, rel_var, half_width=3):
     """analysis/gap/noise.cc NeighbourMagnitude: |a| of the least-squares a + c x^2 through the
     lines k +- 1 .. k +- m (m = half_width, fewer near the ends; their mean when m = 1; |z[k]|
-    itself at the end lines): line k's magnitude from its neighbours alone."""
+    itself at the end lines): line k's magnitude from its neighbours alone, unless they miss
+    the line by more than 9 times the difference's expected (1 + sum w^2) rel_var |z[k]|^2."""
     n = len(z)
     out = np.abs(z).astype(float)
     for k in range(n):
         m = min(half_width, k, n - 1 - k)
         if m == 0:
             continue
+        x = np.arange(1, m + 1)
         if m == 1:
-            a = 0.5 * (z[k - 1] + z[k + 1])
+            w = np.array([0.5])
         else:
-            x2 = np.arange(1, m + 1) ** 2.0
+            x2 = x ** 2.0
             s2, s4 = 2.0 * x2.sum(), 2.0 * (x2 ** 2).sum()
             w = (s4 - s2 * x2) / (2.0 * m * s4 - s2 * s2)
-            a = np.sum(w * (z[k - np.arange(1, m + 1)] + z[k + np.arange(1, m + 1)]))
+        a = np.sum(w * (z[k - x] + z[k + x]))
+        w2 = 2.0 * np.sum(w ** 2)
+        if abs(z[k] - a) ** 2 > 9.0 * (1.0 + w2) * rel_var[k] * abs(z[k]) ** 2:
+            continue
         if abs(a) > 0.0:
             out[k] = abs(a)
     return out
@@ -220,16 +225,15 @@ def neighbour_magnitude(z, half_width=3):
 def estimate_line_sigma(z, half_window=25):
     """analysis/gap/noise.cc EstimateLineSigma, line for line."""
     n = len(z)
-    mag = neighbour_magnitude(z)
     rho = np.zeros(n)
     d = z[:-2] - 2.0 * z[1:-1] + z[2:]
     rho[1:-1] = np.abs(d) ** 2 / (6.0 * np.maximum(np.abs(z[1:-1]) ** 2, 1e-300))
     rho[0], rho[-1] = rho[1], rho[-2]
-    sigma = np.empty(n)
+    rel = np.empty(n)
     for k in range(n):
         win = np.sort(rho[max(0, k - half_window):min(n - 1, k + half_window) + 1])
-        sigma[k] = mag[k] * math.sqrt(win[len(win) // 2] / math.log(2.0))
-    return sigma
+        rel[k] = win[len(win) // 2] / math.log(2.0)
+    return neighbour_magnitude(z, rel) * np.sqrt(rel)
 
 
 def cmd_refit(args):
