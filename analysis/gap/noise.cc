@@ -10,17 +10,12 @@ namespace eol::analysis {
 
 std::vector<double> NeighbourMagnitude(const Frf& h, std::span<const double> rel_var,
                                        int half_width) {
-  const std::size_t n = h.size();
-  std::vector<double> out(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    out[k] = std::abs(h.value[k]);
-    // The widest symmetric window that fits, at most half_width lines each side.
-    const std::size_t m =
-        std::min({static_cast<std::size_t>(std::max(0, half_width)), k, n - 1 - k});
-    if (m == 0) continue;
-    // Least squares a + c x^2 through offsets +-1..+-m: a = sum w(x) H(x),
-    // w(x) = (S4 - S2 x^2) / (N S4 - S2^2), N = 2m, S2 = sum x^2, S4 = sum x^4 (m = 1: the
-    // mean of the two).
+  // weights[m - 1][x - 1]: the least-squares a + c x^2 through offsets +-1..+-m gives
+  // a = sum w(x) (H(-x) + H(x)), w(x) = (S4 - S2 x^2) / (N S4 - S2^2), N = 2m,
+  // S2 = sum x^2, S4 = sum x^4 over the 2m offsets (m = 1: the mean of the two, w = 1/2).
+  const std::size_t max_m = static_cast<std::size_t>(std::max(0, half_width));
+  std::vector<std::vector<double>> weights(max_m);
+  for (std::size_t m = 1; m <= max_m; ++m) {
     double s2 = 0.0, s4 = 0.0;
     for (std::size_t x = 1; x <= m; ++x) {
       const double x2 = static_cast<double>(x * x);
@@ -28,10 +23,20 @@ std::vector<double> NeighbourMagnitude(const Frf& h, std::span<const double> rel
       s4 += 2.0 * x2 * x2;
     }
     const double den = 2.0 * static_cast<double>(m) * s4 - s2 * s2;
+    for (std::size_t x = 1; x <= m; ++x)
+      weights[m - 1].push_back(m == 1 ? 0.5 : (s4 - s2 * static_cast<double>(x * x)) / den);
+  }
+  const std::size_t n = h.size();
+  std::vector<double> out(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    out[k] = std::abs(h.value[k]);
+    // The widest symmetric window that fits, at most half_width lines each side.
+    const std::size_t m = std::min({max_m, k, n - 1 - k});
+    if (m == 0) continue;
     std::complex<double> a = 0.0;
     double w2 = 0.0;  // sum of the squared weights: a's noise variance over sigma^2
     for (std::size_t x = 1; x <= m; ++x) {
-      const double w = m == 1 ? 0.5 : (s4 - s2 * static_cast<double>(x * x)) / den;
+      const double w = weights[m - 1][x - 1];
       a += w * (h.value[k - x] + h.value[k + x]);
       w2 += 2.0 * w * w;
     }
