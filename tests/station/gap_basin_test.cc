@@ -97,7 +97,7 @@ TEST(GapBasin, CoupledInertiaIsScoredInItsBasinOfBestEvidence) {
 
 // When two effects explain the data about equally (case-056: the spring fits 0.3 worse than
 // the truth), the report says so: the winner, and the rival within 4.6 in evidence (at even
-// prior odds; with the coupled inertia's odds of 5 it wins by more than 4.6 here).
+// prior odds; with the coupled inertia's default odds it wins by more than 4.6 here).
 TEST(GapBasin, AnEqualRivalIsNamed) {
   const BlindCase c = Load("case-056");
   analysis::GapOptions o;
@@ -124,7 +124,7 @@ TEST(GapBasin, AnEqualRivalIsNamed) {
 // The prior odds (GapOptions::prior_odds) enter the evidence as -2 ln odds and decide between
 // effects by exactly that much (seed 7's case-011: a second inertia at the rotor, mass ratio
 // 0.144, f2 2.33 f0, S 35.5; the best spring fits it 7.3 worse than the truth). The coupled
-// inertia wins on evidence, with its default odds of 5 and also at even odds; odds for the
+// inertia wins on evidence, with its default odds and also at even odds; odds for the
 // fixture spring just above exp(gap / 2) make the spring the answer and the inertia its
 // rival, just below they do not. Odds that are not positive are refused.
 TEST(GapBasin, PriorOddsWeighTheEvidenceByTwiceTheirLog) {
@@ -142,9 +142,13 @@ TEST(GapBasin, PriorOddsWeighTheEvidenceByTwiceTheirLog) {
   const double gap =
       Ranked(even, "fixture_compliance").score - Ranked(even, "coupled_inertia").score;
   ASSERT_GT(gap, 0.0);
-  // With the default odds the inertia's score is 2 ln 5 lower, the spring's unchanged.
+  // With the default odds the inertia's score is 2 ln(odds) lower, the spring's unchanged.
+  const analysis::GapOptions defaults;
+  ASSERT_EQ(defaults.prior_odds.size(), 1u);
+  ASSERT_EQ(defaults.prior_odds[0].first, analysis::EffectKind::kCoupledInertia);
   EXPECT_NEAR(Ranked(with, "coupled_inertia").score,
-              Ranked(even, "coupled_inertia").score - 2.0 * std::log(5.0), 1e-6);
+              Ranked(even, "coupled_inertia").score - 2.0 * std::log(defaults.prior_odds[0].second),
+              1e-6);
   EXPECT_NEAR(Ranked(with, "fixture_compliance").score, Ranked(even, "fixture_compliance").score,
               1e-6);
 
