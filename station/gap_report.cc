@@ -199,6 +199,7 @@ json GapReportJson(const GapReport& r) {
       "below none's; which one: the lowest score = cost + Laplace Occam penalty - 2 ln(the "
       "effect's prior odds, analysis/gap/diagnosis.h GapOptions::prior_odds)";
   j["residual_form"] = g.residual_form;
+  j["residual_admittance_hz"] = g.admittance_hz;
   j["message"] = g.message;
   return j;
 }

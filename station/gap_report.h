@@ -22,7 +22,9 @@
 //                       (cost + Laplace Occam penalty: which effect), bic (cost + p ln(2K):
 //                       whether an effect), cost (-2 ln L), gap_after, plausible, rejected}],
 //                       best first, "none" included
-//   residual_form       "impedance", "admittance" or "mixed" (effect_fit.h)
+//   residual_form       "impedance", "admittance" or "mixed" (effect_fit.h ChooseResidualForm)
+//   residual_admittance_hz  per measured unit, the lines (Hz) in admittance form where its
+//                       form is mixed (empty otherwise)
 //   features            [{measurement, name, simulated, measured, gap, sigma, significance}]
 //                       names f0_hz, q, peak_height_ohm, r_ohm, l_h (impedance) or
 //                       gain_rad_per_s2_per_a, damping_per_s (mobility)

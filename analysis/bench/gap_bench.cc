@@ -219,10 +219,7 @@ GapBenchCase RunCase(const GapBenchOptions& o, const Excitation& ex, int index,
   // The oracle scores as the diagnosis does (diagnosis.h: the evidence, on the residual form
   // the diagnosis chose for this unit).
   GapUnit formed = u;
-  formed.admittance =
-      cal.nominal.quantity == Quantity::kImpedanceOhm &&
-      o.gap.residual_form != ResidualForm::kImpedance &&
-      (o.gap.residual_form == ResidualForm::kAdmittance || CurrentNoiseDominates(formed));
+  ChooseResidualForm(formed, cal.nominal.quantity == Quantity::kImpedanceOhm, o.gap.residual_form);
   const EffectFitter fitter(cal.nominal, {formed});
   if (hidden.empty()) {
     c.oracle_separable = true;

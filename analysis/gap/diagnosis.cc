@@ -406,16 +406,19 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
   }
   std::vector<GapUnit> formed = units;
   int admittance = 0;
-  for (GapUnit& u : formed) {
-    u.admittance =
-        nominal.quantity == Quantity::kImpedanceOhm &&
-        (o.residual_form == ResidualForm::kAdmittance ||
-         (o.residual_form == ResidualForm::kAuto && !u.sigma_smooth && CurrentNoiseDominates(u)));
-    admittance += u.admittance ? 1 : 0;
+  s.admittance_hz.resize(formed.size());
+  for (std::size_t u = 0; u < formed.size(); ++u) {
+    ChooseResidualForm(formed[u], nominal.quantity == Quantity::kImpedanceOhm, o.residual_form);
+    admittance += formed[u].admittance ? 1 : 0;
+    for (std::size_t k = 0; k < formed[u].admittance_line.size(); ++k)
+      if (formed[u].admittance_line[k]) s.admittance_hz[u].push_back(formed[u].freq_hz[k]);
   }
-  s.residual_form = admittance == 0                                 ? "impedance"
-                    : admittance == static_cast<int>(formed.size()) ? "admittance"
-                                                                    : "mixed";
+  const bool mixed_lines = std::any_of(s.admittance_hz.begin(), s.admittance_hz.end(),
+                                       [](const auto& hz) { return !hz.empty(); });
+  s.residual_form = mixed_lines || (admittance > 0 && admittance < static_cast<int>(formed.size()))
+                        ? "mixed"
+                    : admittance == 0 ? "impedance"
+                                      : "admittance";
   const EffectFitter fitter(nominal, formed);
   const LineMask all;
   s.chi2_before = fitter.Chi2({}, all, &s.residuals);

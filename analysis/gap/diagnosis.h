@@ -49,12 +49,10 @@
 
 namespace eol::analysis {
 
-enum class ResidualForm { kAuto, kImpedance, kAdmittance };
-
 struct GapOptions {
   BandSearchOptions bands;
-  // kAuto: admittance for a unit whose noise is the current's (CurrentNoiseDominates,
-  // effect_fit.h) and whose sigma is the line's own (not GapUnit::sigma_smooth), else
+  // kAuto: admittance on the lines whose noise is the current's (ChooseResidualForm,
+  // effect_fit.h) unless the unit's sigma is smooth (GapUnit::sigma_smooth), else
   // impedance. Mobility is always fitted as measured.
   ResidualForm residual_form = ResidualForm::kAuto;
   double min_score_gain = 10.0;  // BIC units
@@ -167,7 +165,9 @@ struct GapSummary {
   double noise_z_before = 0.0, noise_z_after = 0.0;  // noise test z (residual.h), with
                                                      // each unit's sigma_dof
   double sigma_scale = 1.0;                 // sqrt(mean |r|^2 / E|r|^2) of the nominal (residual.h)
-  std::string residual_form = "impedance";  // "impedance", "admittance" or "mixed" (units)
+  std::string residual_form = "impedance";  // "impedance", "admittance" or "mixed" (lines)
+  // Per unit, the lines (Hz) in admittance form when the unit's form is mixed (else empty).
+  std::vector<std::vector<double>> admittance_hz;
   HeldOutGap heldout;
   std::vector<BandGap> where;
   std::vector<BandGap> where_after;

@@ -384,8 +384,43 @@ double BoundedPenalty(const Layout& layout, const ResidualFn& residual,
 
 }  // namespace
 
+std::vector<bool> CurrentNoiseLines(const GapUnit& u) {
+  const std::size_t n = u.size();
+  std::vector<double> m2(n), e2(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    std::vector<double> window;
+    for (std::size_t j = k >= 3 ? k - 3 : 0; j < std::min(n, k + 4); ++j)
+      window.push_back(std::abs(u.value[j]));
+    std::nth_element(window.begin(), window.begin() + static_cast<long>(window.size() / 2),
+                     window.end());
+    const double m = window[window.size() / 2];
+    m2[k] = m * m;
+    e2[k] = std::norm(u.sigma[k] / std::abs(u.value[k]));
+  }
+  // Relative least squares (weights 1 / model^2), refined twice from equal weights.
+  double a = 0.0, b = 0.0;
+  for (int pass = 0; pass < 3; ++pass) {
+    double s00 = 0, s01 = 0, s11 = 0, t0 = 0, t1 = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double model = pass == 0 ? 1.0 : std::max(a + b * m2[k], 1e-300);
+      const double w = 1.0 / (model * model);
+      s00 += w, s01 += w * m2[k], s11 += w * m2[k] * m2[k];
+      t0 += w * e2[k], t1 += w * m2[k] * e2[k];
+    }
+    const double det = s00 * s11 - s01 * s01;
+    if (!(det > 0.0)) break;
+    a = (s11 * t0 - s01 * t1) / det;
+    b = (s00 * t1 - s01 * t0) / det;
+    if (a < 0.0) a = 0.0, b = t1 / s11;
+    if (b < 0.0) b = 0.0, a = t0 / s00;
+  }
+  std::vector<bool> current(n);
+  for (std::size_t k = 0; k < n; ++k) current[k] = b * m2[k] > a;
+  return current;
+}
+
 std::complex<double> LineResidual(const GapUnit& u, std::size_t k, std::complex<double> h) {
-  if (u.admittance)
+  if (u.admittance || (k < u.admittance_line.size() && u.admittance_line[k]))
     return (Reciprocal(u.value[k]) - Reciprocal(h)) * (std::norm(u.value[k]) / u.sigma[k]);
   return (u.value[k] - h) / u.sigma[k];
 }
@@ -395,21 +430,14 @@ double LineCost(double r2, double sigma_dof) {
   return (sigma_dof + 2.0) * std::log1p(2.0 * r2 / sigma_dof);
 }
 
-bool CurrentNoiseDominates(const GapUnit& u) {
-  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
-  const double n = static_cast<double>(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) {
-    const double x = std::log(std::abs(u.value[k]));
-    const double y = std::log(u.sigma[k]) - x;
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-  }
-  const double var = sxx - sx * sx / n;
-  // |H| flat over the band: no lever to tell the channels apart; keep the impedance form.
-  if (!(var > 1e-6 * n)) return false;
-  return (sxy - sx * sy / n) / var >= 0.5;
+void ChooseResidualForm(GapUnit& u, bool impedance_quantity, ResidualForm form) {
+  u.admittance = impedance_quantity && form == ResidualForm::kAdmittance;
+  u.admittance_line.clear();
+  if (!impedance_quantity || form != ResidualForm::kAuto || u.sigma_smooth) return;
+  u.admittance_line = CurrentNoiseLines(u);
+  const auto current = std::count(u.admittance_line.begin(), u.admittance_line.end(), true);
+  u.admittance = current == static_cast<long>(u.size()) && current > 0;
+  if (current == 0 || u.admittance) u.admittance_line.clear();
 }
 
 bool Selected(const LineMask& mask, std::size_t unit, std::size_t line) {

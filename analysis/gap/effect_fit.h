@@ -72,6 +72,10 @@ struct GapUnit {
   // times the lines pooled; 0 when sigma is known exactly.
   double sigma_dof = 0.0;
   bool admittance = false;  // residual form (above); impedance quantity only
+  // Per line (empty: `admittance` for every line): the admittance form on the lines whose
+  // current channel carries most of the noise (CurrentNoiseLines), the impedance form on the
+  // others.
+  std::vector<bool> admittance_line;
   // sigma does not depend on the line's own noise draw (estimated from the line-to-line
   // scatter, or pooled over neighbours: noise.h): the impedance form is unbiased for it, and
   // the admittance form's |H_meas|^2 would bring the draw back; DiagnoseGap keeps impedance.
@@ -84,10 +88,21 @@ struct GapUnit {
 std::complex<double> LineResidual(const GapUnit& u, std::size_t k, std::complex<double> h);
 // rho(|r|^2) above for sigma^2 on sigma_dof degrees of freedom (0: exact).
 double LineCost(double r2, double sigma_dof);
-// True when the unit's noise is mostly the current's: the relative sigma eps_k = sigma/|H|
-// grows with |H| (least-squares slope of ln eps against ln |H| at least 0.5; a voltage
-// channel's noise gives eps flat in |H|, a current channel's eps proportional to |H|).
-bool CurrentNoiseDominates(const GapUnit& u);
+// Per line, whether the current channel carries most of the noise: eps_k^2 = a + b |H_k|^2
+// (eps = sigma / |H|; a: the voltage channel's relative noise, flat in |H| under a flat
+// excitation; b |H|^2: the current's) fitted to the lines by relative least squares with
+// a, b >= 0, |H_k| the median of |H| over k +- 3; line k is the current's where
+// b |H_k|^2 > a. There 1/H = I/U is linear in the dominant noise and unbiased, where H = U/I
+// is biased low by about exp(-|I|^2 / s_I^2) (s_I: the mean current's noise) and its sigma
+// follows the draw; on the voltage's lines the other way round.
+std::vector<bool> CurrentNoiseLines(const GapUnit& u);
+
+enum class ResidualForm { kAuto, kImpedance, kAdmittance };
+// Sets the unit's residual form (GapUnit::admittance, admittance_line) for an impedance
+// (mobility: always as measured). kAuto: the admittance form on CurrentNoiseLines, the
+// impedance form on the others and on every line of a unit whose sigma is smooth
+// (GapUnit::sigma_smooth); kAdmittance / kImpedance: every line.
+void ChooseResidualForm(GapUnit& u, bool impedance_quantity, ResidualForm form);
 
 // mask[u][k] != 0: line k of unit u takes part. An empty mask selects every line.
 using LineMask = std::vector<std::vector<char>>;

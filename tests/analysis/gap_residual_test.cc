@@ -10,6 +10,7 @@
 #include <span>
 
 #include "analysis/gap/calibration.h"
+#include "analysis/gap/effect_fit.h"
 #include "analysis/gap/noise.h"
 #include "analysis/gap/prediction.h"
 #include "analysis/gap/residual.h"
@@ -144,6 +145,93 @@ TEST(GapResidual, EstimatedSigmaDoesNotWeighTheLinesByTheirOwnNoise) {
   for (std::size_t k = 0; k < h.size(); ++k) h.sigma[k] = eps * std::abs(h.value[k]);
   const double pooled = weighted_error(PoolLineSigma(h, 5));
   EXPECT_LT(std::abs(pooled), 3.0 * standard_error) << pooled;
+}
+
+// A ratio of period means, Z = mean U / mean I, over P = 8 periods with noise on both
+// channels (the voltage's s_u, the current's s_i per period), and its sigma from the periods
+// (NOTES.md 3). On an inductive Z from 1 to 38 ohm the voltage's noise dominates where
+// |Z| < s_u / s_i = 20 ohm and the current's above. The per-line form (ChooseResidualForm)
+// takes the admittance form above the crossing and the impedance form below. The impedance
+// form is biased low on the current's lines (a line whose current came out high has a low |Z|
+// and a small sigma), the admittance form high on the voltage's; the form chosen per line
+// leaves at most half of either bias in the true model's residual along the curve.
+TEST(GapResidual, PerLineFormFollowsTheNoisyChannelAndLeavesTheTrueModelUnbiased) {
+  const std::size_t n = 2400, periods = 8;
+  const double v = 1.0, s_u = 0.5, s_i = 0.025, crossing = s_u / s_i;
+  std::vector<std::complex<double>> z(n);
+  GapUnit u;
+  u.sigma_dof = 2.0 * (periods - 1);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g(0.0, std::sqrt(0.5));
+  for (std::size_t k = 0; k < n; ++k) {
+    const double f = 50.0 + 0.8125 * static_cast<double>(k);
+    z[k] = {1.0, 2.0 * std::numbers::pi * f * 3e-3};
+    std::vector<std::complex<double>> up(periods), ip(periods);
+    std::complex<double> um, im;
+    for (std::size_t p = 0; p < periods; ++p) {
+      up[p] = v + s_u * std::complex<double>(g(rng), g(rng));
+      ip[p] = v / z[k] + s_i * std::complex<double>(g(rng), g(rng));
+      um += up[p] / static_cast<double>(periods);
+      im += ip[p] / static_cast<double>(periods);
+    }
+    double vu = 0.0, vi = 0.0;
+    std::complex<double> cui;
+    for (std::size_t p = 0; p < periods; ++p) {
+      vu += std::norm(up[p] - um) / (periods - 1.0);
+      vi += std::norm(ip[p] - im) / (periods - 1.0);
+      cui += (up[p] - um) * std::conj(ip[p] - im) / (periods - 1.0);
+    }
+    const std::complex<double> zm = um / im;
+    const double var =
+        std::norm(zm) / periods *
+        (vu / std::norm(um) + vi / std::norm(im) - 2.0 * std::real(cui / (um * std::conj(im))));
+    u.freq_hz.push_back(f);
+    u.value.push_back(zm);
+    u.sigma.push_back(std::sqrt(var));
+  }
+  ChooseResidualForm(u, true, ResidualForm::kAuto);
+  ASSERT_EQ(u.admittance_line.size(), n);
+  EXPECT_FALSE(u.admittance);
+  int wrong = 0, sides = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (std::abs(z[k]) < 0.8 * crossing || std::abs(z[k]) > 1.25 * crossing) {
+      ++sides;
+      wrong += u.admittance_line[k] != (std::abs(z[k]) > crossing) ? 1 : 0;
+    }
+  }
+  EXPECT_LE(wrong, sides / 20) << wrong << " of " << sides;
+
+  // The true model's residual along the curve (Re of r over the direction of +dZ in the
+  // line's form), averaged over the current's lines or the voltage's, in standard errors.
+  const auto mean_along = [&](const GapUnit& formed, bool current_lines) {
+    double sum = 0.0;
+    int lines = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      if ((std::abs(z[k]) > crossing) != current_lines) continue;
+      const std::complex<double> r = LineResidual(formed, k, z[k]);
+      const std::complex<double> unit_dir = z[k] / std::abs(z[k]);
+      const bool y =
+          formed.admittance || (k < formed.admittance_line.size() && formed.admittance_line[k]);
+      sum += y ? -std::real(r * unit_dir) : std::real(r * std::conj(unit_dir));
+      ++lines;
+    }
+    return sum / lines / std::sqrt(0.5 / lines);
+  };
+  GapUnit every = u;
+  ChooseResidualForm(every, true, ResidualForm::kImpedance);
+  const double z_on_current = mean_along(every, true);
+  ChooseResidualForm(every, true, ResidualForm::kAdmittance);
+  const double y_on_voltage = mean_along(every, false);
+  EXPECT_LT(z_on_current, -5.0);
+  EXPECT_GT(y_on_voltage, 5.0);
+  // What is left on each side is the other channel's noise (eps about 0.18 on every line).
+  EXPECT_LT(std::abs(mean_along(u, true)), 0.5 * std::abs(z_on_current)) << mean_along(u, true);
+  EXPECT_LT(std::abs(mean_along(u, false)), 0.5 * y_on_voltage) << mean_along(u, false);
+  // A smooth sigma (estimated, not the line's own) keeps the impedance form.
+  every.sigma_smooth = true;
+  ChooseResidualForm(every, true, ResidualForm::kAuto);
+  EXPECT_FALSE(every.admittance);
+  EXPECT_TRUE(every.admittance_line.empty());
 }
 
 TEST(GapResidual, TrigammaKnownValues) {

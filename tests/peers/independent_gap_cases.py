@@ -275,8 +275,8 @@ def truth_beats_fixture(base, t, eol, extra):
 
     cost = sum rho(|r|^2), rho(u) = (nu + 2) ln(1 + 2 u / nu) (-2 ln L of the Student t for a
     sigma^2 on nu degrees of freedom; 2 u, the chi2, when nu = 0), with r in the residual form
-    the report used: (Z_meas - Z) / sigma, or (1/Z_meas - 1/Z) |Z_meas|^2 / sigma when it
-    took the admittance form (the current channel's noise dominates)."""
+    the report used: (Z_meas - Z) / sigma, or (1/Z_meas - 1/Z) |Z_meas|^2 / sigma on the lines
+    it took in admittance form (the current channel's noise dominates there)."""
     with open(base + "-meas.csv") as src:  # comment lines and the header skipped
         rows = [ln for ln in src if ln.strip() and ln[0] not in "#f"]
     data = np.loadtxt(rows, delimiter=",", ndmin=2)
@@ -288,10 +288,11 @@ def truth_beats_fixture(base, t, eol, extra):
     p = subprocess.run(cmd, capture_output=True, text=True, check=True)
     report = json.loads(p.stdout)
     z_true = impedance(t["motor"], f, t["effect"], t["params"])
-    if report["residual_form"] == "admittance":
-        r = (1.0 / z - 1.0 / z_true) * np.abs(z) ** 2 / sigma
-    else:
-        r = (z - z_true) / sigma
+    admittance = np.full(len(f), report["residual_form"] == "admittance")
+    if report["residual_form"] == "mixed":  # per line: the lines the report lists
+        admittance = np.isin(f, report["residual_admittance_hz"][0])
+    r = np.where(admittance, (1.0 / z - 1.0 / z_true) * np.abs(z) ** 2 / sigma,
+                 (z - z_true) / sigma)
     nu = float(report.get("sigma_dof") or 0.0)
     u = np.abs(r) ** 2
     cost_true = np.sum((nu + 2) * np.log1p(2 * u / nu)) if nu > 0 else np.sum(2 * u)
