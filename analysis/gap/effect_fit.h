@@ -9,7 +9,8 @@
 // noise draw, where sigma_Z (proportional to |Z_meas|^2) does and weights the lines whose
 // current came out high: a bias of -eps/2 sigma per line along Z (eps = sigma/|Z|), which
 // summed over hundreds of noisy lines looks like a lower inductance. Both forms agree to first
-// order when eps is small.
+// order when eps is small. The form is chosen per line (ChooseResidualForm): a motor's |Z|
+// rises with f, so one channel's noise can dominate the low lines and the other's the high.
 //   chi2 = 2 sum |r_uk|^2   (the fit module's convention: 2K real residuals of unit variance)
 //   cost = sum rho(|r_uk|^2),  rho(u) = (nu + 2) ln(1 + 2 u / nu)   (-2 ln L + const)
 // With sigma^2 estimated on nu degrees of freedom (GapUnit::sigma_dof) r is a bivariate
