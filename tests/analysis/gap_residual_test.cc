@@ -227,6 +227,12 @@ TEST(GapResidual, PerLineFormFollowsTheNoisyChannelAndLeavesTheTrueModelUnbiased
   // What is left on each side is the other channel's noise (eps about 0.18 on every line).
   EXPECT_LT(std::abs(mean_along(u, true)), 0.5 * std::abs(z_on_current)) << mean_along(u, true);
   EXPECT_LT(std::abs(mean_along(u, false)), 0.5 * y_on_voltage) << mean_along(u, false);
+  // A flat |H| gives no lever to tell the channels apart: the impedance form.
+  GapUnit flat = u;
+  for (std::size_t k = 0; k < n; ++k) flat.value[k] = 5.0 * u.value[k] / std::abs(u.value[k]);
+  ChooseResidualForm(flat, true, ResidualForm::kAuto);
+  EXPECT_FALSE(flat.admittance);
+  EXPECT_TRUE(flat.admittance_line.empty());
   // A smooth sigma (estimated, not the line's own) keeps the impedance form.
   every.sigma_smooth = true;
   ChooseResidualForm(every, true, ResidualForm::kAuto);
