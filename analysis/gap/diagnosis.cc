@@ -405,20 +405,21 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
     return s;
   }
   std::vector<GapUnit> formed = units;
-  int admittance = 0;
+  std::size_t lines = 0, admittance_lines = 0;
   s.admittance_hz.resize(formed.size());
   for (std::size_t u = 0; u < formed.size(); ++u) {
     ChooseResidualForm(formed[u], nominal.quantity == Quantity::kImpedanceOhm, o.residual_form);
-    admittance += formed[u].admittance ? 1 : 0;
+    lines += formed[u].size();
+    admittance_lines += formed[u].admittance ? formed[u].size() : 0;
     for (std::size_t k = 0; k < formed[u].admittance_line.size(); ++k)
-      if (formed[u].admittance_line[k]) s.admittance_hz[u].push_back(formed[u].freq_hz[k]);
+      if (formed[u].admittance_line[k]) {
+        s.admittance_hz[u].push_back(formed[u].freq_hz[k]);
+        ++admittance_lines;
+      }
   }
-  const bool mixed_lines = std::any_of(s.admittance_hz.begin(), s.admittance_hz.end(),
-                                       [](const auto& hz) { return !hz.empty(); });
-  s.residual_form = mixed_lines || (admittance > 0 && admittance < static_cast<int>(formed.size()))
-                        ? "mixed"
-                    : admittance == 0 ? "impedance"
-                                      : "admittance";
+  s.residual_form = admittance_lines == 0       ? "impedance"
+                    : admittance_lines == lines ? "admittance"
+                                                : "mixed";
   const EffectFitter fitter(nominal, formed);
   const LineMask all;
   s.chi2_before = fitter.Chi2({}, all, &s.residuals);

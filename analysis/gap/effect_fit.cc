@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "analysis/fit/least_squares.h"
+#include "analysis/qc/statistics.h"
 #include "analysis/text.h"
 
 namespace eol::analysis {
@@ -391,9 +392,7 @@ std::vector<bool> CurrentNoiseLines(const GapUnit& u) {
     std::vector<double> window;
     for (std::size_t j = k >= 3 ? k - 3 : 0; j < std::min(n, k + 4); ++j)
       window.push_back(std::abs(u.value[j]));
-    std::nth_element(window.begin(), window.begin() + static_cast<long>(window.size() / 2),
-                     window.end());
-    const double m = window[window.size() / 2];
+    const double m = Median(std::move(window));
     m2[k] = m * m;
     e2[k] = std::norm(u.sigma[k] / std::abs(u.value[k]));
   }
