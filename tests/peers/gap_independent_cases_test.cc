@@ -8,8 +8,8 @@
 // "separable": the true model's cost, -2 ln L as `eol gap` scores it in the report's residual
 // form, at least 10 below the best fixture spring's; on this seed 4 of the 10; of the others
 // four more are named with the prior odds of 15, and in the two named `fixture_compliance` the
-// spring fits better than the truth); at least 90 % of the separable cases are named (13 of
-// 14: a spring of S 20.7 is named `coupled_inertia`).
+// spring fits better than the truth): at least 8 of the 10 in all; at least 90 % of the
+// separable cases are named (14 of 14).
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
@@ -45,7 +45,7 @@ TEST(GapIndependentCases, NamesCoupledInertiaAndNeverInventsAnEffect) {
   ASSERT_TRUE(in) << dir << "/score.json: " << score.output();
   const nlohmann::json s = nlohmann::json::parse(in);
 
-  int coupled = 0, coupled_separable = 0, coupled_named = 0;
+  int coupled = 0, coupled_separable = 0, coupled_named = 0, coupled_named_all = 0;
   for (const auto& row : s["rows"]) {
     const std::string hidden = row["hidden"];
     if (hidden == "none") {
@@ -53,6 +53,7 @@ TEST(GapIndependentCases, NamesCoupledInertiaAndNeverInventsAnEffect) {
     }
     if (hidden.rfind("coupled_inertia", 0) == 0) {
       ++coupled;
+      coupled_named_all += row["ok"].get<bool>() ? 1 : 0;
       if (!row["separable"].get<bool>()) continue;
       ++coupled_separable;
       coupled_named += row["ok"].get<bool>() ? 1 : 0;
@@ -61,6 +62,8 @@ TEST(GapIndependentCases, NamesCoupledInertiaAndNeverInventsAnEffect) {
   EXPECT_EQ(coupled, 10);
   EXPECT_GE(coupled_separable, 4) << score.output();
   EXPECT_GE(coupled_named, 0.8 * coupled_separable) << score.output();
+  // Issue 13's 8 of 10 over every coupled case, near ties included (this seed: 8).
+  EXPECT_GE(coupled_named_all, 8) << score.output();
   const double named = s["separable_named"], separable = s["separable"];
   EXPECT_GE(named, 0.9 * separable) << score.output();
   std::error_code ec;
