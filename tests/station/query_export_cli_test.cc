@@ -296,7 +296,7 @@ TEST_F(QueryExportTest, RecipeDeclaresItsMaskColumnsAndRecordsKeepCurves) {
 }
 
 TEST(ExportSchemaDocs, TheReadmeTableIsWhatTheCommandPrints) {
-  std::ifstream in(std::string(EOL_SOURCE_DIR) + "/README.md");
+  std::ifstream in(std::string(EOL_SOURCE_DIR) + "/deploy/OPERATIONS.md");
   const std::string readme((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string begin = "<!-- export-schema:begin -->\n", end = "<!-- export-schema:end -->";
   const auto b = readme.find(begin), e = readme.find(end);
@@ -305,7 +305,7 @@ TEST(ExportSchemaDocs, TheReadmeTableIsWhatTheCommandPrints) {
   const CliRun s = Eol({"export", "--schema"});
   ASSERT_EQ(s.code, 0) << s.out;
   EXPECT_EQ(readme.substr(b + begin.size(), e - b - begin.size()), s.out)
-      << "README's export schema table differs from `eol export --schema`";
+      << "deploy/OPERATIONS.md's export schema table differs from `eol export --schema`";
 }
 
 TEST_F(QueryExportTest, MissingDatabaseNamesThePath) {
