@@ -24,7 +24,7 @@ SKIP_DIRS = {".git", "node_modules", "__pycache__", "corpus"}
 TOP_LEVEL = ("analysis", "cmake", "db", "deploy", "drivers", "recipes", "station", "tests")
 
 MD_LINK = re.compile(r"\[[^\]\n]*\]\(([^)\s]+)\)")
-ROOTED = re.compile(r"(?<![\w./~@:-])((?:%s)/[\w./+-]*)" % "|".join(TOP_LEVEL))
+ROOTED = re.compile(r"(?<![\w./~@:-])((?:%s)/[\w./+*<>{}$-]*)" % "|".join(TOP_LEVEL))
 BARE_MD = re.compile(r"(?<![\w./-])([A-Za-z][\w-]*\.md)\b")
 OUTSIDE = re.compile(r"(\.\./shared\b[\w./-]*|/work/[\w./-]+)")
 PLACEHOLDER = re.compile(r"[<>*{}$%]")
