@@ -130,8 +130,8 @@ void AddExportCommand(CLI::App& app) {
       "export",
       "Export finished tests for quality engineering, newest first, by serial, order, outcome\n"
       "and/or time range (ISO 8601 UTC, e.g. 2026-11-22T00:00:00.000Z; from inclusive, to\n"
-      "exclusive). csv and json: one row per test in the export schema (README \"Export\n"
-      "schema\"; `--schema` prints it): fixed columns, the same for any data, with every\n"
+      "exclusive). csv and json: one row per test in the export schema (deploy/OPERATIONS.md,\n"
+      "\"Export schema\"; `--schema` prints it): fixed columns, the same for any data, with every\n"
       "declared measurement's value, sigma, limits, unit and outcome. records: full records\n"
       "with curves (what `eol teach --golden` reads).");
   cmd->add_option("--db", args->db, "SQLite file of the station")->check(CLI::ExistingFile);

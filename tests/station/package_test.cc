@@ -36,6 +36,10 @@ TEST(DebianPackage, HoldsProgramUnitConfigRecipesAndPage) {
                         "./usr/share/eol/web/engineer.html", "./usr/share/eol/web/engineer.js"})
     EXPECT_NE(contents.output().find(f), std::string::npos) << f << " missing:\n"
                                                             << contents.output();
+  // The manual page, made from the program's help (cmake/ManPage.cmake).
+  EXPECT_NE(contents.output().find("./usr/share/man/man1/eol.1.gz"), std::string::npos)
+      << "manual page missing:\n"
+      << contents.output();
 
   // The packaged program is stripped: "-rwxr-xr-x root/root 3564736 2026-11-24 13:30
   // ./usr/bin/eol".
