@@ -13,7 +13,7 @@ pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 pkg_check_modules(MODBUS REQUIRED IMPORTED_TARGET libmodbus)
 pkg_check_modules(MOSQUITTO REQUIRED IMPORTED_TARGET libmosquitto)  # results to the MES (MQTT)
 pkg_check_modules(PQ REQUIRED IMPORTED_TARGET libpq)  # the plant's central PostgreSQL record
-pkg_check_modules(SNDFILE REQUIRED IMPORTED_TARGET sndfile)  # WAV recordings (station/files)
+pkg_check_modules(SNDFILE REQUIRED IMPORTED_TARGET sndfile)  # WAV recordings (drivers/io)
 # Charts (drivers/io/chart.h): SVG and PNG through cairo's surfaces.
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
 # cpp-httplib 0.11 is compiled; its .pc carries the defines that fix its class layout.

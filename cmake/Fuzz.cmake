@@ -2,8 +2,8 @@
 # nothing else. Everything is compiled with -fsanitize=fuzzer-no-link,address,undefined (the
 # coverage libFuzzer steers by, and the sanitizers that turn a silent bug into a finding);
 # the fuzzers link with -fsanitize=fuzzer,address,undefined. Undefined behaviour aborts
-# (no recovery), so libFuzzer keeps the input. Build the target eol_fuzzers; see README
-# "Fuzzing" and tests/fuzz/run_fuzzers.sh.
+# (no recovery), so libFuzzer keeps the input. Build the target eol_fuzzers; see
+# tests/README.md "Fuzzing" and tests/fuzz/run_fuzzers.sh.
 if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
   message(FATAL_ERROR "EOL_FUZZ=ON needs clang (libFuzzer): configure with "
                       "-DCMAKE_CXX_COMPILER=clang++-14 (Debian packages clang-14 and "

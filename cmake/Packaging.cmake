@@ -1,5 +1,5 @@
 # Installation layout and the Debian package (cpack -G DEB, or `cmake --build build --target
-# package`). See README "Installing on a station PC".
+# package`). See deploy/OPERATIONS.md "Installing on a station PC".
 #   /usr/bin/eol                              the program
 #   /usr/share/man/man1/eol.1.gz              its manual page (cmake/ManPage.cmake)
 #   /usr/share/eol/recipes/, /usr/share/eol/web/   shipped recipes, the operator and engineer pages

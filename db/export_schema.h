@@ -1,7 +1,7 @@
 // The export schema for quality engineering: one row per test, in fixed columns that never
 // depend on the data exported (`eol export`, CSV and JSON). One field list, here, serves the
 // CSV header, the CSV cells, the JSON objects and the documented table (`eol export --schema`,
-// README "Export schema"), so the three cannot drift apart.
+// deploy/OPERATIONS.md "Export schema"), so the three cannot drift apart.
 //
 // Row layout (schema version kExportSchemaVersion):
 //   1. the base columns (kind of test, identity, times, outcome, first reason, recipe, who,

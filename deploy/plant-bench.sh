@@ -1,6 +1,6 @@
 #!/bin/bash
-# The plant-integration figures of the README: starts a throwaway mosquitto (persistent, as
-# the README asks of a plant's broker) and a throwaway PostgreSQL 15 cluster in a temporary
+# The plant-integration figures of station/README.md: starts a throwaway mosquitto (persistent, as
+# deploy/OPERATIONS.md asks of a plant's broker) and a throwaway PostgreSQL 15 cluster in a temporary
 # directory, each on a free port of 127.0.0.1, runs `eol plant-bench` against them, and stops
 # both by their own pids. As root the servers run as their packages' users (mosquitto drops
 # to `mosquitto` by itself; PostgreSQL refuses root and runs as `postgres` via setpriv).

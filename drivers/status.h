@@ -1,6 +1,6 @@
 // Results of hardware, I/O and user-input operations: a code-free status with a message
-// that names the device, signal or address, the attempt and the timeout (STYLE.md 4).
-// Programmer errors are not Status: they throw std::logic_error or abort.
+// that names the device, signal or address, the attempt and the timeout (drivers/README.md,
+// Contracts). Programmer errors are not Status: they throw std::logic_error or abort.
 #pragma once
 
 #include <optional>

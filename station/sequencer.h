@@ -1,4 +1,4 @@
-// The one path every test takes (ARCHITECTURE.md), as explicit, logged states:
+// The one path every test takes (README.md, Design), as explicit, logged states:
 //
 //   wait_serial -> check_interlocks -> clamp -> confirm_clamp -> excite -> check_interlocks
 //     -> analyse -> judge -> unclamp -> store -> publish -> wait_serial

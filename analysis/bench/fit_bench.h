@@ -10,11 +10,12 @@
 //   (2) coverage: the share of runs with |f0_hat - f0| <= 2 f_sigma_hz (~95 % when honest);
 //   (3) the bias of |Z| peak-picking (the local maximum of |Z| with the deepest dip over the
 //       next 20 lines, refined by a parabola through it and its two neighbours) next to the
-//       bias of the ML fit (NOTES.md 2: |Z| peaks below f0, at 387.6 Hz for the reference);
+//       bias of the ML fit (analysis/README.md 2: |Z| peaks below f0, at 387.6 Hz for the
+//       reference);
 //   (4) the analysis time per test (estimator + fit);
 //   (5) the measurement time for a target std(f0). The per-line sigma of a periodic
-//       measurement falls as 1/sqrt(T_m) (NOTES.md 3: sigma_G^2 = 2 S_v / (A_k^2 T_m)), and
-//       the bound is proportional to sigma, so
+//       measurement falls as 1/sqrt(T_m) (analysis/README.md 3: sigma_G^2 = 2 S_v / (A_k^2 T_m)),
+//       and the bound is proportional to sigma, so
 //           T_needed = T_m (crb_f0(T_m) / target)^2,   T_m = periods / line_spacing_hz;
 //       checked against a second Monte Carlo at the shortest averaging the estimator accepts.
 // Pure computation: no files, no processes (the SciPy comparison is run by the station).
@@ -51,7 +52,7 @@ Recording SimulateRecordingFromRest(const MotionalImpedance& motor, const Excita
                                     double current_noise_a, std::uint64_t seed);
 
 // Per-line complex std of Z from the channels' true sample noise alone, for a record of
-// `periods` periods analysed as one (no price for a transient): NOTES.md 3 with the line
+// `periods` periods analysed as one (no price for a transient): analysis/README.md 3 with the line
 // amplitudes of the motor voltage and current through series_ohm,
 //   sigma_k^2 = |Z_k|^2 (4 s_u^2 / (P n |U_k|^2) + 4 s_i^2 / (P n |I_k|^2)).
 std::vector<double> TrueNoiseLineSigma(const MotionalImpedance& motor, const Excitation& excitation,
@@ -95,7 +96,7 @@ struct FitBenchResult {
   double f0_mean_hz = 0.0;
   double f0_std_hz = 0.0;
   double crb_f0_hz = 0.0;              // at the truth, rms of the reported line sigmas
-  double crb_f0_closed_form_hz = 0.0;  // NOTES.md 4 closed form, the line sigma at f0
+  double crb_f0_closed_form_hz = 0.0;  // analysis/README.md 4 closed form, the line sigma at f0
   double std_over_crb = 0.0;
   // The bound with the channels' true noise over every recorded period (TrueNoiseLineSigma:
   // what an estimator that wasted nothing would have) and the ratio to it.

@@ -13,7 +13,7 @@ namespace eol::analysis {
 namespace {
 
 // The hidden classes drawn: the first eight EffectKinds, the library as it was when the
-// README's figures were measured (coupled_inertia is benched by the independent generator,
+// gap-bench's figures were measured (coupled_inertia is benched by the independent generator,
 // tests/peers/independent_gap_cases.py), so a seed keeps drawing the same cases.
 constexpr int kBenchEffectKinds = 8;
 

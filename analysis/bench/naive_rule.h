@@ -2,7 +2,7 @@
 // largest local excess of |Z| over a straight line fitted to |Z| in a search band, refine it
 // with a parabola through the peak line and its neighbours, and pass the unit when that
 // frequency lies in a fixed window. This is what a hand-tuned station does without a model:
-// |Z| peak-picking is biased low by the inductive background (NOTES.md 2: 387.6 Hz for a
+// |Z| peak-picking is biased low by the inductive background (analysis/README.md 2: 387.6 Hz for a
 // 390 Hz mode) and the window is set once by hand, not learned.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The added-inertia method (the loudspeaker added-mass method, NOTES.md 1): Z identifies
+// The added-inertia method (the loudspeaker added-mass method, analysis/README.md 1): Z identifies
 // only R, L, Rp, f0, Q; a second measurement with a known inertia dJ added to the rotor
 // moves f0 to f0' and gives the missing sixth parameter,
 //   J_r = dJ / ((f0 / f0')^2 - 1),

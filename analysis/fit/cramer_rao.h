@@ -1,4 +1,4 @@
-// Cramer-Rao bound of the clamped-motor impedance fit (NOTES.md section 4).
+// Cramer-Rao bound of the clamped-motor impedance fit (analysis/README.md section 4).
 //
 // Model and parameters as in resonance_fit.h: Z(f) = R + j w L + Rp / (1 + Q (j w/w0 + w0/(j w))),
 // theta = ln(R, L, Rp, f0, Q). With circular complex Gaussian noise of std sigma_k on line k
@@ -39,7 +39,7 @@ CramerRaoBound ComputeCramerRaoBound(const MotionalImpedance& truth,
 CramerRaoBound ComputeCramerRaoBound(const MotionalImpedance& truth,
                                      const std::vector<double>& freq_hz, double sigma);
 
-// Closed forms for one lightly damped mode (NOTES.md 4), uniform line spacing df (Hz) and
+// Closed forms for one lightly damped mode (analysis/README.md 4), uniform line spacing df (Hz) and
 // per-line complex noise std sigma (ohm), with B3dB = f0 / Q, N3 = B3dB / df lines in the
 // half-power band and SNR_pk = Rp^2 / sigma^2. They assume the peak is well inside the band
 // and the background R + j w L is pinned down by the lines around it.

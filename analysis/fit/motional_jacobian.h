@@ -17,7 +17,8 @@
 //   s_k = sqrt(2) / sigma_k.
 // Each r_i then has unit variance, chi2 = |r|^2 = 2 sum_k |Z(f_k) - Z_k|^2 / sigma_k^2 follows a
 // chi-square law with 2K - 5 degrees of freedom at the optimum, and the stacked Jacobian Jr of
-// r gives the Fisher matrix F = Jr^T Jr = sum_k (2 / sigma_k^2) Re(J_k^H J_k) (NOTES.md 4).
+// r gives the Fisher matrix F = Jr^T Jr = sum_k (2 / sigma_k^2) Re(J_k^H J_k) (analysis/README.md
+// 4).
 #pragma once
 
 #include <Eigen/Dense>

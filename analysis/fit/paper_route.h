@@ -8,8 +8,8 @@
 //   R = A1, L = A4 / B3, T = sqrt((J_r/B3)(A2 - A1 B2 - A4/B3)), C_m = B3 / J_r,
 //   R_m = B2 J_r / B3.
 //   The six coefficients carry one constraint the model imposes, A3 = B3 A1 + B2 A4 / B3
-//   (NOTES.md 1); its violation beyond its standard error signals unmodelled dynamics and is
-//   reported as constraint_z = (A3 - B3 A1 - B2 A4/B3) / sigma.
+//   (analysis/README.md 1); its violation beyond its standard error signals unmodelled dynamics and
+//   is reported as constraint_z = (A3 - B3 A1 - B2 A4/B3) / sigma.
 // Mechanical: H_m = beta / I (angular acceleration per current) fitted as
 //   (D1 + D2 s + D3 s^2) / (1 + C2 s + C3 s^2)   (eq. 22, d_0 = 1), then (eq. 24-26)
 //   T = D3 J_r / C3,  C_m = C3 / J_r,  R_m = C2 J_r / C3   (D1, D2 should be ~0).

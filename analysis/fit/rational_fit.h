@@ -1,7 +1,7 @@
 // Output-error fit of a rational transfer function to complex frequency-response data: the
 // paper's route (section 3.2: MATLAB Ident's OE model in the frequency domain), kept for
 // comparison with the physical ML fit (resonance_fit.h), which is sqrt(2) better in f0
-// (NOTES.md 4).
+// (analysis/README.md 4).
 //
 // Model, s = j 2 pi f:
 //   H(s) = N(s) / D(s),  N(s) = sum_{i=0}^{nb} n_i s^i,  D(s) = sum_{i=0}^{na} d_i s^i,

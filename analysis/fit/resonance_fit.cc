@@ -363,7 +363,7 @@ FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options
        << s.estimated_sigma << " ohm per line (complex std), covariance scaled by it";
   } else if (s.chi2_per_dof > 1.0 + 5.0 * std::sqrt(2.0 / s.dof)) {
     os << ". chi2/dof is well above 1: the model does not explain the data within sigma "
-          "(an unmodelled effect, NOTES.md 5, or sigma underestimated)";
+          "(an unmodelled effect, analysis/README.md 5, or sigma underestimated)";
   }
   s.message = os.str();
   return s;

@@ -1,4 +1,4 @@
-// Weighted maximum-likelihood fit of the clamped-motor impedance (NOTES.md section 4).
+// Weighted maximum-likelihood fit of the clamped-motor impedance (analysis/README.md section 4).
 //
 // Model: Z(f) = R + j w L + Rp / (1 + Q (j w/w0 + w0/(j w)))  (analysis/model/motor_model.h)
 // Cost:  chi2 = sum_i r_i^2 = 2 sum_k |Z_k - Z(f_k; theta)|^2 / sigma_k^2, with sigma_k the
@@ -6,7 +6,7 @@
 //        Re and Im of sqrt(2) (Z(f_k) - Z_k) / sigma_k, each of unit variance. This is twice
 //        the negative log-likelihood of circular Gaussian noise (up to a constant), and it
 //        follows a chi-square law with dof = 2K - 5 (K lines), so chi2_per_dof ~ 1 when the
-//        noise matches sigma and the model is right (NOTES.md 4: "about 2F - n_params").
+//        noise matches sigma and the model is right (analysis/README.md 4: "about 2F - n_params").
 // Start: a grid over (f0, Q), f0 log-spaced over [f0_min_hz, f0_max_hz], Q log-spaced over
 //        [q_min, q_max]; at each point R, L, Rp are solved by weighted linear least squares
 //        (Z is linear in them for fixed f0, Q: variable projection) and only points with

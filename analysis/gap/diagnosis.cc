@@ -80,7 +80,7 @@ std::string JoinNames(const std::vector<AppliedEffect>& effects) {
 
 // The first torsional mode of the nominal with the structural effects among `effects`
 // (fixture_compliance, coupled_inertia, adhesive_creep): where Re of the motional part
-// Z - (R + s L) peaks inside the band (NOTES.md 2: Re Z peaks at f0), on a fine log grid;
+// Z - (R + s L) peaks inside the band (analysis/README.md 2: Re Z peaks at f0), on a fine log grid;
 // 0 when it has no peak inside (the structure moved every mode out). Impedance only.
 double FirstModeHz(const NominalNetwork& n, std::span<const AppliedEffect> effects, double f_lo,
                    double f_hi) {

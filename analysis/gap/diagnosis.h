@@ -77,7 +77,7 @@ struct GapOptions {
   // fault). Both lower the first mode, and near the information limit (the spring fits as well
   // as the true second inertia) the coupled inertia's larger Occam penalty (4 parameters against
   // 2) decides for the spring unless the prior says otherwise. Measured on 197 coupled-inertia
-  // and fixture-spring cases of the independent generator (README "Benchmarks: gap diagnosis";
+  // and fixture-spring cases of the independent generator (analysis/gap/README.md;
   // six seeds, all looked at for the choice): odds 5 name 90 of 112 inertias and 82
   // of 85 springs, 15 name 99 and 79, 20 name 100 and 78 (separable springs 70, 69, 68 of 71).
   std::vector<std::pair<EffectKind, double>> prior_odds = {{EffectKind::kCoupledInertia, 15.0}};

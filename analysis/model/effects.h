@@ -1,4 +1,4 @@
-// Unmodelled effects (NOTES.md 5) as structural additions to the nominal network, for the
+// Unmodelled effects (analysis/README.md 5) as structural additions to the nominal network, for the
 // sim-to-real gap diagnosis (analysis/gap/). Each effect has few parameters, an equation
 // below and physical plausibility bounds that depend on the nominal and the band.
 //

@@ -1,4 +1,4 @@
-// The clamped motor seen from one stator phase pair (the paper, eq. 12-14, NOTES.md 1-2).
+// The clamped motor seen from one stator phase pair (the paper, eq. 12-14, analysis/README.md 1-2).
 #pragma once
 
 #include <complex>
@@ -13,7 +13,7 @@ namespace eol::analysis {
 //   Z(s) = R + s L + Zp(s),     Zp(s) = Rp / (1 + Q (s/w0 + w0/s)),   w0 = 2 pi f0
 // This is eq. (14) rearranged: Zp = T^2 / Z_m with Z_m = k/s + R_m + s J, so
 //   Rp = T^2 / R_m,  Lp = T^2 / k,  Cp = J / T^2,  w0 = sqrt(k / J),  Q = sqrt(J k) / R_m.
-// Only these five combinations are identifiable from Z alone (NOTES.md 1).
+// Only these five combinations are identifiable from Z alone (analysis/README.md 1).
 // Re Z peaks at f0 with height R + Rp; |Z| peaks slightly below f0 (inductive background).
 struct MotionalImpedance {
   double r_ohm = 0.0;

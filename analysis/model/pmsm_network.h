@@ -1,5 +1,5 @@
 // The paper's lumped network of a PMSM under single-phase excitation, in physical parameters
-// (the paper, eq. 3-30; NOTES.md 1). Laplace variable s = j w, w = 2 pi f.
+// (the paper, eq. 3-30; analysis/README.md 1). Laplace variable s = j w, w = 2 pi f.
 //
 // Transducer (eq. 3-4): u = T(phi) * angular velocity, torque = T(phi) * i, with
 // T(phi) = T_hat sin(p phi) (p pole pairs, phi the rotor position, eq. 1-2).
@@ -62,7 +62,7 @@ std::complex<double> MechanicalTransfer(const PmsmParams& p, double f_hz);
 double UndampedPoleFrequencyHz(const PmsmParams& p);
 double UndampedZeroFrequencyHz(const PmsmParams& p);
 
-// The five combinations Z identifies (NOTES.md 1; motor_model.h):
+// The five combinations Z identifies (analysis/README.md 1; motor_model.h):
 //   Rp = T^2 / R_m,  f0 = 1 / (2 pi sqrt(J_r C_m)),  Q = sqrt(J_r / C_m) / R_m,  R, L.
 MotionalImpedance ToMotional(const PmsmParams& p);
 // And back, with J_r given from elsewhere (the sixth parameter Z cannot identify):

@@ -1,4 +1,4 @@
-// The clamped rotor of a PMSM as a torsional chain (NOTES.md 2; the paper, section 4):
+// The clamped rotor of a PMSM as a torsional chain (analysis/README.md 2; the paper, section 4):
 //
 //   magnet_i --bond_i-- pole_i --bridge_i-- hub --shaft-- clamp --fixture-- ground
 //                                                 (rigid fixture: hub --shaft-- ground)

@@ -1,4 +1,4 @@
-// A lumped torsional network: inertias joined by springs with dampers (NOTES.md 2).
+// A lumped torsional network: inertias joined by springs with dampers (analysis/README.md 2).
 //
 // Degrees of freedom theta (rad), one per inertia. Each element joins two inertias, or one
 // inertia and ground, with a spring k (N m/rad) in parallel with a damper c (N m s/rad).

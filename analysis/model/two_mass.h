@@ -63,7 +63,7 @@ struct TwoMassFitOptions {
   // Lines used: f_lo_hz <= f <= f_hi_hz (0, 0: all).
   double f_lo_hz = 0.0;
   double f_hi_hz = 0.0;
-  bool fit_friction = false;  // add beta (NOTES.md 5: an optional term, one parameter)
+  bool fit_friction = false;  // add beta (analysis/README.md 5: an optional term, one parameter)
   bool fit_delay = false;     // add tau
   int max_iterations = 400;
 

@@ -12,7 +12,7 @@
 // statistic with the most separation for a shift along d among good units with covariance S
 // (of ln f0, ln A) is w = S^-1 d (Fisher's discriminant); scaled so that ln A has weight 1,
 // the exponent is m = -w_f0 / w_A. m = 0 is the residue alone; m grows when f0 varies little
-// among good units relative to A. Evidence (README, "Learning limits"): on the independent
+// among good units relative to A. Evidence (analysis/qc/README.md): on the independent
 // generator (m = 5.3 from 300 good units), all ten bonds at losses 0.85-0.90 were rejected
 // 18 of 51 with the index against 9 of 51 with f0 and A alone at the same false-reject budget.
 //

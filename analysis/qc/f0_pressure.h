@@ -10,7 +10,7 @@
 // good rotors, and a soft bond has to lower f0 past that spread to be caught. The exponent m is
 // measured, not assumed: teaching regresses ln f0 on ln p over the golden units and declares
 // the measurement only when the slope is positive and significant (TeachF0Pressure).
-// Evidence (README, "Learning limits"): on tests/peers/independent_population.py's chain (600
+// Evidence (analysis/qc/README.md): on tests/peers/independent_population.py's chain (600
 // good rotors, seed 5), slope 0.114, the good units' f0 spread 1.06 % -> 0.85 %, all ten bonds
 // at a loss of 0.92 from z -2.56 to -3.20.
 //

@@ -34,8 +34,8 @@
 //                                           units' spread (bond_index.h; taught first: its
 //                                           exponent and references from the golden units).
 //                                           Evidence for 0.20 / 0.10 / 0.30 against f0 0.30
-//                                           and residue 0.30 without it (README, "Learning
-//                                           limits"): independent generator, 400 all-ten
+//                                           and residue 0.30 without it (analysis/qc/
+//                                           README.md): independent generator, 400 all-ten
 //                                           rotors at losses 0.8-0.99, seeds 1 and 2: 188 and
 //                                           160 rejected against 174 and 157, three soft
 //                                           71 / 89 against 66 / 88, 0 of 400 good; line model

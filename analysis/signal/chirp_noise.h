@@ -4,17 +4,17 @@
 // Periodic chirp: one period of N = sample_rate_hz / line_spacing_hz samples (a whole number,
 // T = N / fs) sweeps the band linearly, f(t) = f_lo + (f_hi - f_lo) t / T:
 //   u(t) = peak_v sin(phi(t)),   phi(t) = 2 pi (f_lo t + (f_hi - f_lo) t^2 / (2 T)),
-// so its crest factor is sqrt(2) (NOTES.md 3). Repeated, it is periodic, so its power sits on
-// the DFT lines k / T only; a chirp cannot put all of it inside [f_lo, f_hi]: about 1 % leaks
-// into the lines just outside (the Fresnel skirts of width ~ sqrt((f_hi - f_lo) / T)), and the
-// in-band line amplitudes ripple by about +20 %/-50 % at the edges. Estimate it with the
+// so its crest factor is sqrt(2) (analysis/README.md 3). Repeated, it is periodic, so its power
+// sits on the DFT lines k / T only; a chirp cannot put all of it inside [f_lo, f_hi]: about 1 %
+// leaks into the lines just outside (the Fresnel skirts of width ~ sqrt((f_hi - f_lo) / T)), and
+// the in-band line amplitudes ripple by about +20 %/-50 % at the edges. Estimate it with the
 // periodic estimator on Excitation::lines (the band lines), as a multisine.
 //
 // Band-limited noise: white Gaussian samples (seeded, reproducible) filtered to [f_lo, f_hi]
 // by zeroing every DFT bin of the whole record outside the band. Not periodic: estimate with
 // Welch (welch.h). Its crest factor grows slowly with the record length (the largest of many
 // Gaussian samples): about 4.2 for 10 s and 4.5-4.7 for a minute in a 600 Hz band, so noise
-// needs about 10 times the time of a multisine for the same accuracy (NOTES.md 3).
+// needs about 10 times the time of a multisine for the same accuracy (analysis/README.md 3).
 #pragma once
 
 #include <cstddef>

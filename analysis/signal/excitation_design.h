@@ -25,7 +25,7 @@
 //
 // The record: periods >= min_periods (2 for the transient-aware estimator, which removes the
 // start transient instead of waiting it out: transient_frf.h); the bound is computed for the
-// whole record (the transient-aware estimator reaches it: std/CRB 1.01, README).
+// whole record (the transient-aware estimator reaches it: std/CRB 1.01, analysis/README.md).
 // Candidates: the largest spacing that resolves the mode (fs / n for a whole n), and halves of
 // it; per candidate the fewest periods that meet the bound; the shortest record wins (a tie:
 // the coarser grid, fewer lines to fit).

@@ -4,7 +4,8 @@
 // samples (must be a whole number). Lines are the DFT bins k (f_k = k * line_spacing_hz) in
 // [f_lo_hz, f_hi_hz]; all get the same amplitude. Phases (F lines, i = 1..F):
 //   Schroeder:  phi_i = -pi i (i - 1) / F     crest factor about 1.7 for a band from near DC,
-//                                             1.9 for the recipe's 200-800 Hz (NOTES.md 3)
+//                                             1.9 for the recipe's 200-800 Hz (analysis/README.md
+//                                             3)
 //   random:     phi_i uniform on [0, 2 pi)    crest factor about 3.6-3.9 (seeded)
 // Clipping iterations (clip in time at 0.9 of the peak, restore the line amplitudes in
 // frequency, keep the phases the clipping produced, zero every other bin) converge slowly:
@@ -22,7 +23,7 @@
 // line amplitudes equal; the best period seen (the smallest max(peak u, w peak i) / rms u) is
 // kept and scaled to peak_v as before. For the fast recipe's limits (8 V, 1.6 A) the same
 // current range then carries about 1.6 times the line amplitude (about 2.6 times the
-// information; README, Transient-aware estimator and cycle time).
+// information; analysis/README.md, Excitation designed for time).
 #pragma once
 
 #include <complex>

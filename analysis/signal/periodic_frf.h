@@ -5,8 +5,8 @@
 //   X = mean_p X_p,  Y = mean_p Y_p,  H = (j w)^n Y / X      (n = output_jw_power)
 //   var H = w^2n / (P |X|^2) * (s_Y^2 + |H0|^2 s_X^2 - 2 Re(conj(H0) s_YX)),   H0 = Y / X
 //         = |H|^2 / P * (s_Y^2/|Y|^2 + s_X^2/|X|^2 - 2 Re(s_YX / (Y X*)))
-// with s_X^2, s_Y^2, s_YX = cov(Y_p, X_p) the period-to-period (co)variances (NOTES.md 3).
-// With few periods each line's (co)variances are poor (2(P-1) degrees of freedom: 6 for the
+// with s_X^2, s_Y^2, s_YX = cov(Y_p, X_p) the period-to-period (co)variances (analysis/README.md
+// 3). With few periods each line's (co)variances are poor (2(P-1) degrees of freedom: 6 for the
 // recipe's 4 periods), and a weighted fit with such sigmas loses efficiency (the weights'
 // scatter inflates var(f0) by about (nu-2)/(nu-4) = 2 at nu = 6) and under-covers. The noise
 // spectra s_X^2, s_Y^2, s_YX of sensor noise are smooth in frequency, so they are pooled

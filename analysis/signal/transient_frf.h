@@ -42,11 +42,11 @@
 //     Q = 150: about 3 for every choice: the mode's transient (f0 / (2 Q) = 1.3 Hz) is
 //              narrower than the record's 2 Hz bins and has not decayed by the record's end
 //              (tau = Q / (pi f0) = 0.12 s); such a mode also has fewer than 1 line per
-//              half-power band at 4 Hz spacing (NOTES.md 3 asks for 3): the spacing, not the
-//              estimator, is wrong for it.
+//              half-power band at 4 Hz spacing (analysis/README.md 3 asks for 3): the spacing, not
+//              the estimator, is wrong for it.
 // The winding's L / (R + R_s) transient (tens of Hz wide) is removed far below the noise by
 // any of them. Measured on f0 with `eol fit-bench --frf-method transient_lpm --sim
-// time_domain` (README).
+// time_domain` (analysis/README.md).
 //
 // Sigma. The residuals of the polynomial fit give the channels' noise (co)variances at each
 // excited line, with q = 2 w - (R + 1) complex degrees of freedom:
@@ -70,7 +70,7 @@
 //
 // Cost: one real FFT of the whole record per channel (N log N), then per excited line a
 // (2 w) x (R + 1) least-squares fit: O(N log N + lines w R^2). Under a millisecond for the
-// recipe's record (README).
+// recipe's record (analysis/README.md).
 //
 // Refusals as periodic_frf.h (CheckChannels: NaN, clipping, unequal lengths; no signal when
 // more than a tenth of the lines have their corrected input within min_line_snr of the noise).

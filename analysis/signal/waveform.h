@@ -12,7 +12,7 @@ double PeakAbs(const std::vector<double>& x);
 // sqrt(mean x_t^2) (0 for an empty waveform).
 double Rms(const std::vector<double>& x);
 // Peak over rms, PeakAbs(x) / Rms(x): sqrt(2) for a sine, ~1.5-1.7 for a Schroeder multisine
-// (NOTES.md 3). 0 when the waveform is empty or all zero.
+// (analysis/README.md 3). 0 when the waveform is empty or all zero.
 double CrestFactor(const std::vector<double>& x);
 
 // The DFT bins k (f_k = k * line_spacing_hz) with f_lo_hz <= f_k <= f_hi_hz, increasing. A

@@ -13,15 +13,15 @@
 // This is scipy.signal.csd / welch / coherence with window 'hann', detrend 'constant',
 // noverlap = floor(overlap M): csd(x, y) = conj(X) Y, so H1 = Pxy / Pxx.
 //
-// Per-line sigma (E|dH|^2 = sigma^2), from the coherence (Bendat and Piersol, NOTES.md 3):
-// std|H|/|H| = sqrt(1 - g^2) / (|g| sqrt(2 n_d)), and the phase error (radians) is the same,
-// so the complex error is circular with E|dH|^2 = 2 |H|^2 (1 - g^2) / (2 g^2 n_d):
+// Per-line sigma (E|dH|^2 = sigma^2), from the coherence (Bendat and Piersol, analysis/README.md
+// 3): std|H|/|H| = sqrt(1 - g^2) / (|g| sqrt(2 n_d)), and the phase error (radians) is the same, so
+// the complex error is circular with E|dH|^2 = 2 |H|^2 (1 - g^2) / (2 g^2 n_d):
 //   sigma = |H| sqrt((1 - g^2) / (g^2 n_d)).
 // Overlapping segments are not independent: n_d is Welch's equivalent number of averages,
 //   n_d = K / (1 + 2 sum_{j=1}^{K-1} (1 - j/K) rho_j^2),   rho_j = sum_n w_n w_{n+jS} / sum_n w_n^2
 // (K for no overlap, about K / 1.06 at 50 % with Hann). The formula holds for many averages
 // and does not include the leakage bias of a lightly damped peak: Hann segments need
-// M / fs >= 8 / B3dB for a bias of at most 2 % (NOTES.md 3).
+// M / fs >= 8 / B3dB for a bias of at most 2 % (analysis/README.md 3).
 #pragma once
 
 #include <cstddef>

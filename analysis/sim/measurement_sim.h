@@ -4,7 +4,7 @@
 // it (drivers/sim/sim_daq.h: 2 mV and 1 mA rms at 8 kHz), and the periodic errors-in-variables
 // estimate with per-line sigma (periodic_frf.h).
 //
-// Expected per-line sigma of that estimate (NOTES.md 3), for line amplitude |U_k| of the
+// Expected per-line sigma of that estimate (analysis/README.md 3), for line amplitude |U_k| of the
 // period (DFT scaled by 2/N), N samples per period, P averaged periods:
 //   E|dU|^2 = 4 s_u^2 / N,  E|dI|^2 = 4 s_i^2 / N per period,  |I_k| = |U_k| / |Z_k|,
 //   sigma_k^2 = |Z_k|^2 / P (E|dU|^2 / |U_k|^2 + E|dI|^2 / |I_k|^2).

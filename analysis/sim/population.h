@@ -1,4 +1,5 @@
-// A production population of clamped ten-pole rotors, calibrated to the paper (NOTES.md 2):
+// A production population of clamped ten-pole rotors, calibrated to the paper (analysis/README.md
+// 2):
 //   good rotor, rigid fixture            706 Hz  -> k_rotor = J (2 pi 706)^2
 //   poorly cemented magnets, rigid       529 Hz  -> k_rotor_defect = J (2 pi 529)^2
 //   good rotor in the default fixture    390 Hz  -> k_fixture from the series spring:

@@ -21,7 +21,8 @@
 //   kZeroOrder    u constant over the sample (c_0 = u[n]): what a DAC without reconstruction
 //                 filter plays. The sampled staircase and the current it drives are then related
 //                 by the ZOH equivalent, not by Z: U/I = Z e^{j w Ts/2} / sinc(f Ts) roughly, a
-//                 half-sample skew (NOTES.md 5) of several ohms in Re Z at 800 Hz and 8 kHz.
+//                 half-sample skew (analysis/README.md 5) of several ohms in Re Z at 800 Hz and 8
+//                 kHz.
 //   kBandLimited  (default) u is the Lagrange polynomial through the hold_points samples
 //                 n-h+1 .. n+h around the interval (h = hold_points/2), which approaches the
 //                 band-limited interpolation of the samples (a DAC with its reconstruction

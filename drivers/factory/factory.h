@@ -1,4 +1,4 @@
-// The one place that lists the drivers and makes them from configuration (STYLE.md 1).
+// The one place that lists the drivers and makes them from configuration (drivers/README.md).
 //
 //   "fixture": {"driver": "sim"}                    in-process simulated bench
 //   "fixture": {"driver": "modbus-tcp", "host": "10.0.0.20", "port": 502, "unit_id": 1, ...}
@@ -12,7 +12,7 @@
 //                                                   a sound interface (alsa_daq.h)
 //   "daq":     {"driver": "replay", "files": [...] | "directory": "..." | "file": "..."}
 //                                                   recordings from files (replay_daq.h)
-//              keys of these and the calibration: daq/daq_config.h
+//              keys of these and the calibration: factory/daq_config.h
 //   "sim":     {"population": {...}, "clamp_close_s": 0.15, ...,   the simulated bench
 //               "masters": [{"serial": "MASTER-G"}, {"serial": "MASTER-L", "defective": true}],
 //               "fixture_wear_per_test": 0.001,

@@ -1,4 +1,4 @@
-// The error every file reader and writer of station/files throws: it names the file and,
+// The error every file reader and writer of drivers/io throws: it names the file and,
 // for text files, the line and column (1-based) where the problem is.
 #pragma once
 

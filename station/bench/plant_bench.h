@@ -1,4 +1,4 @@
-// `eol plant-bench`: the plant-integration figures of the README, measured against a real
+// `eol plant-bench`: the plant-integration figures of station/README.md, measured against a real
 // MQTT broker and a real PostgreSQL server (deploy/plant-bench.sh starts throwaway ones):
 //   - end-to-end delay, record stored -> received by an MES subscriber (QoS 1) and -> its row
 //     visible in the central `tests` table, with the station's own publisher and replicator

@@ -37,7 +37,7 @@ struct CentralConfig {
   double idle_poll_s = 0.05;  // how often an idle replicator looks at the outbox
 };
 
-// For the README, /metrics and tests.
+// For station/README.md, /metrics and tests.
 struct CentralStatus {
   bool connected = false;
   std::int64_t backlog = -1;        // outbox rows not yet in the central record (-1: unknown)

@@ -1,6 +1,7 @@
 // The plant's central record in PostgreSQL, created by the stations themselves
 // (CREATE ... IF NOT EXISTS, under an advisory lock so that eight stations starting at once
-// do not race on the catalogue). The README's "Central record" table documents these columns.
+// do not race on the catalogue). deploy/OPERATIONS.md's "Central record" table documents these
+// columns.
 //
 // tests: one row per stored record of every station, unique on (station_id, test_id): the
 //   station's own test id (db/store.h) is the idempotency key, so a record replicated twice

@@ -1,8 +1,8 @@
 // `eol fit-bench`: the benchmark of the identification engine (analysis/bench/fit_bench.h) on the
 // recipe's measurement of the population's nominal good rotor with the simulated DAQ's noise,
 // and the same pipeline in SciPy on the same data for the time ratio
-// (station/bench/fit_bench_peer.h). Prints the five figures of issue 3; README "Benchmarks:
-// identification engine" records them.
+// (station/bench/fit_bench_peer.h). Prints the five figures that
+// analysis/README.md "Measured figures" records.
 #include <cmath>
 #include <iostream>
 #include <locale>

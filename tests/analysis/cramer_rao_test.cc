@@ -1,5 +1,5 @@
 // Tests of the Cramer-Rao bound (analysis/fit/cramer_rao.h): the Fisher matrix against an
-// independent finite-difference evaluation of the model, the NOTES.md 4 closed forms, and
+// independent finite-difference evaluation of the model, the analysis/README.md 4 closed forms, and
 // the bound's scaling laws.
 #include "analysis/fit/cramer_rao.h"
 
@@ -76,7 +76,7 @@ TEST(CramerRaoTest, ClosedFormKnownValues) {
 }
 
 // Lightly damped modes well inside the band: the full bound (all five parameters free, finite
-// band) agrees with the NOTES.md closed forms within 15 %.
+// band) agrees with the closed forms of analysis/README.md 4 within 15 %.
 TEST(CramerRaoTest, AgreesWithClosedFormWhenLightlyDamped) {
   struct Case {
     double f0_hz, q, rp_ohm, df_hz, sigma;

@@ -1,6 +1,6 @@
 // Excitation designs (multisine.h, chirp_noise.h): lines, levels, periodicity and the crest
-// factors of NOTES.md 3 (Schroeder ~1.7, after clipping iterations ~1.5; random phase ~3.6;
-// Gaussian noise ~4.7, growing slowly with the record length; chirp sqrt(2)).
+// factors of analysis/README.md 3 (Schroeder ~1.7, after clipping iterations ~1.5; random phase
+// ~3.6; Gaussian noise ~4.7, growing slowly with the record length; chirp sqrt(2)).
 #include <gtest/gtest.h>
 
 #include <cmath>

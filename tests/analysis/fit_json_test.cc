@@ -14,7 +14,7 @@
 namespace eol::analysis {
 namespace {
 
-// The paper's case (NOTES.md 2) with circular noise, sigma 0.02 ohm, fixed seed.
+// The paper's case (analysis/README.md 2) with circular noise, sigma 0.02 ohm, fixed seed.
 FitSummary ReferenceFit(bool with_sigma = true) {
   MotionalImpedance m;
   m.r_ohm = 0.5;

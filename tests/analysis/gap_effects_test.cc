@@ -151,8 +151,8 @@ TEST(GapEffects, PlausibilityBoundsNameTheParameter) {
 }
 
 // coupled_inertia at a node of the support against the mechanics written out (torque / angular
-// velocity, NOTES.md 1): J on the rotor spring k_r (c_r) to a node that holds J2 on k2 (c2) and
-// sits on the fixture spring k_f (c_f) to ground, damping stiffness-proportional, so that
+// velocity, analysis/README.md 1): J on the rotor spring k_r (c_r) to a node that holds J2 on k2
+// (c2) and sits on the fixture spring k_f (c_f) to ground, damping stiffness-proportional, so that
 // k = k_r k_f / (k_r + k_f) and x = k / k_r. Z = R + s L + T^2 / Zm.
 TEST(GapEffects, CoupledInertiaAtANodeIsTheThreeSpringChain) {
   const NominalNetwork n = PaperNominal();

@@ -149,7 +149,7 @@ TEST(GapResidual, EstimatedSigmaDoesNotWeighTheLinesByTheirOwnNoise) {
 
 // A ratio of period means, Z = mean U / mean I, over P = 8 periods with noise on both
 // channels (the voltage's s_u, the current's s_i per period), and its sigma from the periods
-// (NOTES.md 3). On an inductive Z from 1 to 38 ohm the voltage's noise dominates where
+// (analysis/README.md 3). On an inductive Z from 1 to 38 ohm the voltage's noise dominates where
 // |Z| < s_u / s_i = 20 ohm and the current's above. The per-line form (ChooseResidualForm)
 // takes the admittance form above the crossing and the impedance form below. The impedance
 // form is biased low on the current's lines (a line whose current came out high has a low |Z|

@@ -62,7 +62,7 @@ TEST(PaperRoute, AdmittanceFitOnNoiseFreeDataRecoversThePhysicalParameters) {
 
 TEST(PaperRoute, AdmittanceFitWithNoiseIsConsistentWithItsSigma) {
   const PmsmParams p = Motor();
-  // sigma 0.02 ohm: SNR_pk ~ 650, the regime of NOTES.md 4.
+  // sigma 0.02 ohm: SNR_pk ~ 650, the regime of analysis/README.md 4.
   for (std::uint64_t seed : {3u, 4u, 5u}) {
     const PaperRouteSummary s = FitPaperAdmittance(Impedance(p, 0.02, seed), p.inertia_kg_m2);
     ASSERT_TRUE(s.usable) << s.message;

@@ -1,7 +1,7 @@
-// The production line model (analysis/production/): units are reproducible, land where the
+// The production line model (analysis/qc/line_population.h): units are reproducible, land where the
 // rotor chain says, the fast modal impedance agrees with the chain's exact one, the fast
-// measurement's noise has the stated sigma, and the naive |Z| peak is biased as NOTES.md 2
-// says.
+// measurement's noise has the stated sigma, and the naive |Z| peak is biased as analysis/README.md
+// 2 says.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,8 +1,8 @@
 // Known-answer tests of FitMotionalResonance (analysis/fit/resonance_fit.h).
-// The reference motor is the paper's measured case (NOTES.md 2): R = 0.5 ohm, L = 2 mH,
+// The reference motor is the paper's measured case (analysis/README.md 2): R = 0.5 ohm, L = 2 mH,
 // Rp = 0.5 ohm, f0 = 390 Hz, Q = 50, lines 200..800 Hz at 1 Hz. Noise is circular complex
 // Gaussian with E|dZ|^2 = sigma^2; sigma = 0.02 ohm puts the peak at SNR_pk = 625 and the f0
-// bound near 0.045 Hz, the regime of NOTES.md 4.
+// bound near 0.045 Hz, the regime of analysis/README.md 4.
 #include "analysis/fit/resonance_fit.h"
 
 #include <gtest/gtest.h>

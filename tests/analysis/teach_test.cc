@@ -300,7 +300,7 @@ TEST(Teach, RefusesFewerUnitsThanNeededUnlessAllowed) {
             std::string::npos)
       << s.message;
   EXPECT_GT(s.units_needed, 20);
-  EXPECT_LE(s.units_needed, 40);  // the README workflow's 40 golden units are enough
+  EXPECT_LE(s.units_needed, 40);  // analysis/qc/README.md's 40 golden units are enough
   o.allow_few_units = true;
   s = TeachLimits(kStationSpecs, StationUnits(20, 7), o);
   ASSERT_TRUE(s.usable) << s.message;

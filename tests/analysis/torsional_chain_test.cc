@@ -1,6 +1,6 @@
 // The clamped rotor chain (analysis/model/rotor_chain.h, torsional_chain.h) against the
-// paper's numbers (NOTES.md 2): 706 Hz rigid, 529 Hz rigid with every bond poor, 390 Hz in
-// the default fixture; one soft magnet gives a local mode (a split peak on a rigid fixture).
+// paper's numbers (analysis/README.md 2): 706 Hz rigid, 529 Hz rigid with every bond poor, 390 Hz
+// in the default fixture; one soft magnet gives a local mode (a split peak on a rigid fixture).
 #include "analysis/model/torsional_chain.h"
 
 #include <gtest/gtest.h>

@@ -2,7 +2,7 @@
 // SocketCAN interface (EOL_CAN_INTERFACE; ctest runs this under
 // tests/support/vcan/with-vcan, whose shim every child process inherits):
 //   - tests/peers/can_fixture_peer.py (python3-can) playing a fixture node for our driver,
-//     and as a client of our emulator; it encodes the README's frame map on its own;
+//     and as a client of our emulator; it encodes deploy/OPERATIONS.md's frame map on its own;
 //   - can-utils' cansend and candump against the emulator.
 // Peers are declared dependencies (deploy/install-deps.sh --tests): a missing one fails the
 // test with the install hint; it never skips.

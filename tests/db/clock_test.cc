@@ -80,7 +80,7 @@ TEST(ClockTest, RefusesWhatIsNotAnIso8601TimeNamingWhy) {
             "such as +02:00");
 }
 
-// Found by tests/fuzz/http_body_fuzzer (?from=1026-11-26T10:00:00.123+01:00): a year outside
+// Found by tests/fuzz/http_body_fuzzer.cc (?from=1026-11-26T10:00:00.123+01:00): a year outside
 // 1678..2262 overflowed system_clock's nanoseconds (undefined behaviour, a wrong time).
 TEST(ClockTest, NormalisesEveryFourDigitYearAndRefusesOffsetsBeyondThem) {
   auto n = [](const std::string& text) { return NormaliseIso8601(text, nullptr).value_or("-"); };

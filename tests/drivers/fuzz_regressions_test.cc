@@ -1,4 +1,4 @@
-// Inputs the fuzzers (tests/fuzz/, README "Fuzzing") found to break a reader's contract in
+// Inputs the fuzzers (tests/fuzz/, tests/README.md "Fuzzing") found to break a reader's contract in
 // drivers/io, each kept here as a test that fails without its fix. The inputs are in the
 // seed corpora too (tests/fuzz/corpus/<target>/finding-*).
 #include <gtest/gtest.h>

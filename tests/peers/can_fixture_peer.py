@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""An independent CAN peer for the fixture frame map (README "Fixture over CAN"), on
-python3-can's socketcan interface. The frame layout is written out here from the README,
+"""An independent CAN peer for the fixture frame map (deploy/OPERATIONS.md "Fixture over CAN"), on
+python3-can's socketcan interface. The frame layout is written out here from deploy/OPERATIONS.md,
 not taken from our code, so a drift between the two fails the tests.
 
   node IFNAME [--node-id N] [--pressure-counts C] [--heartbeat-stops-after-ms T]

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Blind cases for `eol gap`, written from the physics with no code shared with analysis/.
 
-Each case is a random clamped motor (the paper's network, NOTES.md 1-2), one hidden effect or
+Each case is a random clamped motor (the paper's network, analysis/README.md 1-2), one hidden effect or
 none, and a periodic multisine measurement with noise on both channels, written as
   case-NNN-sim.csv   the nominal's impedance, noise-free (f_hz,re_ohm,im_ohm)
   case-NNN-meas.csv  the measured impedance with sigma from the periods (f_hz,re_ohm,im_ohm,
@@ -30,7 +30,7 @@ Hidden effects (the measured unit has them, the simulation does not):
 Measurement: a Schroeder multisine voltage on every line of the band, P periods; per period
 and line the channels are U_p = V + n_u, I_p = V / Z + n_i with independent complex Gaussian
 noise (what white noise gives on the lines of a whole period). Z = mean U / mean I and
-  var Z = |Z|^2 / P (s_U^2/|U|^2 + s_I^2/|I|^2 - 2 Re(s_UI / (U I*)))   (NOTES.md 3)
+  var Z = |Z|^2 / P (s_U^2/|U|^2 + s_I^2/|I|^2 - 2 Re(s_UI / (U I*)))   (analysis/README.md 3)
 with the sample (co)variances of the P periods: sigma^2 then has 2 (P - 1) degrees of freedom.
 The channel noise is scaled so that the effect's strength
   S = sqrt(sum_k 2 |Z_meas_true - Z_nominal|^2 / sigma_true_k^2)

@@ -4,7 +4,7 @@
 Shares no code or model with analysis/ (issue 12): its own chain topology, its own spreads,
 its own damping law and its own measurement simulation. Only the nominal numbers are chosen so
 that the station's shipped recipe (recipes/pmsm-10pole.json) sees the same band: good rotors
-ring near 390 Hz in the fixture (NOTES.md section 2: 706 Hz rigid shaft, 529 Hz with every
+ring near 390 Hz in the fixture (analysis/README.md section 2: 706 Hz rigid shaft, 529 Hz with every
 magnet bonded on one side only, 390 Hz in the real fixture).
 
 Mechanics: a clamped torsional chain, N = 14 degrees of freedom (angles, rad):
@@ -47,7 +47,7 @@ Measurement: periodic Schroeder multisine over 200-800 Hz at 1 Hz spacing (601 l
 peak with crest factor 1.7 (line amplitude A = 2 / (1.7 sqrt(601 / 2)) V), sampled at 8 kHz,
 P = 4 periods of 1 s. The DAQ adds white noise of 2 mV (voltage) and 1 mA (current) rms per
 sample: per period and line the DFT error is complex Gaussian with E|e|^2 = 4 s^2 / N
-(N = 8000 samples). Z = mean U / mean I; its sigma from the period-to-period scatter (NOTES.md
+(N = 8000 samples). Z = mean U / mean I; its sigma from the period-to-period scatter (analysis/README.md
 section 3), var Z = |Z|^2 / P (s_U^2 / |U|^2 + s_I^2 / |I|^2 - 2 Re(s_UI / (U I*))), the
 sample (co)variances pooled over 11 neighbouring lines (4 periods alone give 3 degrees of
 freedom per line).

@@ -1,6 +1,6 @@
 // Taught limits on populations simulated independently of analysis/ (issue 12), through
-// tests/peers/population_rejects.py (the README workflow: `eol teach` from 40 golden units of
-// tests/peers/independent_population.py, then `eol analyze --recipe taught` unit by unit).
+// tests/peers/population_rejects.py (analysis/qc/README.md's workflow: `eol teach` from 40 golden
+// units of tests/peers/independent_population.py, then `eol analyze --recipe taught` unit by unit).
 //
 // 1. Poorly cemented rotors (fixed seeds 101 and 202): soft bonds lose 94-99 % of their
 //    stiffness (0.96 is the paper's magnets-cemented-on-one-side case; the blind populations'
@@ -29,7 +29,7 @@
 //    never rejects fewer all-ten-soft rotors nor more good ones than the same teaching without
 //    the pressure.
 // Milder softness (losses below about 0.9) moves f0 by less than the good units' spread: no
-// limit on this fixture sees it (README, "Learning limits and detectability").
+// limit on this fixture sees it (analysis/qc/README.md).
 #include <gtest/gtest.h>
 #include <unistd.h>
 

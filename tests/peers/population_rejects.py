@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The README workflow on independent populations: rejected units per class.
+"""The teaching workflow of analysis/qc/README.md on independent populations: rejected units per class.
 
 For each seed: independent_population.py writes a population (truth.csv says each unit's
 class); `eol teach --recipe R --golden <the first --golden good units> --out taught.json`

@@ -1,7 +1,7 @@
 // The soak of issue 14, CI-sized: tests/peers/soak_station.py drives `eol station` against
 // `eol fixture-sim` over Modbus TCP from outside (Python's http.client and sqlite3, no code of
 // ours) for 120 tests with fixture faults, SIGKILLs and file-size caps mixed in. The full run
-// (5000 tests) is documented in the README ("Soak").
+// (5000 tests) is documented in station/README.md ("Soak").
 #include <gtest/gtest.h>
 
 #include <chrono>

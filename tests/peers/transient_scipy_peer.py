@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Independent peer for the transient-aware FRF estimator (analysis/signal/transient_frf.h).
 
-Simulates, FROM REST and written from the physics alone (NOTES.md 1-2: the clamped rotor as
+Simulates, FROM REST and written from the physics alone (analysis/README.md 1-2: the clamped rotor as
 one inertia J on a spring k with damper c, transducer T, winding R and L, the amplifier's
 output and shunt resistance Rs in series), the recording the station would make of a
 periodic multisine switched on at t = 0:

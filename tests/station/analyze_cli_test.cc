@@ -140,7 +140,7 @@ TEST(AnalyzeCliTest, RawRecordingCsvAndWav) {
 
 // Random excitation: band-limited noise through the motor (the record's circular steady state,
 // a linear response apart from the wrap at the record's ends), Welch H1 with 2 s segments
-// (>= 8 / B3dB, NOTES.md 3), sigma from the coherence.
+// (>= 8 / B3dB, analysis/README.md 3), sigma from the coherence.
 TEST(AnalyzeCliTest, NoiseRecordingWithWelch) {
   testing::TempDir dir;
   analysis::NoiseOptions n;

@@ -147,7 +147,7 @@ TEST_F(CentralRecordTest, EightStationsAndAServerStoppedMidRunLoseAndDuplicateNo
       },
       20s))
       << "every station should have met the outage";
-  // The back-off grows to its limit. EOL_CENTRAL_OUTAGE_S lengthens the outage (the README's
+  // The back-off grows to its limit. EOL_CENTRAL_OUTAGE_S lengthens the outage (station/README.md's
   // minutes-long run: EOL_CENTRAL_OUTAGE_S=180 ctest -R EightStations); the suite keeps 3 s.
   const char* outage_env = std::getenv("EOL_CENTRAL_OUTAGE_S");
   const double outage_s = outage_env ? std::strtod(outage_env, nullptr) : 3.0;

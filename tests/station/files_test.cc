@@ -1,4 +1,4 @@
-// Readers and writers of station/files: round trips, and garbage rejected with a FileError
+// Readers and writers of drivers/io: round trips, and garbage rejected with a FileError
 // naming file, line and column.
 #include <gtest/gtest.h>
 #include <sndfile.h>

@@ -5,8 +5,9 @@
 // evidence; the fit answers the basin with the better evidence, keeps the lowest-cost one for
 // the pairs, and the diagnosis then names the coupled inertia (with the lowest-cost basin it
 // named the fixture spring).
-// And a winding whose whole inductance is a semi-inductance (tests/data/gap-independent-semi-
-// inductance): the fractional inductance's share sits at its bound of 1, a plausible answer.
+// And a winding whose whole inductance is a semi-inductance
+// (tests/data/gap-independent-semi-inductance): the fractional inductance's share sits at its
+// bound of 1, a plausible answer.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,7 +1,7 @@
 // `eol gap` and `eol gap-bench` through the binary: the JSON's stable names, noise estimation
 // when a file has no sigma, several units (leave-one-unit-out), the plot, errors that name
 // the file, and a small blind benchmark (sanity only; the full one is a CLI benchmark,
-// README "Benchmarks: gap diagnosis").
+// analysis/gap/README.md "Measured figures").
 #include <gtest/gtest.h>
 
 #include <fstream>

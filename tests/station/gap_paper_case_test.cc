@@ -1,8 +1,8 @@
-// The paper's case end to end through the `eol` binary (NOTES.md 2, the paper's section 4):
-// the simulation clamps the shaft end rigidly (706 Hz), the real fixture rings at 390 Hz.
-// `eol gap` must name fixture_compliance, estimate the fixture's stiffness, and predict where
-// a rotor with poorly cemented magnets (706 -> 529 Hz in the simulation) rings in this real
-// fixture (about 350 Hz: -10 % instead of -25 %).
+// The paper's case end to end through the `eol` binary (analysis/README.md 2, the paper's section
+// 4): the simulation clamps the shaft end rigidly (706 Hz), the real fixture rings at 390 Hz. `eol
+// gap` must name fixture_compliance, estimate the fixture's stiffness, and predict where a rotor
+// with poorly cemented magnets (706 -> 529 Hz in the simulation) rings in this real fixture (about
+// 350 Hz: -10 % instead of -25 %).
 //
 // Two simulators stand for "the real motor": the population's single-mode clamped rotor
 // (analysis/sim/population.h; its fixture is exactly a series spring, so the stiffness and the

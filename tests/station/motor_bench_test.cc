@@ -1,4 +1,4 @@
-// The real motor bench (shared/data/motor-bench-multisine, README there): a servo motor driving
+// The real motor bench (tests/data/motor-bench-multisine, README there): a servo motor driving
 // a load inertia through a flexible coupling, excited by a periodic multisine on the q-axis
 // current (2500 Hz, 2500 samples per period, 20 periods). The periodic EIV estimator on the
 // pair x = iq, y = theta_motor with H = j w Theta / I (kMobility) after dropping the first
@@ -13,7 +13,7 @@
 // no friction to ground and no loop delay. So chi2/dof is in the hundreds to thousands: the
 // model error dominates the noise. "Reasonable" is asserted as: the normalised rms model
 // error sqrt(sum |dH|^2 / sum |H|^2) below 25 % (it is about 20 %, most of it at the peak),
-// chi2/dof below 5000, and the optional friction and delay terms (NOTES.md 5 style) lower
+// chi2/dof below 5000, and the optional friction and delay terms (analysis/README.md 5 style) lower
 // chi2/dof by at least a factor 3 (to about 330 for typeA, 830 for typeB).
 #include <gtest/gtest.h>
 

@@ -103,7 +103,7 @@ TEST_F(PlcHandshakeTest, StartsTestsAndReadsPassAndFailWithTheCounter) {
   ops.push_back({"read_ir", 100, 4});
   r = Plc(ops);
   ASSERT_EQ(r.size(), 7u);
-  // For the README: how long the PLC waited for the station to take the start, and for done.
+  // For station/README.md: how long the PLC waited for the station to take the start, and for done.
   std::cout << "[ figures  ] PLC start taken after " << r[2].value("waited_s", -1.0)
             << " s, done after " << r[4].value("waited_s", -1.0) << " s (sim test)\n";
   EXPECT_EQ(r[3]["values"], nlohmann::json::array({0})) << "refusal after an accepted start";

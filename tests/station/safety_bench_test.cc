@@ -1,6 +1,6 @@
 // `eol safety-bench`'s measurement (station/bench/safety_bench.h) over both fixtures: every
 // injected fault must end its test ERROR and yield a measured reaction (relay open after the fault
-// was visible). The figures themselves are benchmark output (README), not asserted here.
+// was visible). The figures themselves are benchmark output (station/README.md), not asserted here.
 #include "station/bench/safety_bench.h"
 
 #include <gtest/gtest.h>

@@ -372,8 +372,8 @@ TEST_F(SequencerTest, PoorlyCementedRotorFailsOnResonance) {
 }
 
 // Issue 17: ERROR is not shown as FAIL on the fixture: both lamps light (documented in
-// README, Safety), so an operator does not put a rotor the station could not judge in the
-// reject bin.
+// station/README.md, Safety), so an operator does not put a rotor the station could not judge in
+// the reject bin.
 TEST_F(SequencerTest, ErrorLightsBothLampsNotTheFailLampAlone) {
   Build(0.0);
   bench_->InjectFault(SimFault::kDoorOpens, 0ms, /*on_excitation=*/false);

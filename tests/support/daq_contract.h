@@ -1,5 +1,5 @@
 // The contract of drivers::Daq (drivers/daq/daq.h), one parameterised suite that every
-// acquisition backend runs (STYLE.md 9): sim, replay and ALSA. Each backend is a DaqBackend
+// acquisition backend runs (tests/README.md): sim, replay and ALSA. Each backend is a DaqBackend
 // that makes a DaqUnderTest: the driver configured with ContractCalibration() and ready for
 // ContractRequest(), plus a second driver of the same backend whose device is broken, so
 // that the suite can check that errors name the device. A backend that needs something the

@@ -1,5 +1,5 @@
 // The contract of drivers::Fixture (drivers/fixture/fixture.h), one parameterised suite that
-// every backend runs (STYLE.md 9): the sim fixture in-process, and the Modbus and CAN
+// every backend runs (tests/README.md): the sim fixture in-process, and the Modbus and CAN
 // fixtures against their emulators over real transports. Each backend is a FixtureBackend:
 // given the simulated bench (on a ManualClock), it starts whatever peer it needs and makes
 // the driver. The bench is the truth the driver is checked against: what a write did is read

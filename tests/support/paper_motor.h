@@ -1,5 +1,5 @@
-// The paper's ten-pole motor in the regime of NOTES.md 2 (f0 = 390 Hz, Q = 50), shared by the
-// tests of the paper's network and of its identification route.
+// The paper's ten-pole motor in the regime of analysis/README.md 2 (f0 = 390 Hz, Q = 50), shared by
+// the tests of the paper's network and of its identification route.
 #pragma once
 
 #include <numbers>
