@@ -112,6 +112,7 @@ void Station::StartHttp(const std::string& web_root) {
   o.port = config_.http_port;
   o.db_path = config_.db_path;
   o.tokens = config_.tokens;
+  o.hosts = config_.http_hosts;
   o.web_root = web_root;
   if (config_.central) o.central_postgres = config_.central->postgres;
   HttpHandlers h;
