@@ -140,6 +140,7 @@ inline void SendMalformed(int port, const std::atomic<bool>* stop, std::atomic<i
     if (SendAll(fd, frames[i % frames.size()])) ++*sent;
     ClosedByServer(fd, std::chrono::milliseconds(500));
     ::close(fd);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
 }
 
