@@ -184,7 +184,9 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       MqttConfig q;
       std::string why;
       bool tls = false;
-      m->Require(ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &tls, &why), "url", why);
+      // Not Require: its "(got ...)" would print a password; `why` shows the URL redacted.
+      if (!ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &tls, &why))
+        throw io::ConfigError(m->PathOf("url") + ": " + why);
       q.topic_prefix = m->String("topic_prefix", q.topic_prefix);
       m->Require(!q.topic_prefix.empty() &&
                      q.topic_prefix.find_first_of("#+") == std::string::npos &&

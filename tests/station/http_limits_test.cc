@@ -78,7 +78,7 @@ std::string Post(int port, const std::string& path, const std::string& body) {
 }
 
 TEST(JsonDepth, BracketsAreCountedOutsideStringsOnly) {
-  EXPECT_EQ(JsonNestingDepth(R"({"a": [1, {"b": []}]})", 64), 3);
+  EXPECT_EQ(JsonNestingDepth(R"({"a": [1, {"b": []}]})", 64), 4);
   EXPECT_EQ(JsonNestingDepth(R"({"a": "[[[[{{{{", "b": "\"[["})", 64), 1);
   EXPECT_EQ(JsonNestingDepth("1", 64), 0);
   EXPECT_EQ(JsonNestingDepth(std::string(100000, '['), 64), 65);  // stops at the first too deep

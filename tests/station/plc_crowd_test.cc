@@ -72,7 +72,10 @@ TEST(PlcCrowd, ASlowPlcIsCutOffAtTheFrameDeadlineAndTheCapRefusesTheExtra) {
 }
 
 TEST(PlcCrowd, TheConfigListensOnLoopbackUnlessToldAndSetsTheDeadlines) {
-  const nlohmann::json base = {{"recipe", "r.json"}, {"db", "x.sqlite"}};
+  const nlohmann::json base = {{"recipe", "r.json"},
+                               {"db", "x.sqlite"},
+                               {"fixture", {{"driver", "sim"}}},
+                               {"daq", {{"driver", "sim"}}}};
   nlohmann::json j = base;
   j["plc"] = nlohmann::json::object();
   EXPECT_EQ(ParseStationConfig(j, "t", "").plc->listen, "127.0.0.1");

@@ -48,7 +48,10 @@ TEST(ParseMqttUrl, RefusesUserInfoNamingTheFieldsAndNeverShowsThePassword) {
 }
 
 TEST(ParseMqttUrl, TheConfigRefusesUserInfoAndTakesTheFields) {
-  nlohmann::json j = {{"recipe", "r.json"}, {"db", "x.sqlite"}};
+  nlohmann::json j = {{"recipe", "r.json"},
+                      {"db", "x.sqlite"},
+                      {"fixture", {{"driver", "sim"}}},
+                      {"daq", {{"driver", "sim"}}}};
   j["mqtt"] = {{"url", "mqtt://line:s3cret@broker:1883"}};
   try {
     ParseStationConfig(j, "station.json", "");
