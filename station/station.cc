@@ -7,6 +7,7 @@
 
 #include "analysis/text.h"
 #include "db/clock.h"
+#include "drivers/fixture/modbus_tcp_server.h"
 #include "station/systemd_notify.h"
 #include "station/version.h"
 
@@ -107,6 +108,8 @@ Station::~Station() {
 }
 
 void Station::StartHttp(const std::string& web_root) {
+  // Many HTTP connections must never push the fixture link's descriptor past select()'s range.
+  drivers::KeepDescriptorsBelowFdSetSize();
   HttpOptions o;
   o.listen = config_.http_listen;
   o.port = config_.http_port;

@@ -5,6 +5,8 @@
 // same loop (tests/station/plc_crowd_test.cc).
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/select.h>
 
 #include <iostream>
 #include <memory>
@@ -191,6 +193,19 @@ TEST(ModbusTcpLoop, AClientThatNeverReadsItsRepliesIsClosed) {
   EXPECT_TRUE(ReadsBack(other, 4));
   ::close(other);
   ::close(fd);
+}
+
+TEST(ModbusTcpLoop, DescriptorsAreKeptBelowSelectsRange) {
+  rlimit r{};
+  ASSERT_EQ(getrlimit(RLIMIT_NOFILE, &r), 0);
+  if (r.rlim_max != RLIM_INFINITY && r.rlim_max <= FD_SETSIZE)
+    GTEST_SKIP() << "the hard limit " << r.rlim_max << " is within FD_SETSIZE already";
+  r.rlim_cur = r.rlim_max;  // as a unit file's LimitNOFILE=65536 would set it
+  ASSERT_EQ(setrlimit(RLIMIT_NOFILE, &r), 0);
+  EXPECT_EQ(KeepDescriptorsBelowFdSetSize(), FD_SETSIZE);
+  ASSERT_EQ(getrlimit(RLIMIT_NOFILE, &r), 0);
+  EXPECT_EQ(r.rlim_cur, static_cast<rlim_t>(FD_SETSIZE));
+  EXPECT_EQ(KeepDescriptorsBelowFdSetSize(), FD_SETSIZE);  // already within: unchanged
 }
 
 TEST(ModbusFixtureServerCrowd, EightIdleSlowAndMalformedClientsLeaveAWellBehavedOneServed) {
