@@ -66,7 +66,8 @@ std::variant<json, ApiError> ObjectBody(const httplib::Request& req,
     if (!known.count(key)) {
       std::string list;
       for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-      return BadRequest("unknown field " + Excerpt(key) + " (" + list + ")");
+      return BadRequest("unknown field '" + (key.size() > 100 ? key.substr(0, 100) + "..." : key) +
+                        "' (" + list + ")");
     }
   return parsed;
 }
