@@ -3,7 +3,9 @@
 // worker is taken (slow clients hold none; oversized heads, too many headers and too many
 // waiting connections of one peer are refused with bounded memory), the Host header must
 // name this station (DNS rebinding), and no response may be framed.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -31,9 +33,12 @@ using Clock = std::chrono::steady_clock;
 using eol::testing::RawClient;
 
 struct Api {
-  explicit Api(ServerLimits limits, std::vector<std::string> hosts = {}) : board("http-limits") {
+  explicit Api(ServerLimits limits, std::vector<std::string> hosts = {},
+               std::string listen = "127.0.0.1")
+      : board("http-limits") {
     db::Store::Open(dir / "s.sqlite");
     HttpOptions o;
+    o.listen = std::move(listen);
     o.port = 0;
     o.db_path = dir / "s.sqlite";
     o.limits = limits;
@@ -219,6 +224,31 @@ TEST(HttpLimits, TheHostHeaderMustNameThisStation) {
   EXPECT_EQ(ask("Host: 127.0.0.1.evil.example\r\n"), 421);
   EXPECT_EQ(ask(""), 400);
   EXPECT_EQ(ask("Host: 127.0.0.1\r\nHost: evil.example\r\n"), 400);
+}
+
+TEST(HttpLimits, OnEveryInterfaceTheAddressConnectedToIsAHostName) {
+  Api api(ServerLimits{}, {}, "0.0.0.0");
+  const auto ask = [&](const char* address, const std::string& host) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<std::uint16_t>(api.port()));
+    inet_pton(AF_INET, address, &a.sin_addr);
+    std::string got;
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) {
+      const std::string req =
+          "GET /api/status HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n";
+      ::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+      char buf[512];
+      const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+      if (n > 0) got.assign(buf, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    return got.size() >= 12 ? std::stoi(got.substr(9, 3)) : -1;
+  };
+  EXPECT_EQ(ask("127.0.0.2", "127.0.0.2"), 200);  // the address the client connected to
+  EXPECT_EQ(ask("127.0.0.2", "127.0.0.3"), 421);  // another address of this host: not asked
+  EXPECT_EQ(ask("127.0.0.2", "0.0.0.0"), 421);
 }
 
 TEST(HttpLimits, EveryResponseForbidsFraming) {
