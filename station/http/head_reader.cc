@@ -53,6 +53,18 @@ std::size_t PrefetchLength(const std::string& head, std::size_t cap) {
   return i > digits && n <= cap ? n : 0;
 }
 
+// Whether a head announces a body (chunked, or a Content-Length other than 0).
+bool HasBody(const std::string& head) {
+  std::string lower(head);
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (lower.find("\ntransfer-encoding:") != std::string::npos) return true;
+  const std::size_t at = lower.find("\ncontent-length:");
+  if (at == std::string::npos) return false;
+  const std::size_t from = at + 16, line_end = lower.find('\n', from);
+  return lower.substr(from, line_end - from).find_first_not_of(" \t\r0") != std::string::npos;
+}
+
 }  // namespace
 
 struct HeadReader::Waiting {
@@ -61,9 +73,10 @@ struct HeadReader::Waiting {
   int served = 0;
   std::string peer;
   Clock::time_point deadline;
-  std::size_t need = 0;   // once the head is in: the bytes to hold before dispatching
-  bool counted = false;   // in per_peer_ and waiting_count_
-  bool draining = false;  // refused: what it still sends is read and dropped until deadline
+  std::size_t need = 0;       // once the head is in: the bytes to hold before dispatching
+  bool body_pending = false;  // the head announces a body that is not prefetched
+  bool counted = false;       // in per_peer_ and waiting_count_
+  bool draining = false;      // refused: what it still sends is read and dropped until deadline
   bool done = false;
 };
 
@@ -235,18 +248,18 @@ bool HeadReader::Read(Waiting& w) {
     }
     if (end == std::string::npos) return true;
     w.need = end + PrefetchLength(w.bytes.substr(0, end), limits_.prefetch_body_bytes);
+    w.body_pending = w.need == end && HasBody(w.bytes.substr(0, end));
   }
   if (w.bytes.size() < w.need) return true;
   {
     std::lock_guard<std::mutex> lock(mu_);
     ++counts_.dispatched;
   }
-  const int fd = w.fd, served = w.served;
-  std::string bytes = std::move(w.bytes);
+  Ready ready{w.fd, std::move(w.bytes), w.served, w.peer, w.body_pending};
   w.fd = -1;
   Forget(w);
-  SetBlocking(fd, true);  // the workers' stream waits with poll() and writes whole responses
-  dispatch_(fd, std::move(bytes), served);
+  SetBlocking(ready.fd, true);  // the workers' stream waits with poll(), writes whole responses
+  dispatch_(std::move(ready));
   return false;
 }
 

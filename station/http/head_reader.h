@@ -32,8 +32,17 @@ namespace eol::station::http {
 class HeadReader {
  public:
   // A connection with its head read: the socket, the bytes read so far (the head, a body or
-  // part of it, maybe the start of a pipelined request) and the requests it already served.
-  using Dispatch = std::function<void(int fd, std::string bytes, int served)>;
+  // part of it, maybe the start of a pipelined request), the requests it already served, the
+  // peer's address and whether a body is still to be read (chunked, or a Content-Length
+  // above prefetch_body_bytes).
+  struct Ready {
+    int fd = -1;
+    std::string bytes;
+    int served = 0;
+    std::string peer;
+    bool body_pending = false;
+  };
+  using Dispatch = std::function<void(Ready ready)>;
 
   HeadReader(const ServerLimits& limits, Dispatch dispatch);
   ~HeadReader();  // Stop()

@@ -21,8 +21,9 @@ struct ServerLimits {
   std::size_t max_header_count = 64;              // header lines: 431 beyond
   std::size_t prefetch_body_bytes = 64 * 1024;    // a Content-Length body up to this is read too
   std::size_t max_waiting_per_peer = 256;         // connections of one address waiting for a head
-  std::size_t max_waiting = 768;          // of all addresses (below 1024 descriptors in all)
-  int max_requests_per_connection = 100;  // then Connection: close
+  std::size_t max_waiting = 768;              // of all addresses (below 1024 descriptors in all)
+  int max_requests_per_connection = 100;      // then Connection: close
+  std::size_t max_body_readers_per_peer = 8;  // workers reading bodies of one address
 };
 
 }  // namespace eol::station::http

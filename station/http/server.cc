@@ -15,6 +15,7 @@
 #include <deque>
 #include <functional>
 #include <list>
+#include <unordered_map>
 #include <vector>
 
 #include "station/http/head_reader.h"
@@ -49,13 +50,11 @@ int PollOne(int fd, short events, Clock::duration timeout) {
 // already taken its place. httplib creates one per listen and deletes it after shutdown().
 class ConnectionPool final : public httplib::TaskQueue {
  public:
-  using Serve = std::function<void(int fd, std::string bytes, int served)>;
+  using Serve = std::function<void(HeadReader::Ready ready)>;
 
   ConnectionPool(const ServerLimits& limits, Serve serve)
-      : limits_(limits), reader_(limits, [this, serve](int fd, std::string bytes, int served) {
-          Enqueue([serve, fd, bytes = std::move(bytes), served]() mutable {
-            serve(fd, std::move(bytes), served);
-          });
+      : limits_(limits), reader_(limits, [this, serve](HeadReader::Ready ready) {
+          Enqueue([serve, ready = std::move(ready)]() mutable { serve(std::move(ready)); });
         }) {
     std::lock_guard<std::mutex> lock(mu_);
     for (std::size_t i = 0; i < limits_.request_workers; ++i)
@@ -71,6 +70,21 @@ class ConnectionPool final : public httplib::TaskQueue {
     tl_admitting = nullptr;
   }
   HeadReader& reader() { return reader_; }
+
+  // A worker reading a body that was not prefetched, for `peer`: false when that peer has
+  // max_body_readers_per_peer workers reading bodies already.
+  bool TakeBodyReader(const std::string& peer) {
+    std::lock_guard<std::mutex> lock(mu_);
+    std::size_t& n = body_readers_[peer];
+    if (n >= limits_.max_body_readers_per_peer) return false;
+    ++n;
+    return true;
+  }
+  void ReleaseBodyReader(const std::string& peer) {
+    std::lock_guard<std::mutex> lock(mu_);
+    const auto it = body_readers_.find(peer);
+    if (it != body_readers_.end() && --it->second == 0) body_readers_.erase(it);
+  }
 
   void shutdown() override {
     reader_.Stop();
@@ -159,6 +173,7 @@ class ConnectionPool final : public httplib::TaskQueue {
   std::list<std::thread> threads_;
   std::vector<std::thread::id> finished_;
   std::size_t streams_ = 0;
+  std::unordered_map<std::string, std::size_t> body_readers_;
   bool stopping_ = false;
 };
 
@@ -297,6 +312,19 @@ void RefuseOverloaded(int fd, Clock::duration waited) {
   ::close(fd);
 }
 
+void RefuseSlowBodies(int fd, const std::string& peer, std::size_t max) {
+  const std::string body = R"({"error": {"code": "overloaded", "message": ")" +
+                           std::to_string(max) + " request bodies of " + peer +
+                           R"( are being read already; the request was not read"}})";
+  const std::string reply =
+      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nRetry-After: 1\r\n"
+      "Connection: close\r\nContent-Security-Policy: frame-ancestors 'none'\r\n"
+      "X-Frame-Options: DENY\r\nContent-Length: " +
+      std::to_string(body.size()) + "\r\n\r\n" + body;
+  (void)::send(fd, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+  LingeringClose(fd);
+}
+
 }  // namespace
 
 bool BecomeStream() { return tl_pool != nullptr && tl_pool->BecomeStream(); }
@@ -305,9 +333,8 @@ void CloseAfterResponse() { tl_close_after_response = true; }
 
 ApiServer::ApiServer(ServerLimits limits) : limits_(limits) {
   new_task_queue = [this] {
-    return new ConnectionPool(limits_, [this](int fd, std::string bytes, int served) {
-      ServeRequest(fd, std::move(bytes), served);
-    });
+    return new ConnectionPool(limits_,
+                              [this](HeadReader::Ready ready) { ServeRequest(std::move(ready)); });
   };
   const auto io = static_cast<time_t>(limits_.io_timeout.count());
   set_read_timeout(io, 0);
@@ -349,12 +376,26 @@ bool ApiServer::process_and_close_socket(::socket_t sock) {
   return true;
 }
 
-void ApiServer::ServeRequest(int sock, std::string bytes, int served) {
+void ApiServer::ServeRequest(HeadReader::Ready ready) {
+  const int sock = ready.fd;
+  const int served = ready.served;
   if (tl_waited > limits_.max_queue_wait) {
     RefuseOverloaded(sock, tl_waited);
     return;
   }
-  DeadlineStream stream(sock, limits_, std::move(bytes));
+  // A body still to come holds this worker until it is in: one peer may hold only so many.
+  if (ready.body_pending && !tl_pool->TakeBodyReader(ready.peer)) {
+    RefuseSlowBodies(sock, ready.peer, limits_.max_body_readers_per_peer);
+    return;
+  }
+  struct Release {
+    ConnectionPool* pool;
+    const HeadReader::Ready& r;
+    ~Release() {
+      if (r.body_pending) pool->ReleaseBodyReader(r.peer);
+    }
+  } release{tl_pool, ready};
+  DeadlineStream stream(sock, limits_, std::move(ready.bytes));
   stream.StartRequest();
   bool closed = false;
   const bool last = served + 1 >= limits_.max_requests_per_connection;

@@ -16,6 +16,9 @@
 //                    on head bytes, header lines and waiting connections per peer address
 //                    (station/http/head_reader.h); a worker gets a connection with its head in
 //                    hand, serves one request and gives a kept-alive connection back.
+//   slow bodies      a body that is not prefetched (chunked, or above prefetch_body_bytes) is
+//                    read by its worker: at most `max_body_readers_per_peer` workers read
+//                    bodies of one peer address; one more is answered 503 unread.
 //   deadlines        the rest of a body must arrive within `request_deadline` of the head, and
 //                    each read or write within `io_timeout`; a slow client is cut off when
 //                    either passes.
@@ -27,6 +30,7 @@
 
 #include <string>
 
+#include "station/http/head_reader.h"
 #include "station/http/limits.h"
 
 namespace eol::station::http {
@@ -59,7 +63,7 @@ class ApiServer final : public httplib::Server {
   bool process_and_close_socket(::socket_t sock) override;
   // On a worker: one request whose head (station/http/head_reader.h) is in `bytes`; the
   // connection goes back to the head reader when kept alive.
-  void ServeRequest(int sock, std::string bytes, int served);
+  void ServeRequest(HeadReader::Ready ready);
 
   const ServerLimits limits_;
   int listen_fd_ = -1;  // the listening socket, seen by the socket-options hook

@@ -185,6 +185,30 @@ TEST(HttpLimits, SlowClientsHoldNoWorkerAndANormalRequestIsAnsweredFast) {
   EXPECT_LT(ms.back(), 100.0);
 }
 
+TEST(HttpLimits, SlowBodiesOfOnePeerHoldAtMostTheirShareOfWorkers) {
+  ServerLimits limits;
+  limits.request_workers = 4;
+  limits.max_body_readers_per_peer = 2;
+  Api api(limits);
+  // Chunked bodies are not prefetched: each one read holds a worker until its deadline.
+  std::vector<std::unique_ptr<RawClient>> hogs;
+  for (int i = 0; i < 4; ++i) {
+    hogs.push_back(std::make_unique<RawClient>(api.port()));
+    hogs.back()->Send(
+        "POST /api/tests HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+        "Transfer-Encoding: chunked\r\n\r\n");
+  }
+  int refused = 0;
+  for (auto& h : hogs)
+    if (h->ReadUntil("}}", 300ms).find("503") != std::string::npos) ++refused;
+  EXPECT_EQ(refused, 2);
+  for (int i = 0; i < 10; ++i) {
+    const auto [status, took] = GetStatus(api.port());
+    EXPECT_EQ(status, 200);
+    EXPECT_LT(took, 100.0);
+  }
+}
+
 TEST(HttpLimits, WaitingConnectionsArePerPeerCappedAndCutAtTheHeadDeadline) {
   ServerLimits limits;
   limits.max_waiting_per_peer = 4;
