@@ -2,6 +2,8 @@
 
 #include <arpa/inet.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -86,6 +88,22 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
           c.tokens.push_back(token);
         }
       }
+      if (http->Has("hosts")) {
+        const nlohmann::json& list = http->Raw("hosts");
+        const auto name_ok = [](const nlohmann::json& h) {
+          if (!h.is_string()) return false;
+          const std::string s = h.get<std::string>();
+          return !s.empty() && s.size() <= 253 &&
+                 s.find_first_not_of(
+                     "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                     "0123456789.-[]:") == std::string::npos;
+        };
+        if (!list.is_array() || !std::all_of(list.begin(), list.end(), name_ok))
+          throw io::ConfigError(http->PathOf("hosts") +
+                                ": must be an array of host names or addresses, without a port "
+                                "(\"eol-1.plant.local\", \"10.0.0.5\")");
+        for (const auto& h : list) c.http_hosts.push_back(h.get<std::string>());
+      }
       http->RejectUnknown();
       // Without tokens anyone who reaches the port may start tests: only this host may.
       if (c.tokens.empty() && !IsLoopback(c.http_listen))
@@ -151,6 +169,13 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       p->Require(s.port >= 0 && s.port <= 65535, "port", "must be in [0, 65535]");
       p->Require(s.unit_id >= 1 && s.unit_id <= 247, "unit_id", "must be in [1, 247]");
       p->Require(s.max_clients >= 1 && s.max_clients <= 64, "max_clients", "must be in [1, 64]");
+      const double frame_ms = p->Number("frame_deadline_ms", 1000);
+      const double idle_s = p->Number("idle_timeout_s", 60);
+      p->Require(frame_ms >= 10 && frame_ms <= 60000, "frame_deadline_ms",
+                 "must be in [10, 60000] ms");
+      p->Require(idle_s >= 0.1 && idle_s <= 86400, "idle_timeout_s", "must be in [0.1, 86400] s");
+      s.frame_deadline = std::chrono::milliseconds(std::lround(frame_ms));
+      s.idle_timeout = std::chrono::milliseconds(std::lround(idle_s * 1000));
       if (p->Has("map")) s.map = plc::ParsePlcMap(p->Raw("map"), p->PathOf("map"));
       p->RejectUnknown();
       c.plc = s;
@@ -159,7 +184,9 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
       MqttConfig q;
       std::string why;
       bool tls = false;
-      m->Require(ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &tls, &why), "url", why);
+      // Not Require: its "(got ...)" would print a password; `why` shows the URL redacted.
+      if (!ParseMqttUrl(m->RequiredString("url"), &q.host, &q.port, &tls, &why))
+        throw io::ConfigError(m->PathOf("url") + ": " + why);
       q.topic_prefix = m->String("topic_prefix", q.topic_prefix);
       m->Require(!q.topic_prefix.empty() &&
                      q.topic_prefix.find_first_of("#+") == std::string::npos &&

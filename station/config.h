@@ -10,6 +10,9 @@
 //     Reads need no token. With tokens configured, starting a test needs an operator or
 //     engineer token; changing the recipe always needs an engineer token. Listening beyond
 //     loopback (anything but 127.0.0.0/8, ::1, localhost) needs tokens: refused otherwise.
+//     "hosts": ["eol-1.plant.local"]: the names browsers reach the station by; a request
+//     whose Host header is none of these, the listen address, the address it connected to
+//     or a loopback name (localhost, 127.0.0.1, [::1]) is refused 421 (DNS rebinding).
 //   "fixture": {"driver": "sim" | ...},              see drivers/factory/factory.h
 //   "daq": {"driver": "sim" | ...},
 //   "sim": {...},                                    the simulated bench, when a driver is sim
@@ -19,9 +22,13 @@
 //                                                    (its line format: station/test_request.h)
 //   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
 //                  "every_n_tests": 50, "every_hours": 8}       optional, station/self_check.h
-//   "plc": {"listen": "0.0.0.0", "port": 502, "unit_id": 1, "max_clients": 8,
+//   "plc": {"listen": "127.0.0.1", "port": 502, "unit_id": 1, "max_clients": 8,
+//           "frame_deadline_ms": 1000, "idle_timeout_s": 60,
 //           "map": {"serial": 100, ...}}         optional: the line PLC's handshake, served
-//                                                when the block is there (station/plc/)
+//                                                when the block is there (station/plc/).
+//                                                "listen" defaults to loopback (Modbus has no
+//                                                authentication): set it to the station's
+//                                                address in the PLC network
 //   "mqtt": {"url": "mqtt://host:1883" | "mqtts://host:8883", "topic_prefix": "plant/eol",
 //            "client_id": "", "username": "", "password": "", "keepalive_s": 30,
 //            "reconnect_s": 1,
@@ -88,6 +95,8 @@ struct StationConfig {
   std::string http_listen = "127.0.0.1";
   int http_port = 8080;
   std::vector<ApiToken> tokens;
+  // Host header values the API answers besides the listen address and loopback names.
+  std::vector<std::string> http_hosts;
   SafetyOptions safety;
   bool serial_from_stdin = false;
   // Store and publish the verdict while the clamp opens (SequencerOptions, station/sequencer.h).

@@ -71,6 +71,9 @@ struct HttpOptions {
   std::string db_path;
   // Empty: starting tests needs no token. Recipe changes always need an engineer token.
   std::vector<ApiToken> tokens;
+  // Host header names answered besides `listen`, the address connected to and loopback names
+  // (station/http/gate.h); others are refused 421.
+  std::vector<std::string> hosts;
   std::string web_root;  // folder of the operator page; empty: built-in fallback page
   // The central record's URI (station/central/): GET /api/units/{serial}?scope=plant reads
   // it; empty: that scope answers 400.

@@ -30,7 +30,8 @@ MqttPublisher::MqttPublisher(MqttConfig config, std::string station_id, std::str
     : config_(std::move(config)),
       station_id_(std::move(station_id)),
       db_path_(std::move(db_path)),
-      state_(std::move(state)) {}
+      state_(std::move(state)),
+      where_(RedactUrl("mqtt://" + config_.host + ":" + std::to_string(config_.port))) {}
 
 MqttPublisher::~MqttPublisher() { Stop(); }
 
@@ -50,7 +51,7 @@ void MqttPublisher::Start() {
   // after each reconnect resends from the cursor.
   mosq_ = mosquitto_new(client_id.c_str(), /*clean_session=*/true, this);
   if (mosq_ == nullptr) throw std::runtime_error("mqtt: mosquitto_new failed (out of memory)");
-  const std::string where = "mqtt " + config_.host + ":" + std::to_string(config_.port);
+  const std::string& where = where_;
   const auto check = [&](int rc, const char* what) {
     if (rc == MOSQ_ERR_SUCCESS) return;
     mosquitto_destroy(mosq_);
@@ -117,8 +118,7 @@ bool MqttPublisher::Connect() {
     rc = mosquitto_loop(mosq_, 100, 1);
   if (rc != MOSQ_ERR_SUCCESS || connack_ != 0) {
     if (!outage_logged_)
-      spdlog::warn("mqtt {}:{}: not connected ({}); records wait in the outbox", config_.host,
-                   config_.port,
+      spdlog::warn("{}: not connected ({}); records wait in the outbox", where_,
                    rc != MOSQ_ERR_SUCCESS ? mosquitto_strerror(rc)
                    : connack_ < 0         ? "no CONNACK within 5 s"
                                           : mosquitto_connack_string(connack_));
@@ -126,7 +126,7 @@ bool MqttPublisher::Connect() {
     mosquitto_disconnect(mosq_);
     return false;
   }
-  if (outage_logged_) spdlog::info("mqtt {}:{}: connected again", config_.host, config_.port);
+  if (outage_logged_) spdlog::info("{}: connected again", where_);
   outage_logged_ = false;
   connected_ = true;
   in_flight_.reset();  // a new session: whatever was not acknowledged is sent again

@@ -99,6 +99,7 @@ class MqttPublisher {
   const std::string station_id_;
   const std::string db_path_;
   const std::function<std::string()> state_;
+  const std::string where_;  // "mqtt://host:port" for messages, user-info redacted (RedactUrl)
   mosquitto* mosq_ = nullptr;
   std::thread thread_;
   std::mutex mu_;

@@ -9,10 +9,15 @@ bool ParseMqttUrl(const std::string& url, std::string* host, int* port, bool* tl
   *tls = url.rfind("mqtts://", 0) == 0;
   const std::string scheme = *tls ? "mqtts://" : "mqtt://";
   if (url.rfind(scheme, 0) != 0) {
-    *why = "must start with mqtt:// or mqtts:// (got '" + url + "')";
+    *why = "must start with mqtt:// or mqtts:// (got '" + RedactUrl(url) + "')";
     return false;
   }
   std::string rest = url.substr(scheme.size());
+  if (rest.find('@') != std::string::npos) {
+    *why = "must not carry user-info (got '" + RedactUrl(url) +
+           "'): put the user in \"username\" and the password in \"password\"";
+    return false;
+  }
   if (!rest.empty() && rest.back() == '/') rest.pop_back();
   const std::size_t colon = rest.rfind(':');
   *host = colon == std::string::npos ? rest : rest.substr(0, colon);
@@ -28,20 +33,17 @@ bool ParseMqttUrl(const std::string& url, std::string* host, int* port, bool* tl
     *port = std::stoi(digits);
   }
   if (host->empty() || host->find('/') != std::string::npos) {
-    *why = "no host in '" + url + "'";
+    *why = "no host in '" + RedactUrl(url) + "'";
     return false;
   }
   return true;
 }
 
-}  // namespace eol::station
-
-namespace eol::station::central {
-
 std::string RedactUrl(const std::string& url) {
-  static const std::regex kUserinfo(R"(^([A-Za-z][A-Za-z0-9+.-]*://[^:/@]*):[^@]*@)");
-  static const std::regex kPasswordKey(R"((password\s*=\s*)\S+)");
+  // scheme://user:password@host...: the password up to the authority's last '@'.
+  static const std::regex kUserinfo(R"(^([A-Za-z][A-Za-z0-9+.-]*://[^:/@?#]*):[^/?#]*@)");
+  static const std::regex kPasswordKey(R"((password\s*=\s*)('[^']*'|\S+))");
   return std::regex_replace(std::regex_replace(url, kUserinfo, "$1:***@"), kPasswordKey, "$1***");
 }
 
-}  // namespace eol::station::central
+}  // namespace eol::station

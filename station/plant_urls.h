@@ -8,16 +8,21 @@
 namespace eol::station {
 
 // "mqtt://host:port" (port optional, 1883) or "mqtts://host:port" (8883) into host and port
-// and whether TLS is asked for; false with the reason.
+// and whether TLS is asked for; false with the reason. A URL with user-info
+// ("mqtt://user:password@host") is refused: the credentials go in the "username" and
+// "password" fields, which are never logged. The reason never shows a password.
 bool ParseMqttUrl(const std::string& url, std::string* host, int* port, bool* tls,
                   std::string* why);
+
+// Any URL as logs and error messages show it: the password of its user-info replaced
+// ("postgresql://user:secret@host:5432/db" -> "postgresql://user:***@host:5432/db"), and a
+// conninfo's password=... -> password=***. Every log line that prints a URL prints this.
+std::string RedactUrl(const std::string& url);
 
 }  // namespace eol::station
 
 namespace eol::station::central {
 
-// "postgresql://user:secret@host:5432/db" -> "postgresql://user:***@host:5432/db" (and a
-// conninfo's password=... -> password=***): what the logs and error messages show.
-std::string RedactUrl(const std::string& url);
+using eol::station::RedactUrl;
 
 }  // namespace eol::station::central

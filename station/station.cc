@@ -7,6 +7,7 @@
 
 #include "analysis/text.h"
 #include "db/clock.h"
+#include "drivers/fixture/modbus_tcp_server.h"
 #include "station/systemd_notify.h"
 #include "station/version.h"
 
@@ -107,11 +108,14 @@ Station::~Station() {
 }
 
 void Station::StartHttp(const std::string& web_root) {
+  // Many HTTP connections must never push the fixture link's descriptor past select()'s range.
+  drivers::KeepDescriptorsBelowFdSetSize();
   HttpOptions o;
   o.listen = config_.http_listen;
   o.port = config_.http_port;
   o.db_path = config_.db_path;
   o.tokens = config_.tokens;
+  o.hosts = config_.http_hosts;
   o.web_root = web_root;
   if (config_.central) o.central_postgres = config_.central->postgres;
   HttpHandlers h;

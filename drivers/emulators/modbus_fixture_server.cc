@@ -17,6 +17,8 @@
 #include <optional>
 #include <vector>
 
+#include "drivers/fixture/modbus_tcp_server.h"
+
 namespace eol::drivers {
 
 namespace {
@@ -204,84 +206,71 @@ void ModbusFixtureServer::CloseAll() {
 }
 
 void ModbusFixtureServer::Serve() {
-  const bool tcp = settings_.link.transport == ModbusLink::Transport::kTcp;
-  const int io_fd = tcp ? listen_fd_ : modbus_get_socket(ctx_);
-  std::vector<int> clients;
+  relay_dropped_logged_ = false;
+  if (settings_.link.transport == ModbusLink::Transport::kTcp) {
+    ModbusTcpLoopSettings loop_settings;
+    loop_settings.name = "fixture server";
+    loop_settings.max_clients = settings_.max_clients;
+    loop_settings.frame_deadline = settings_.frame_deadline;
+    loop_settings.idle_timeout = settings_.idle_timeout;
+    ModbusTcpLoop loop(
+        loop_settings,
+        [this](int fd, const std::uint8_t* request, int length) {
+          modbus_set_socket(ctx_, fd);
+          Handle(request, length);
+          return true;  // a reply that could not be sent: the loop's unread-reply check
+        },
+        [this] { DropRelayIfSilent(); });
+    loop.Run(listen_fd_, wake_[0]);
+    return;
+  }
+  ServeRtu();
+}
+
+// A controller that stops answering drops its excitation relay on its own.
+void ModbusFixtureServer::DropRelayIfSilent() {
+  if (!bench_->FaultActive(SimFault::kStopsAnswering) ||
+      !bench_->output(FixtureOutput::kExcitationEnable))
+    return;
+  try {
+    bench_->Write(FixtureOutput::kExcitationEnable, false);
+  } catch (const DeviceError&) {
+  }
+  if (!relay_dropped_logged_)
+    spdlog::info("fixture server: stops_answering: excitation relay dropped out");
+  relay_dropped_logged_ = true;
+}
+
+void ModbusFixtureServer::ServeRtu() {
+  const int io_fd = modbus_get_socket(ctx_);
   std::vector<std::uint8_t> request(MODBUS_MAX_ADU_LENGTH);
   bool serial_down = false;  // the serial line hung up: poll it again only after a pause
-  bool relay_dropped_logged = false;
-
-  // poll() rather than select(): no FD_SETSIZE limit on the descriptors a test process has.
   for (;;) {
     std::vector<pollfd> fds;
     fds.push_back({wake_[0], POLLIN, 0});
     if (!serial_down) fds.push_back({io_fd, POLLIN, 0});
-    for (int c : clients) fds.push_back({c, POLLIN, 0});
     const int n = poll(fds.data(), fds.size(), serial_down ? 200 : 100);
     if (n < 0 && errno != EINTR) {
       spdlog::error("fixture server: poll: {}", std::strerror(errno));
       break;
     }
     serial_down = false;
-
-    // A controller that stops answering drops its excitation relay on its own.
-    if (bench_->FaultActive(SimFault::kStopsAnswering) &&
-        bench_->output(FixtureOutput::kExcitationEnable)) {
-      try {
-        bench_->Write(FixtureOutput::kExcitationEnable, false);
-      } catch (const DeviceError&) {
-      }
-      if (!relay_dropped_logged)
-        spdlog::info("fixture server: stops_answering: excitation relay dropped out");
-      relay_dropped_logged = true;
-    }
+    DropRelayIfSilent();
     if (n <= 0) continue;
     if (fds[0].revents != 0) break;
-
-    if (!tcp) {
-      if (fds.size() > 1 && fds[1].revents != 0) {
-        const int rc = modbus_receive(ctx_, request.data());
-        if (rc > 0) {
-          Handle(request.data(), rc);
-        } else if (rc == -1) {
-          const int err = errno;
-          spdlog::debug("fixture server: RTU receive: {}", modbus_strerror(err));
-          if (err != EMBBADCRC && err != EMBBADDATA && err != EMBMDATA && err != ETIMEDOUT &&
-              err != EMBBADSLAVE)
-            serial_down = true;
-          modbus_flush(ctx_);
-        }
-      }
-      continue;
-    }
-
-    if (fds[1].revents & POLLIN) {
-      const int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
-      if (fd >= 0 && static_cast<int>(clients.size()) >= settings_.max_clients) {
-        spdlog::warn("fixture server: refusing a connection: {} clients already", clients.size());
-        close(fd);
-      } else if (fd >= 0) {
-        clients.push_back(fd);
-      }
-    }
-    std::vector<int> closed;
-    for (std::size_t i = 0; i < clients.size(); ++i) {
-      const pollfd& p = fds[2 + i];
-      if (p.revents == 0) continue;
-      modbus_set_socket(ctx_, p.fd);
-      const int rc = modbus_receive(ctx_, request.data());
-      if (rc > 0) {
-        Handle(request.data(), rc);
-      } else if (rc == -1) {
-        closed.push_back(p.fd);  // closed by the client, or a broken frame: drop it
-      }
-    }
-    for (int fd : closed) {
-      close(fd);
-      clients.erase(std::find(clients.begin(), clients.end(), fd));
+    if (fds.size() < 2 || fds[1].revents == 0) continue;
+    const int rc = modbus_receive(ctx_, request.data());
+    if (rc > 0) {
+      Handle(request.data(), rc);
+    } else if (rc == -1) {
+      const int err = errno;
+      spdlog::debug("fixture server: RTU receive: {}", modbus_strerror(err));
+      if (err != EMBBADCRC && err != EMBBADDATA && err != EMBMDATA && err != ETIMEDOUT &&
+          err != EMBBADSLAVE)
+        serial_down = true;
+      modbus_flush(ctx_);
     }
   }
-  for (int fd : clients) close(fd);
 }
 
 void ModbusFixtureServer::Handle(const unsigned char* request, int length) {

@@ -7,6 +7,16 @@
 #include <sstream>
 
 namespace eol::io {
+namespace {
+
+// A value as messages show it: never whole when long (a request body's value can be 4 MB).
+std::string Shown(const nlohmann::json& v) {
+  std::string text = v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  if (text.size() > 200) text = text.substr(0, 200) + "...";
+  return text;
+}
+
+}  // namespace
 
 JsonObject::JsonObject(const nlohmann::json& j, std::string path) : j_(j), path_(std::move(path)) {
   if (!j_.is_object())
@@ -16,7 +26,7 @@ JsonObject::JsonObject(const nlohmann::json& j, std::string path) : j_(j), path_
 bool JsonObject::Has(const std::string& key) const { return j_.contains(key); }
 
 void JsonObject::Fail(const std::string& key, const std::string& what) const {
-  throw ConfigError(PathOf(key) + ": " + what);
+  throw ConfigError(PathOf(key.size() > 200 ? key.substr(0, 200) + "..." : key) + ": " + what);
 }
 
 const nlohmann::json& JsonObject::At(const std::string& key) const {
@@ -36,7 +46,7 @@ std::optional<double> JsonObject::OptionalNumber(const std::string& key) const {
 
 double JsonObject::RequiredNumber(const std::string& key) const {
   const nlohmann::json& v = At(key);
-  if (!v.is_number()) Fail(key, "must be a number (got " + v.dump() + ")");
+  if (!v.is_number()) Fail(key, "must be a number (got " + Shown(v) + ")");
   const double d = v.get<double>();
   if (!std::isfinite(d)) Fail(key, "must be finite");
   return d;
@@ -51,7 +61,7 @@ int JsonObject::Integer(const std::string& key, int fallback) const {
   read_.insert(key);
   if (!Has(key)) return fallback;
   const nlohmann::json& v = At(key);
-  if (!v.is_number_integer()) Fail(key, "must be a whole number (got " + v.dump() + ")");
+  if (!v.is_number_integer()) Fail(key, "must be a whole number (got " + Shown(v) + ")");
   // get<int>() wraps: 4294967300 would be read as 4.
   const bool fits =
       v.is_number_unsigned()
@@ -59,7 +69,7 @@ int JsonObject::Integer(const std::string& key, int fallback) const {
           : v.get<std::int64_t>() >= std::numeric_limits<int>::min() &&
                 v.get<std::int64_t>() <= std::numeric_limits<int>::max();
   if (!fits)
-    Fail(key, "must be a whole number in [-2147483648, 2147483647] (got " + v.dump() + ")");
+    Fail(key, "must be a whole number in [-2147483648, 2147483647] (got " + Shown(v) + ")");
   return v.get<int>();
 }
 
@@ -67,13 +77,13 @@ bool JsonObject::Bool(const std::string& key, bool fallback) const {
   read_.insert(key);
   if (!Has(key)) return fallback;
   const nlohmann::json& v = At(key);
-  if (!v.is_boolean()) Fail(key, "must be true or false (got " + v.dump() + ")");
+  if (!v.is_boolean()) Fail(key, "must be true or false (got " + Shown(v) + ")");
   return v.get<bool>();
 }
 
 std::string JsonObject::RequiredString(const std::string& key) const {
   const nlohmann::json& v = At(key);
-  if (!v.is_string()) Fail(key, "must be a string (got " + v.dump() + ")");
+  if (!v.is_string()) Fail(key, "must be a string (got " + Shown(v) + ")");
   return v.get<std::string>();
 }
 
@@ -91,7 +101,7 @@ std::vector<double> JsonObject::Numbers(const std::string& key,
   std::vector<double> out;
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!v[i].is_number() || !std::isfinite(v[i].get<double>()))
-      Fail(key + "/" + std::to_string(i), "must be a finite number (got " + v[i].dump() + ")");
+      Fail(key + "/" + std::to_string(i), "must be a finite number (got " + Shown(v[i]) + ")");
     out.push_back(v[i].get<double>());
   }
   return out;
@@ -119,7 +129,7 @@ void JsonObject::RejectUnknown() const {
 void JsonObject::Require(bool ok, const std::string& key, const std::string& rule) const {
   if (ok) return;
   const auto it = j_.find(key);
-  Fail(key, rule + (it != j_.end() ? " (got " + it->dump() + ")" : ""));
+  Fail(key, rule + (it != j_.end() ? " (got " + Shown(*it) + ")" : ""));
 }
 
 nlohmann::json ParseJsonText(const std::string& text, const std::string& source) {

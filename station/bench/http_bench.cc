@@ -100,6 +100,36 @@ void OfferChunkedBody(int port, std::size_t bytes, HttpBenchResult* r) {
   ::close(fd);
 }
 
+// `n` slow connections until `stop`: each sends a request head one byte every 500 ms and
+// reconnects when the server closes it (as an attacker would).
+void HoldSlowConnections(int port, int n, const std::atomic<bool>& stop, long* connects) {
+  const std::string head =
+      "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: " + std::string(4000, 's') +
+      "\r\n\r\n";
+  std::vector<int> fds(static_cast<std::size_t>(n), -1);
+  std::vector<std::size_t> sent(fds.size(), 0);
+  while (!stop) {
+    for (std::size_t i = 0; i < fds.size(); ++i) {
+      if (fds[i] >= 0) {
+        pollfd p{fds[i], POLLIN, 0};
+        const bool cut = ::poll(&p, 1, 0) > 0;  // an answer or a close: either ends it
+        if (!cut && ::send(fds[i], head.data() + sent[i], 1, MSG_NOSIGNAL) == 1) {
+          sent[i] = (sent[i] + 1) % head.size();
+          continue;
+        }
+        ::close(fds[i]);
+      }
+      fds[i] = Connect(port);
+      sent[i] = 0;
+      ++*connects;
+    }
+    for (int k = 0; k < 10 && !stop; ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  for (const int fd : fds)
+    if (fd >= 0) ::close(fd);
+}
+
 }  // namespace
 
 HttpBenchResult RunHttpBench(const HttpBenchOptions& o) {
@@ -136,6 +166,11 @@ HttpBenchResult RunHttpBench(const HttpBenchOptions& o) {
     streams.push_back(fd);
   }
 
+  r.slow_requested = o.slow;
+  std::atomic<bool> stop_slow{false};
+  std::thread slow([&] { HoldSlowConnections(port, o.slow, stop_slow, &r.slow_connects); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(o.slow > 0 ? 1000 : 0));
+
   std::mutex mu;
   std::vector<double> latencies;
   std::atomic<long> ok{0}, refused{0}, failed{0};
@@ -165,6 +200,8 @@ HttpBenchResult RunHttpBench(const HttpBenchOptions& o) {
     });
   }
   for (auto& t : clients) t.join();
+  stop_slow = true;
+  slow.join();
   for (const int fd : streams) ::close(fd);
   api.Stop();
   std::error_code ec;
@@ -183,6 +220,8 @@ HttpBenchResult RunHttpBench(const HttpBenchOptions& o) {
 
 nlohmann::json ToJson(const HttpBenchResult& r) {
   return {{"streams_requested", r.streams_requested},
+          {"slow_requested", r.slow_requested},
+          {"slow_connects", r.slow_connects},
           {"streams_open", r.streams_open},
           {"status_requests", r.requests},
           {"status_refused_503", r.refused},

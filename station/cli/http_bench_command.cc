@@ -23,6 +23,10 @@ void AddHttpBenchCommand(CLI::App& app) {
   cmd->add_option("--streams", o->streams, "Open event streams")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
+  cmd->add_option("--slow", o->slow,
+                  "Slow connections during the poll (a head, a byte every 500 ms)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 700));
   cmd->add_option("--clients", o->clients, "Concurrent clients polling /api/status")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
@@ -48,10 +52,10 @@ void AddHttpBenchCommand(CLI::App& app) {
           *mib, static_cast<double>(r.chunked_sent_bytes) / 1048576.0, r.chunked_status,
           r.rss_before_mib, r.rss_peak_mib);
       std::printf(
-          "streams open %d of %d; %d clients for %.1f s: %ld answered 200, %ld 503, "
-          "%ld failed\n",
-          r.streams_open, r.streams_requested, o->clients, o->seconds, r.requests, r.refused,
-          r.failed);
+          "streams open %d of %d; %d slow connections (%ld connects); %d clients for %.1f s: "
+          "%ld answered 200, %ld 503, %ld failed\n",
+          r.streams_open, r.streams_requested, r.slow_requested, r.slow_connects, o->clients,
+          o->seconds, r.requests, r.refused, r.failed);
       std::printf("GET /api/status latency ms: p50 %.2f  p90 %.2f  p99 %.2f  max %.2f\n", r.p50_ms,
                   r.p90_ms, r.p99_ms, r.max_ms);
       return 0;

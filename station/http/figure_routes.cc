@@ -66,7 +66,8 @@ std::variant<json, ApiError> ObjectBody(const httplib::Request& req,
     if (!known.count(key)) {
       std::string list;
       for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-      return BadRequest("unknown field '" + key + "' (" + list + ")");
+      return BadRequest("unknown field '" + (key.size() > 100 ? key.substr(0, 100) + "..." : key) +
+                        "' (" + list + ")");
     }
   return parsed;
 }
@@ -87,7 +88,8 @@ double Number(const json& body, const std::string& key, double fallback, double 
   const json& v = body.at(key);
   if (!v.is_number() || !(v.get<double>() >= lo && v.get<double>() <= hi)) {
     std::ostringstream range;
-    range << key << ": must be a number in [" << lo << ", " << hi << "] (have " << v.dump() << ")";
+    range << key << ": must be a number in [" << lo << ", " << hi << "] (have " << Excerpt(v)
+          << ")";
     throw BadField{range.str()};
   }
   return v.get<double>();
@@ -122,8 +124,8 @@ void PostPodSvg(ApiContext& c, const httplib::Request& req, httplib::Response& r
     if (body.contains("f0_limits_hz"))
       for (const json& f : Array(body, "f0_limits_hz", 0, 10)) {
         if (!f.is_number() || !(f.get<double>() > 0.0 && f.get<double>() <= 1e5))
-          throw BadField{"f0_limits_hz: each must be a number in (0, 100000] Hz (have " + f.dump() +
-                         ")"};
+          throw BadField{"f0_limits_hz: each must be a number in (0, 100000] Hz (have " +
+                         Excerpt(f) + ")"};
         limits.push_back({"f0 limit", f.get<double>()});
       }
   } catch (const BadField& e) {
@@ -184,7 +186,7 @@ void PostGapSvg(ApiContext& c, const httplib::Request& req, httplib::Response& r
       for (const json& e : Array(body, "effects", 1, 32)) {
         const auto kind =
             e.is_string() ? analysis::ParseEffectKind(e.get<std::string>()) : std::nullopt;
-        if (!kind) throw BadField{"effects: unknown effect " + e.dump()};
+        if (!kind) throw BadField{"effects: unknown effect " + Excerpt(e)};
         o.effects.push_back(*kind);
       }
     if (body.contains("pairs")) {

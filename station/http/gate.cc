@@ -33,8 +33,42 @@ httplib::Server::HandlerResponse Refuse(httplib::Response& res, ApiErrorKind kin
   return httplib::Server::HandlerResponse::Handled;
 }
 
+// The host part of a Host header value ("name:8080" -> "name", "[::1]:80" -> "[::1]").
+std::string HostName(const std::string& value) {
+  const std::string v = Lower(Trim(value));
+  if (!v.empty() && v.front() == '[') return v.substr(0, v.find(']') + 1);
+  const std::size_t colon = v.find(':');
+  return colon == std::string::npos ? v : v.substr(0, colon);
+}
+
+// The Host names this station answers to: loopback names, the listen address, the address
+// the client connected to, and the configured names.
+bool KnownHost(const ApiContext& c, const httplib::Request& req, const std::string& host) {
+  if (host == "localhost" || host == "127.0.0.1" || host == "[::1]") return true;
+  const auto same = [&host](std::string address) {
+    address = Lower(address);
+    if (address.find(':') != std::string::npos) address = "[" + address + "]";
+    return !address.empty() && address != "0.0.0.0" && address != "[::]" && host == address;
+  };
+  if (same(c.options.listen) || same(req.local_addr)) return true;
+  return std::any_of(c.options.hosts.begin(), c.options.hosts.end(),
+                     [&host](const std::string& h) { return Lower(h) == host; });
+}
+
 httplib::Server::HandlerResponse Check(const ApiContext& c, const httplib::Request& req,
                                        httplib::Response& res) {
+  // DNS rebinding: a foreign page whose name resolves to this station sends its own name.
+  const bool has_body_framing =
+      req.has_header("Content-Length") || req.has_header("Transfer-Encoding");
+  if (!req.has_header("Host") || req.get_header_value_count("Host") != 1)
+    return Refuse(res, ApiErrorKind::kBadRequest, "bad_host",
+                  "a request needs exactly one Host header", has_body_framing);
+  const std::string host = HostName(req.get_header_value("Host"));
+  if (!KnownHost(c, req, host))
+    return Refuse(res, ApiErrorKind::kMisdirected, "unknown_host",
+                  "Host '" + host.substr(0, 100) +
+                      "' is not a name of this station (configure it in http.hosts)",
+                  has_body_framing);
   const std::string method = req.method == "HEAD" ? "GET" : req.method;
   std::string allow;
   bool allowed = false;
@@ -146,6 +180,9 @@ void Route(httplib::Server& s, ApiContext& c, const std::string& method, const s
 }
 
 void InstallGate(ApiServer& s, ApiContext& c) {
+  // No page of this station may be framed by another (clickjacking).
+  s.set_default_headers(
+      {{"Content-Security-Policy", "frame-ancestors 'none'"}, {"X-Frame-Options", "DENY"}});
   s.set_pre_routing_handler(
       [&c](const httplib::Request& req, httplib::Response& res) { return Check(c, req, res); });
   // httplib's own refusals (a malformed request line, a URI too long) carry no body.

@@ -15,6 +15,15 @@ struct ServerLimits {
   std::chrono::seconds io_timeout{5};
   std::chrono::seconds keep_alive_idle{2};  // an idle kept-alive connection is closed after
   int listen_backlog = 1024;                // capped by the kernel's net.core.somaxconn
+  // Read before a worker is taken (station/http/head_reader.h):
+  std::chrono::milliseconds head_deadline{5000};  // a request's head, from its first byte
+  std::size_t max_head_bytes = 16 * 1024;         // request line and headers: 431 beyond
+  std::size_t max_header_count = 64;              // header lines: 431 beyond
+  std::size_t prefetch_body_bytes = 64 * 1024;    // a Content-Length body up to this is read too
+  std::size_t max_waiting_per_peer = 256;         // connections of one address waiting for a head
+  std::size_t max_waiting = 768;              // of all addresses (below 1024 descriptors in all)
+  int max_requests_per_connection = 100;      // then Connection: close
+  std::size_t max_body_readers_per_peer = 8;  // workers reading bodies of one address
 };
 
 }  // namespace eol::station::http

@@ -143,7 +143,7 @@ void PostTeach(ApiContext& c, const httplib::Request& req, httplib::Response& re
   std::vector<std::string> serials;
   for (const auto& s : body["serials"]) {
     if (!s.is_string())
-      return Send(res, BadRequest("bad_serial", "serials: " + s.dump() + ": must be a string"));
+      return Send(res, BadRequest("bad_serial", "serials: " + Excerpt(s) + ": must be a string"));
     serials.push_back(s.get<std::string>());
   }
   const auto recipe = c.handlers.current_recipe();

@@ -24,6 +24,8 @@ int HttpStatus(ApiErrorKind kind) {
       return 413;
     case ApiErrorKind::kUnsupportedMedia:
       return 415;
+    case ApiErrorKind::kMisdirected:
+      return 421;
     case ApiErrorKind::kUnprocessable:
       return 422;
     case ApiErrorKind::kInternal:
@@ -40,7 +42,8 @@ HttpReply ToReply(const ApiError& error) {
 
 void Send(httplib::Response& res, const HttpReply& reply) {
   res.status = reply.status;
-  res.set_content(reply.body.dump(), "application/json");
+  res.set_content(reply.body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
+                  "application/json");
 }
 
 void Send(httplib::Response& res, const ApiError& error) { Send(res, ToReply(error)); }

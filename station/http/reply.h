@@ -22,6 +22,7 @@ enum class ApiErrorKind {
   kLengthRequired,    // 411: a body without Content-Length or chunked framing
   kTooLarge,          // 413: the request body exceeds the limit, however it is framed
   kUnsupportedMedia,  // 415: a write route's body is not application/json
+  kMisdirected,       // 421: the Host header names no name of this station
   kUnprocessable,     // 422: well-formed, but nothing usable can be made of it
   kInternal,          // 500: the station failed (file system, database, a bug)
   kUnavailable,       // 503: at capacity (event streams, request workers)

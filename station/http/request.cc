@@ -2,6 +2,7 @@
 
 #include <httplib.h>
 
+#include <algorithm>
 #include <charconv>
 
 #include "db/clock.h"
@@ -47,12 +48,47 @@ std::variant<nlohmann::json, ApiError> ParseBody(const httplib::Request& req,
                   ApiError{ApiErrorKind::kTooLarge, "too_large",
                            "request body is " + std::to_string(req.body.size()) +
                                " bytes; the limit is " + std::to_string(max_bytes)});
+  if (JsonNestingDepth(req.body, kMaxJsonDepth) > kMaxJsonDepth)
+    return Result(std::in_place_type<ApiError>,
+                  ApiError{ApiErrorKind::kBadRequest, "too_deep",
+                           "request body nests arrays and objects deeper than " +
+                               std::to_string(kMaxJsonDepth) + " levels"});
   try {
     return Result(std::in_place_type<nlohmann::json>, nlohmann::json::parse(req.body));
   } catch (const nlohmann::json::exception&) {
     return Result(std::in_place_type<ApiError>,
                   ApiError{ApiErrorKind::kBadRequest, "bad_json", "request body is not JSON"});
   }
+}
+
+int JsonNestingDepth(std::string_view text, int stop_above) {
+  int depth = 0, deepest = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > stop_above) return deepest;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+std::string Excerpt(const nlohmann::json& value, std::size_t max_chars) {
+  std::string text = value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  if (text.size() > max_chars) text = text.substr(0, max_chars) + "...";
+  return text;
 }
 
 namespace {

@@ -40,9 +40,23 @@ std::variant<ApiToken, ApiError> RequireRole(const httplib::Request& req,
                                              const std::vector<ApiToken>& tokens, Role role,
                                              std::string_view action);
 
-// The body as JSON: 413 "too_large" above `max_bytes`, 400 "bad_json" when it does not parse.
+// Arrays and objects nest at most this deep in a request body (a value nested 100,000 deep
+// overflowed the stack of the code that printed it).
+inline constexpr int kMaxJsonDepth = 64;
+
+// The body as JSON: 413 "too_large" above `max_bytes`, 400 "too_deep" when arrays and objects
+// nest deeper than kMaxJsonDepth (found by a scan before parsing), 400 "bad_json" when it
+// does not parse.
 std::variant<nlohmann::json, ApiError> ParseBody(const httplib::Request& req,
                                                  std::size_t max_bytes = kMaxBodyBytes);
+
+// The deepest nesting of arrays and objects in JSON text (brackets inside strings do not
+// count), scanning no further than the first point deeper than `stop_above`.
+int JsonNestingDepth(std::string_view text, int stop_above);
+
+// A value as error messages show it: its JSON, cut to `max_chars` with "..." (a rejected
+// value is never printed whole).
+std::string Excerpt(const nlohmann::json& value, std::size_t max_chars = 200);
 
 // Query parameters, parsed whole (no trailing characters, no exponent for integers, the C
 // locale's '.' whatever the locale): absent leaves *out as it was; otherwise a value outside

@@ -15,7 +15,10 @@
 #include <deque>
 #include <functional>
 #include <list>
+#include <unordered_map>
 #include <vector>
+
+#include "station/http/head_reader.h"
 
 namespace eol::station::http {
 namespace {
@@ -29,6 +32,8 @@ thread_local ConnectionPool* tl_pool = nullptr;
 thread_local bool tl_is_stream = false;
 thread_local bool tl_close_after_response = false;
 thread_local Clock::duration tl_waited{};
+// On httplib's accept thread while it hands over a socket: the pool whose reader takes it.
+thread_local ConnectionPool* tl_admitting = nullptr;
 
 int PollOne(int fd, short events, Clock::duration timeout) {
   const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count();
@@ -45,22 +50,44 @@ int PollOne(int fd, short events, Clock::duration timeout) {
 // already taken its place. httplib creates one per listen and deletes it after shutdown().
 class ConnectionPool final : public httplib::TaskQueue {
  public:
-  explicit ConnectionPool(const ServerLimits& limits) : limits_(limits) {
+  using Serve = std::function<void(HeadReader::Ready ready)>;
+
+  ConnectionPool(const ServerLimits& limits, Serve serve)
+      : limits_(limits), reader_(limits, [this, serve](HeadReader::Ready ready) {
+          Enqueue([serve, ready = std::move(ready)]() mutable { serve(std::move(ready)); });
+        }) {
     std::lock_guard<std::mutex> lock(mu_);
     for (std::size_t i = 0; i < limits_.request_workers; ++i)
       threads_.emplace_back([this] { Work(); });
   }
   ~ConnectionPool() override { shutdown(); }
 
+  // httplib's accept thread, with a job that serves one socket: run here, the job gives the
+  // socket to the head reader (ApiServer::process_and_close_socket), no worker is taken.
   void enqueue(std::function<void()> fn) override {
-    {
-      std::lock_guard<std::mutex> lock(mu_);
-      jobs_.push_back({std::move(fn), Clock::now()});
-    }
-    cv_.notify_one();
+    tl_admitting = this;
+    fn();
+    tl_admitting = nullptr;
+  }
+  HeadReader& reader() { return reader_; }
+
+  // A worker reading a body that was not prefetched, for `peer`: false when that peer has
+  // max_body_readers_per_peer workers reading bodies already.
+  bool TakeBodyReader(const std::string& peer) {
+    std::lock_guard<std::mutex> lock(mu_);
+    std::size_t& n = body_readers_[peer];
+    if (n >= limits_.max_body_readers_per_peer) return false;
+    ++n;
+    return true;
+  }
+  void ReleaseBodyReader(const std::string& peer) {
+    std::lock_guard<std::mutex> lock(mu_);
+    const auto it = body_readers_.find(peer);
+    if (it != body_readers_.end() && --it->second == 0) body_readers_.erase(it);
   }
 
   void shutdown() override {
+    reader_.Stop();
     {
       std::lock_guard<std::mutex> lock(mu_);
       stopping_ = true;
@@ -76,6 +103,14 @@ class ConnectionPool final : public httplib::TaskQueue {
       if (threads.empty()) return;
       for (auto& t : threads) t.join();
     }
+  }
+
+  void Enqueue(std::function<void()> fn) {
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      jobs_.push_back({std::move(fn), Clock::now()});
+    }
+    cv_.notify_one();
   }
 
   bool BecomeStream() {
@@ -131,12 +166,14 @@ class ConnectionPool final : public httplib::TaskQueue {
   }
 
   const ServerLimits limits_;
+  HeadReader reader_;
   std::mutex mu_;
   std::condition_variable cv_;
   std::deque<Job> jobs_;
   std::list<std::thread> threads_;
   std::vector<std::thread::id> finished_;
   std::size_t streams_ = 0;
+  std::unordered_map<std::string, std::size_t> body_readers_;
   bool stopping_ = false;
 };
 
@@ -160,12 +197,21 @@ std::string PeerText(int fd, bool remote, int& port) {
 // a client that sends its request slower than the deadline is cut off however it paces it.
 class DeadlineStream final : public httplib::Stream {
  public:
-  DeadlineStream(int fd, const ServerLimits& limits) : fd_(fd), limits_(limits) {}
+  DeadlineStream(int fd, const ServerLimits& limits, std::string seed)
+      : fd_(fd), limits_(limits), seed_(std::move(seed)) {}
+  // What was read and not consumed (the start of a pipelined request).
+  std::string TakeUnread() {
+    std::string rest = seed_.substr(seed_off_);
+    rest.append(buf_ + off_, end_ - off_);
+    seed_.clear();
+    seed_off_ = off_ = end_ = 0;
+    return rest;
+  }
 
   void StartRequest() { deadline_ = Clock::now() + limits_.request_deadline; }
   bool deadline_passed() const { return deadline_passed_; }
 
-  bool is_readable() const override { return WaitRead() > 0; }
+  bool is_readable() const override { return seed_off_ < seed_.size() || WaitRead() > 0; }
   bool is_writable() const override {
     if (PollOne(fd_, POLLOUT, limits_.io_timeout) <= 0) return false;
     // Alive unless the peer closed: readable with nothing to read.
@@ -174,6 +220,12 @@ class DeadlineStream final : public httplib::Stream {
     return ::recv(fd_, &b, 1, MSG_PEEK) > 0;
   }
   ssize_t read(char* ptr, size_t size) override {
+    if (seed_off_ < seed_.size()) {  // what the head reader read first
+      const size_t n = std::min(size, seed_.size() - seed_off_);
+      std::memcpy(ptr, seed_.data() + seed_off_, n);
+      seed_off_ += n;
+      return static_cast<ssize_t>(n);
+    }
     if (off_ == end_) {
       if (WaitRead() <= 0) return -1;
       ssize_t n;
@@ -223,6 +275,8 @@ class DeadlineStream final : public httplib::Stream {
   const ServerLimits& limits_;
   Clock::time_point deadline_ = Clock::now();
   mutable bool deadline_passed_ = false;
+  std::string seed_;
+  size_t seed_off_ = 0;
   char buf_[4096];
   size_t off_ = 0, end_ = 0;
 };
@@ -250,11 +304,25 @@ void RefuseOverloaded(int fd, Clock::duration waited) {
                            R"( ms for a free request worker; the request was not read"}})";
   const std::string reply =
       "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nRetry-After: 1\r\n"
-      "Connection: close\r\nContent-Length: " +
+      "Connection: close\r\nContent-Security-Policy: frame-ancestors 'none'\r\n"
+      "X-Frame-Options: DENY\r\nContent-Length: " +
       std::to_string(body.size()) + "\r\n\r\n" + body;
   (void)::send(fd, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
   ::shutdown(fd, SHUT_RDWR);
   ::close(fd);
+}
+
+void RefuseSlowBodies(int fd, const std::string& peer, std::size_t max) {
+  const std::string body = R"({"error": {"code": "overloaded", "message": ")" +
+                           std::to_string(max) + " request bodies of " + peer +
+                           R"( are being read already; the request was not read"}})";
+  const std::string reply =
+      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nRetry-After: 1\r\n"
+      "Connection: close\r\nContent-Security-Policy: frame-ancestors 'none'\r\n"
+      "X-Frame-Options: DENY\r\nContent-Length: " +
+      std::to_string(body.size()) + "\r\n\r\n" + body;
+  (void)::send(fd, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+  LingeringClose(fd);
 }
 
 }  // namespace
@@ -264,7 +332,10 @@ bool BecomeStream() { return tl_pool != nullptr && tl_pool->BecomeStream(); }
 void CloseAfterResponse() { tl_close_after_response = true; }
 
 ApiServer::ApiServer(ServerLimits limits) : limits_(limits) {
-  new_task_queue = [this] { return new ConnectionPool(limits_); };
+  new_task_queue = [this] {
+    return new ConnectionPool(limits_,
+                              [this](HeadReader::Ready ready) { ServeRequest(std::move(ready)); });
+  };
   const auto io = static_cast<time_t>(limits_.io_timeout.count());
   set_read_timeout(io, 0);
   set_write_timeout(io, 0);
@@ -297,31 +368,49 @@ int ApiServer::Bind(const std::string& host, int port, std::string* why) {
 }
 
 bool ApiServer::process_and_close_socket(::socket_t sock) {
-  if (tl_waited > limits_.max_queue_wait) {
-    RefuseOverloaded(sock, tl_waited);
+  if (tl_admitting == nullptr) {  // not from the pool's enqueue: no reader to take it
+    ::close(sock);
     return false;
   }
-  DeadlineStream stream(sock, limits_);
-  bool ok = false;
-  // As httplib's loop: at most 5 requests per connection, each after at most keep_alive_idle.
-  for (int left = 5; left > 0 && svr_sock_ != INVALID_SOCKET; --left) {
-    if (PollOne(sock, POLLIN, left == 5 ? limits_.request_deadline : limits_.keep_alive_idle) <= 0)
-      break;
-    stream.StartRequest();
-    bool closed = false;
-    ok = process_request(stream, left == 1, closed, nullptr);
-    if (stream.deadline_passed())
-      spdlog::warn("http: closed a connection that did not send its request within {} ms",
-                   limits_.request_deadline.count());
-    if (!ok || closed || tl_close_after_response || tl_is_stream) break;
+  tl_admitting->reader().Admit(sock);
+  return true;
+}
+
+void ApiServer::ServeRequest(HeadReader::Ready ready) {
+  const int sock = ready.fd;
+  const int served = ready.served;
+  if (tl_waited > limits_.max_queue_wait) {
+    RefuseOverloaded(sock, tl_waited);
+    return;
   }
+  // A body still to come holds this worker until it is in: one peer may hold only so many.
+  if (ready.body_pending && !tl_pool->TakeBodyReader(ready.peer)) {
+    RefuseSlowBodies(sock, ready.peer, limits_.max_body_readers_per_peer);
+    return;
+  }
+  struct Release {
+    ConnectionPool* pool;
+    const HeadReader::Ready& r;
+    ~Release() {
+      if (r.body_pending) pool->ReleaseBodyReader(r.peer);
+    }
+  } release{tl_pool, ready};
+  DeadlineStream stream(sock, limits_, std::move(ready.bytes));
+  stream.StartRequest();
+  bool closed = false;
+  const bool last = served + 1 >= limits_.max_requests_per_connection;
+  const bool ok = process_request(stream, last, closed, nullptr);
+  if (stream.deadline_passed())
+    spdlog::warn("http: closed a connection that did not send its request within {} ms",
+                 limits_.request_deadline.count());
   if (tl_close_after_response) {
     LingeringClose(sock);
-  } else {
+  } else if (!ok || closed || last || tl_is_stream || svr_sock_ == INVALID_SOCKET || !tl_pool) {
     ::shutdown(sock, SHUT_RDWR);
     ::close(sock);
+  } else {
+    tl_pool->reader().Admit(sock, stream.TakeUnread(), served + 1);  // kept alive
   }
-  return ok;
 }
 
 }  // namespace eol::station::http

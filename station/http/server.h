@@ -11,9 +11,17 @@
 //                    "overloaded" and closed without its request being read, so a request its
 //                    client has given up on (a POST /api/tests that timed out) is never acted
 //                    on later.
-//   deadlines        the request line, headers and body must arrive within `request_deadline`
-//                    of the connection's start or of the previous response, and each read or
-//                    write within `io_timeout`; a slow client is cut off when either passes.
+//   heads            no worker waits for a request's head: one thread reads every connection's
+//                    head (and a body of up to `prefetch_body_bytes`) with a deadline and caps
+//                    on head bytes, header lines and waiting connections per peer address
+//                    (station/http/head_reader.h); a worker gets a connection with its head in
+//                    hand, serves one request and gives a kept-alive connection back.
+//   slow bodies      a body that is not prefetched (chunked, or above prefetch_body_bytes) is
+//                    read by its worker: at most `max_body_readers_per_peer` workers read
+//                    bodies of one peer address; one more is answered 503 unread.
+//   deadlines        the rest of a body must arrive within `request_deadline` of the head, and
+//                    each read or write within `io_timeout`; a slow client is cut off when
+//                    either passes.
 //   backlog          `listen_backlog` pending connections (httplib's built-in is 5).
 //   one per port     no SO_REUSEPORT: a second server on a bound port fails to bind.
 #pragma once
@@ -22,6 +30,7 @@
 
 #include <string>
 
+#include "station/http/head_reader.h"
 #include "station/http/limits.h"
 
 namespace eol::station::http {
@@ -52,6 +61,9 @@ class ApiServer final : public httplib::Server {
   // deadline, refusing connections that waited too long for a worker, and closing after a
   // refused body.
   bool process_and_close_socket(::socket_t sock) override;
+  // On a worker: one request whose head (station/http/head_reader.h) is in `bytes`; the
+  // connection goes back to the head reader when kept alive.
+  void ServeRequest(HeadReader::Ready ready);
 
   const ServerLimits limits_;
   int listen_fd_ = -1;  // the listening socket, seen by the socket-options hook

@@ -4,7 +4,6 @@
 #include <fcntl.h>
 #include <modbus.h>
 #include <netinet/in.h>
-#include <poll.h>
 #include <spdlog/spdlog.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -18,6 +17,7 @@
 #include <vector>
 
 #include "drivers/fixture/modbus_link.h"
+#include "drivers/fixture/modbus_tcp_server.h"
 #include "station/serial_number.h"
 
 namespace eol::station::plc {
@@ -96,6 +96,10 @@ void PlcServer::Start() {
   thread_ = std::thread([this] { Serve(); });
   spdlog::info("PLC server: Modbus TCP on {}:{} unit {}", settings_.listen, port_.load(),
                settings_.unit_id);
+  if (settings_.listen == "0.0.0.0")
+    spdlog::warn(
+        "PLC server: listening on every interface (0.0.0.0); Modbus has no "
+        "authentication: set plc.listen to the station's address in the PLC network");
 }
 
 void PlcServer::Stop() {
@@ -124,76 +128,46 @@ void PlcServer::CloseAll() {
 }
 
 void PlcServer::Serve() {
-  std::vector<int> clients;
-  std::vector<std::uint8_t> request(MODBUS_TCP_MAX_ADU_LENGTH);
-  // poll() rather than select(): no FD_SETSIZE limit on the descriptors a process has.
-  for (;;) {
-    std::vector<pollfd> fds;
-    fds.push_back({wake_[0], POLLIN, 0});
-    fds.push_back({listen_fd_, POLLIN, 0});
-    for (int c : clients) fds.push_back({c, POLLIN, 0});
-    const int n = poll(fds.data(), fds.size(), 100);
-    if (n < 0 && errno != EINTR) {
-      spdlog::error("PLC server: poll: {}", std::strerror(errno));
-      break;
-    }
-    try {
-      Refresh();  // busy -> done shows within 100 ms even while no PLC asks
-    } catch (const std::exception& e) {
-      spdlog::error("PLC server: reading the station's state: {}", e.what());
-    }
-    if (n <= 0) continue;
-    if (fds[0].revents != 0) break;
-    if (fds[1].revents & POLLIN) {
-      const int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
-      if (fd >= 0 && static_cast<int>(clients.size()) >= settings_.max_clients) {
-        spdlog::warn("PLC server: refusing a connection: {} clients already", clients.size());
-        close(fd);
-      } else if (fd >= 0) {
-        clients.push_back(fd);
-      }
-    }
-    std::vector<int> closed;
-    for (std::size_t i = 0; i < clients.size(); ++i) {
-      const pollfd& p = fds[2 + i];
-      if (p.revents == 0) continue;
-      modbus_set_socket(ctx_, p.fd);
-      const int rc = modbus_receive(ctx_, request.data());
-      if (rc > 0) {
+  drivers::ModbusTcpLoopSettings loop_settings;
+  loop_settings.name = "PLC server";
+  loop_settings.max_clients = settings_.max_clients;
+  loop_settings.frame_deadline = settings_.frame_deadline;
+  loop_settings.idle_timeout = settings_.idle_timeout;
+  drivers::ModbusTcpLoop loop(
+      loop_settings,
+      [this](int fd, const std::uint8_t* request, int length) {
+        modbus_set_socket(ctx_, fd);
         try {
-          Handle(request.data(), rc);
+          return Handle(request, length);
         } catch (const std::exception& e) {
           spdlog::error("PLC server: request failed: {}", e.what());
+          return true;
         }
-      } else if (rc == -1) {
-        closed.push_back(p.fd);  // closed by the PLC, or a broken frame: drop it
-      }
-    }
-    for (int fd : closed) {
-      close(fd);
-      clients.erase(std::find(clients.begin(), clients.end(), fd));
-    }
-  }
-  for (int fd : clients) close(fd);
+      },
+      [this] {
+        try {
+          Refresh();  // busy -> done shows within 100 ms even while no PLC asks
+        } catch (const std::exception& e) {
+          spdlog::error("PLC server: reading the station's state: {}", e.what());
+        }
+      });
+  loop.Run(listen_fd_, wake_[0]);
 }
 
-void PlcServer::Handle(const std::uint8_t* request, int length) {
+bool PlcServer::Handle(const std::uint8_t* request, int length) {
   const int header = modbus_get_header_length(ctx_);
-  if (length <= header) return;
+  if (length <= header) return true;
   const int unit = request[header - 1];
   const int function = request[header];
-  if (unit != settings_.unit_id) {
-    modbus_reply_exception(ctx_, request, MODBUS_EXCEPTION_GATEWAY_TARGET);
-    return;
-  }
-  if (!drivers::IsPlainModbusFunction(function)) {
-    modbus_reply_exception(ctx_, request, MODBUS_EXCEPTION_ILLEGAL_FUNCTION);
-    return;
-  }
+  if (unit != settings_.unit_id)
+    return modbus_reply_exception(ctx_, request, MODBUS_EXCEPTION_GATEWAY_TARGET) >= 0;
+  if (!drivers::IsPlainModbusFunction(function))
+    return modbus_reply_exception(ctx_, request, MODBUS_EXCEPTION_ILLEGAL_FUNCTION) >= 0;
   Refresh();
-  modbus_reply(ctx_, request, length, mapping_);  // applies a write, then answers it
+  const int sent = modbus_reply(ctx_, request, length, mapping_);  // applies a write, answers
   const int coil = settings_.map.start - mapping_->start_bits;
   if (mapping_->tab_bits[coil] != 0) TakeStart();
+  return sent >= 0;
 }
 
 void PlcServer::TakeStart() {

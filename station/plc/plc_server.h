@@ -1,8 +1,12 @@
 // The line PLC's handshake: the station as a Modbus TCP server (libmodbus) that the line PLC
 // polls. The map and the handshake are in station/plc/plc_map.h.
 //
-// One thread serves every connected PLC (several at once, up to max_clients) with poll();
-// before each request and at least every 100 ms it refreshes the tables from the station
+// One thread serves every connected PLC (several at once, up to max_clients; one more is
+// refused and closed at once) through drivers/fixture/modbus_tcp_server.h: non-blocking
+// sockets, each request assembled per connection, so a slow or idle PLC stalls no other; a
+// request must arrive whole within frame_deadline of its first byte and a connection without
+// a request for idle_timeout is closed. Before each request and at least every 100 ms it
+// refreshes the tables from the station
 // (PlcBackend::view), and after a request that left the start coil set it takes the start:
 // the serial is decoded and validated, the station asked to queue it, the refusal code
 // written and the coil cleared, all before the next request of any client is served, so a
@@ -14,6 +18,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -30,11 +35,16 @@ struct _modbus_mapping_t;
 namespace eol::station::plc {
 
 struct PlcServerSettings {
-  std::string listen = "0.0.0.0";  // dotted IPv4 address to listen on
-  int port = 502;                  // 0: any free port (see PlcServer::port())
-  int unit_id = 1;                 // 1..247
+  // Dotted IPv4 address to listen on. Modbus has no authentication: the default is loopback
+  // only; a station serves the line PLC on its address in the PLC network ("0.0.0.0" is
+  // every interface, which the station logs as a warning).
+  std::string listen = "127.0.0.1";
+  int port = 502;   // 0: any free port (see PlcServer::port())
+  int unit_id = 1;  // 1..247
   PlcMap map;
-  int max_clients = 8;  // connections served at once; more are refused
+  int max_clients = 8;                             // connections served at once; more are refused
+  std::chrono::milliseconds frame_deadline{1000};  // a request's first byte to its last
+  std::chrono::milliseconds idle_timeout{60000};   // a connection without a request
 };
 
 // What the PLC sees of the station. Read under the station's own locks, so busy, verdicts
@@ -79,7 +89,7 @@ class PlcServer {
 
  private:
   void Serve();
-  void Handle(const std::uint8_t* request, int length);
+  bool Handle(const std::uint8_t* request, int length);  // false: the reply was not sent
   void Refresh();
   void TakeStart();
   void CloseAll();

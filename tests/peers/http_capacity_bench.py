@@ -61,7 +61,7 @@ def hold_streams(port, n):
     socks, ok = [], []
     for _ in range(n):
         s = socket.create_connection(("127.0.0.1", port))
-        s.sendall(b"GET /api/events HTTP/1.1\r\nHost: bench\r\n\r\n")
+        s.sendall(b"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
         socks.append(s)
     for s in socks:
         s.settimeout(10)
@@ -100,7 +100,7 @@ def wrk_latency(port, clients, seconds):
 def chunked_body(port, pid, total_bytes):
     before = vm_hwm_kb(pid)
     s = socket.create_connection(("127.0.0.1", port))
-    s.sendall(b"POST /api/tests HTTP/1.1\r\nHost: bench\r\nContent-Type: application/json\r\n"
+    s.sendall(b"POST /api/tests HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
               b"Transfer-Encoding: chunked\r\n\r\n")
     chunk = b"100000\r\n" + b"x" * 0x100000 + b"\r\n"
     answer = bytearray()

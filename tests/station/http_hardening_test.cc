@@ -74,7 +74,7 @@ TEST(HttpCapacity, StatusAnswersWithMoreStreamsThanWorkersAndSlowClients) {
   std::vector<std::unique_ptr<RawClient>> streams;
   for (int i = 0; i < 16; ++i) {
     streams.push_back(std::make_unique<RawClient>(api.port()));
-    ASSERT_TRUE(streams.back()->Send("GET /api/events HTTP/1.1\r\nHost: t\r\n\r\n"));
+    ASSERT_TRUE(streams.back()->Send("GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"));
   }
   for (auto& s : streams)
     ASSERT_NE(s->ReadUntil("\r\n\r\n", 5s).find("text/event-stream"), std::string::npos)
@@ -97,10 +97,10 @@ TEST(HttpCapacity, StreamsBeyondTheMaximumAre503WithAJsonBody) {
   Api api(limits);
   RawClient a(api.port()), b(api.port()), c(api.port());
   for (RawClient* s : {&a, &b}) {
-    ASSERT_TRUE(s->Send("GET /api/events HTTP/1.1\r\nHost: t\r\n\r\n"));
+    ASSERT_TRUE(s->Send("GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"));
     ASSERT_NE(s->ReadUntil("\r\n\r\n", 5s).find("200 OK"), std::string::npos);
   }
-  ASSERT_TRUE(c.Send("GET /api/events HTTP/1.1\r\nHost: t\r\n\r\n"));
+  ASSERT_TRUE(c.Send("GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"));
   const std::string third = c.ReadUntil("}}", 5s);
   EXPECT_NE(third.find("503"), std::string::npos) << third;
   EXPECT_NE(third.find(R"("code":"too_many_streams")"), std::string::npos) << third;
@@ -108,11 +108,12 @@ TEST(HttpCapacity, StreamsBeyondTheMaximumAre503WithAJsonBody) {
 
 TEST(HttpCapacity, ASlowRequestIsCutOffAtItsDeadlineHoweverItIsPaced) {
   ServerLimits limits;
+  limits.head_deadline = 1000ms;  // the head, read before a worker is taken
   limits.request_deadline = 1000ms;
   Api api(limits);
   RawClient slow(api.port());
   const std::string request =
-      "GET /api/status HTTP/1.1\r\nHost: t\r\nX-Pad: " + std::string(200, 'a') + "\r\n\r\n";
+      "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Pad: " + std::string(200, 'a') + "\r\n\r\n";
   // One byte every 50 ms never trips the 5 s read timeout; only the deadline stops it.
   const auto t0 = Clock::now();
   for (char ch : request) {
@@ -131,13 +132,17 @@ TEST(HttpCapacity, APostThatWaitedTooLongForAWorkerIsRefusedUnread) {
   limits.request_deadline = 1500ms;
   limits.max_queue_wait = 500ms;
   Api api(limits);
-  RawClient hog(api.port());  // holds the only worker until its deadline
-  ASSERT_TRUE(hog.Send("GET /api/status HTTP/1.1\r\n"));
+  // Holds the only worker until its deadline: a head in full (read without a worker), then
+  // a chunked body that never comes.
+  RawClient hog(api.port());
+  ASSERT_TRUE(
+      hog.Send("POST /api/tests HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+               "Transfer-Encoding: chunked\r\n\r\n"));
   std::this_thread::sleep_for(100ms);  // the hog's connection reaches the worker first
   RawClient post(api.port());
   const std::string body = R"({"serial": "Q-1"})";
   ASSERT_TRUE(
-      post.Send("POST /api/tests HTTP/1.1\r\nHost: t\r\nContent-Type: application/json\r\n"
+      post.Send("POST /api/tests HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
                 "Content-Length: " +
                 std::to_string(body.size()) + "\r\n\r\n" + body));
   const std::string answer = post.ReadUntil("}}", 5s);
@@ -231,7 +236,7 @@ TEST(HttpGate, AChunkedBodyAboveTheCapIsRefusedWithoutBuffering) {
   Api api(ServerLimits{});
   RawClient c(api.port());
   ASSERT_TRUE(
-      c.Send("POST /api/tests HTTP/1.1\r\nHost: t\r\nContent-Type: application/json\r\n"
+      c.Send("POST /api/tests HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
              "Transfer-Encoding: chunked\r\n\r\n"));
   const std::string chunk = "4000\r\n" + std::string(0x4000, ' ') + "\r\n";
   for (int i = 0; i < 8 && c.Send(chunk); ++i) {
@@ -297,7 +302,7 @@ TEST(HttpGate, TheDaemonsPeakMemoryStaysFlatUnder50MbOfChunkedBody) {
   const long before_kb = PeakRssKb(station.pid());
   RawClient c(port);
   ASSERT_TRUE(
-      c.Send("POST /api/tests HTTP/1.1\r\nHost: t\r\nContent-Type: application/json\r\n"
+      c.Send("POST /api/tests HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
              "Transfer-Encoding: chunked\r\n\r\n"));
   std::string answer;
   std::thread reader([&] { answer = c.ReadUntil("}}", 20s); });
