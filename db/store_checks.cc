@@ -1,0 +1,161 @@
+#include "db/store_checks.h"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "db/schema.h"
+#include "db/sqlite_statement.h"
+
+namespace eol::db::internal {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kHeaderBytes = 100;     // SQLite's database header
+constexpr char kMagic[] = "SQLite format 3";  // with its NUL: the first 16 bytes
+constexpr int kQuickCheckRows = 10;           // problems named at most
+
+// How a refused file is left, and what a person does about it.
+constexpr const char* kUntouched = "; the file is left as it is and nothing was created beside it";
+
+std::uint32_t BigEndian32(const unsigned char* p) {
+  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) |
+         std::uint32_t{p[3]};
+}
+
+// The first bytes as text an operator can recognise ("root:x:0:0:...").
+std::string Printable(const unsigned char* p, std::size_t n) {
+  std::string out;
+  for (std::size_t i = 0; i < n && i < 24; ++i)
+    out += (p[i] >= 0x20 && p[i] < 0x7f) ? static_cast<char>(p[i]) : '.';
+  return out;
+}
+
+void CheckHeader(const std::string& path, std::uintmax_t size) {
+  std::array<unsigned char, kHeaderBytes> h{};
+  std::ifstream in(path, std::ios::binary);
+  in.read(reinterpret_cast<char*>(h.data()), h.size());
+  const auto n = static_cast<std::size_t>(in.gcount());
+  if (!in && !in.eof()) throw StoreError(Message(path, "open", "cannot read the file"));
+  if (n < sizeof kMagic || std::memcmp(h.data(), kMagic, sizeof kMagic) != 0)
+    throw StoreRefused(Message(path, "open",
+                               "not a database (" + std::to_string(size) + " bytes beginning \"" +
+                                   Printable(h.data(), n) +
+                                   "\", not SQLite's header), so not a store" + kUntouched));
+  // The header may lag behind the WAL, but never holds another application's id.
+  const std::uint32_t app_id = n >= 72 ? BigEndian32(h.data() + 68) : 0;
+  if (app_id != 0 && app_id != static_cast<std::uint32_t>(schema::kApplicationId))
+    throw StoreRefused(Message(path, "open",
+                               "not an EOL test store (an SQLite database with application_id " +
+                                   std::to_string(app_id) + ")" + kUntouched));
+}
+
+}  // namespace
+
+FileState CheckFile(const std::string& path, Store::Role role, const OpenOptions& options) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (!fs::exists(st)) {
+    // sqlite3_open_v2 would name a missing file "unable to open database file".
+    if (role == Store::Role::kReadOnly)
+      throw StoreError(Message(path, "open read-only", "no such file"));
+    std::string problem;
+    const std::optional<LastVerdict> acked = ReadLastVerdict(LastVerdictPath(path), &problem);
+    if (acked && !options.create_if_empty)
+      throw StoreRefused(
+          Message(path, "open",
+                  "no such file, but " + LastVerdictPath(path) + " says test " +
+                      std::to_string(acked->test_id) + " (" + acked->outcome + ", serial " +
+                      acked->serial + ") was stored here at " + acked->finished_at +
+                      ": the store was deleted or moved; restore it, or start with --init-store to "
+                      "begin a new store (new tests are numbered after that one)"));
+    return FileState::kMissing;
+  }
+  if (!fs::is_regular_file(st))
+    throw StoreRefused(
+        Message(path, "open", "not a regular file, so not a store" + std::string(kUntouched)));
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) throw StoreError(Message(path, "open", "cannot read its size: " + ec.message()));
+  if (size == 0) {
+    if (options.create_if_empty && role != Store::Role::kReadOnly) return FileState::kEmpty;
+    throw StoreRefused(
+        Message(path, "open",
+                "the file is empty (0 bytes): not a store (truncated or replaced?)" +
+                    std::string(kUntouched) + "; " +
+                    (role == Store::Role::kReadOnly ? "nothing to read" : kInitStoreHint)));
+  }
+  CheckHeader(path, size);
+  return FileState::kHasBytes;
+}
+
+void QuickCheck(sqlite3* db, const std::string& path) {
+  const std::string op = "open (PRAGMA quick_check)";
+  Statement s(db, path, "PRAGMA quick_check(" + std::to_string(kQuickCheckRows) + ")", op);
+  std::string problems;
+  try {
+    while (s.Step()) {
+      std::string row = s.Text(0);
+      if (row == "ok") return;
+      constexpr std::string_view kHeading = "*** in database main ***\n";
+      if (row.starts_with(kHeading)) row.erase(0, kHeading.size());
+      std::replace(row.begin(), row.end(), '\n', ' ');
+      problems += (problems.empty() ? "" : "; ") + row;
+    }
+  } catch (const StoreError&) {
+    // SQLite stops the check at a page it cannot read, after naming what it found.
+    if (problems.empty()) throw;
+    problems += "; then " + std::string(sqlite3_errmsg(db));
+  }
+  throw StoreRefused(Message(
+      path, op,
+      "the store is damaged: " + problems +
+          "; it is not used: keep the file (and its -wal) for analysis, then restore a backup "
+          "or move the file aside and start a new store"));
+}
+
+std::string FindLostVerdict(sqlite3* db, const std::string& path, const LastVerdict& acked) {
+  const std::string op = "open (compare with " + LastVerdictPath(path) + ")";
+  const std::string what = "test " + std::to_string(acked.test_id) + " (" + acked.outcome +
+                           ", serial " + acked.serial + ") was acknowledged at " +
+                           acked.finished_at;
+  std::string stored;
+  {
+    Statement s(db, path, "SELECT outcome FROM tests WHERE id = ?1", op);
+    s.BindInt(1, acked.test_id);
+    if (s.Step()) stored = s.Text(0);
+  }
+  if (stored == acked.outcome) return "";
+  if (!stored.empty())
+    return what + ", but the store holds it as " + stored +
+           ": its verdict is lost (a deleted or damaged WAL, or an older copy of the file)";
+  const std::int64_t newest =
+      PragmaInt(db, path, "SELECT coalesce(max(id), 0) FROM tests", op + " (newest test)");
+  const std::string range = newest + 1 < acked.test_id ? "tests " + std::to_string(newest + 1) +
+                                                             " to " + std::to_string(acked.test_id)
+                                                       : "test " + std::to_string(acked.test_id);
+  return "the store ends at test " + std::to_string(newest) + ", but " + what +
+         ": the records of " + range +
+         " are lost (a deleted or damaged WAL, or an older copy of the file); new tests are "
+         "numbered from " +
+         std::to_string(acked.test_id + 1);
+}
+
+std::vector<std::string> FindLostDeliveries(sqlite3* db, const std::string& path) {
+  const std::string op = "open (compare the outbox cursors with the outbox)";
+  Statement s(db, path,
+              "SELECT consumer, last_id, (SELECT coalesce(max(id), 0) FROM outbox) "
+              "FROM outbox_cursors WHERE last_id > (SELECT coalesce(max(id), 0) FROM outbox) "
+              "ORDER BY consumer",
+              op);
+  std::vector<std::string> out;
+  while (s.Step())
+    out.push_back("the '" + s.Text(0) + "' publisher delivered outbox row " +
+                  std::to_string(s.Int(1)) + ", but the outbox ends at row " +
+                  std::to_string(s.Int(2)) + ": records it delivered are not in the store");
+  return out;
+}
+
+}  // namespace eol::db::internal
