@@ -72,7 +72,15 @@ struct OpenOptions {
   // the current size); 0: SQLite's. Past it a write fails as on a full disk ("database or
   // disk is full"), which is how the tests fill the disk.
   std::int64_t max_page_count = 0;
+  // How long PRAGMA quick_check may take at open (its time grows with the file); past it the
+  // check is interrupted, the store is used, and check_on_open() says the check was cut
+  // short. -1: kWriterCheckBudgetMs for kWriter (under systemd's 90 s start timeout),
+  // kReadOnlyCheckBudgetMs for kReadOnly (each `eol query` pays it on a large store).
+  int quick_check_budget_ms = -1;
 };
+
+inline constexpr int kWriterCheckBudgetMs = 20000;
+inline constexpr int kReadOnlyCheckBudgetMs = 2000;
 
 struct TestQuery {
   std::optional<std::string> from;  // ISO 8601, inclusive, on started_at
@@ -177,6 +185,9 @@ class Store {
   // outcome) and the outbox cursors (a publisher that delivered rows the outbox no longer
   // has). New tests then get ids above every acknowledged one, so no id is used twice.
   const std::string& loss_on_open() const { return loss_on_open_; }
+  // "" when Open() checked the whole file (or created it); otherwise that PRAGMA quick_check
+  // ran out of its budget (OpenOptions::quick_check_budget_ms) before the file's end.
+  const std::string& check_on_open() const { return check_on_open_; }
   // The last write that failed (e.g. "... database or disk is full"), until a write
   // succeeds; empty while writes work. The station shows it as the reason it is not ready.
   const std::string& write_failure() const { return write_failure_; }
@@ -245,6 +256,7 @@ class Store {
   bool checkpoint_each_test_ = false;
   std::int64_t id_floor_ = 0;  // new tests get ids >= this (above every acknowledged one)
   std::string loss_on_open_;
+  std::string check_on_open_;
   std::string write_failure_;
   // Tests whose FinishTest failed and that are still RUNNING: id and the failure.
   std::vector<std::pair<std::int64_t, std::string>> failed_finishes_;

@@ -2,9 +2,14 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <thread>
 
 #include "db/schema.h"
 #include "db/sqlite_statement.h"
@@ -91,20 +96,66 @@ FileState CheckFile(const std::string& path, Store::Role role, const OpenOptions
   return FileState::kHasBytes;
 }
 
-void QuickCheck(sqlite3* db, const std::string& path) {
+namespace {
+
+// Interrupts `db` (sqlite3_interrupt) once `budget_ms` have passed, unless destroyed first.
+class Deadline {
+ public:
+  Deadline(sqlite3* db, int budget_ms)
+      : thread_([this, db, budget_ms] {
+          std::unique_lock<std::mutex> lock(mu_);
+          if (!cv_.wait_for(lock, std::chrono::milliseconds(budget_ms), [this] { return done_; }))
+            sqlite3_interrupt(db);
+        }) {}
+  ~Deadline() {
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      done_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  Deadline(const Deadline&) = delete;
+  Deadline& operator=(const Deadline&) = delete;
+
+ private:
+  std::mutex mu_;
+  std::condition_variable cv_;
+  bool done_ = false;
+  std::thread thread_;  // last: started once the members above exist
+};
+
+}  // namespace
+
+std::string QuickCheck(sqlite3* db, const std::string& path, int budget_ms) {
   const std::string op = "open (PRAGMA quick_check)";
+  if (budget_ms == 0) return "PRAGMA quick_check not run (its budget is 0 s)";
   Statement s(db, path, "PRAGMA quick_check(" + std::to_string(kQuickCheckRows) + ")", op);
   std::string problems;
+  const auto start = std::chrono::steady_clock::now();
   try {
+    Deadline deadline(db, budget_ms);
     while (s.Step()) {
       std::string row = s.Text(0);
-      if (row == "ok") return;
+      if (row == "ok") return "";
       constexpr std::string_view kHeading = "*** in database main ***\n";
       if (row.starts_with(kHeading)) row.erase(0, kHeading.size());
       std::replace(row.begin(), row.end(), '\n', ' ');
       problems += (problems.empty() ? "" : "; ") + row;
     }
   } catch (const StoreError&) {
+    if (problems.empty() && (sqlite3_errcode(db) & 0xff) == SQLITE_INTERRUPT) {
+      const double s_used =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::error_code ec;
+      const double gb = static_cast<double>(fs::file_size(path, ec)) / 1e9;
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "PRAGMA quick_check stopped after its budget of %.1f s (%.1f s) on %.2f GB: "
+                    "the file was not checked to its end",
+                    budget_ms / 1e3, s_used, gb);
+      return text;
+    }
     // SQLite stops the check at a page it cannot read, after naming what it found.
     if (problems.empty()) throw;
     problems += "; then " + std::string(sqlite3_errmsg(db));

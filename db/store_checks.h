@@ -28,8 +28,10 @@ enum class FileState { kMissing, kEmpty, kHasBytes };
 // kReadOnly: a missing file is a StoreError ("no such file").
 FileState CheckFile(const std::string& path, Store::Role role, const OpenOptions& options);
 
-// PRAGMA quick_check: throws StoreRefused naming the first problems it reports.
-void QuickCheck(sqlite3* db, const std::string& path);
+// PRAGMA quick_check, interrupted after `budget_ms` (its time grows with the file: about a
+// year of a line's tests is tens of GB): throws StoreRefused naming the first problems it
+// reports; returns "" when it checked the whole file, otherwise what it left unchecked.
+std::string QuickCheck(sqlite3* db, const std::string& path, int budget_ms);
 
 // "" when the store holds test `acked.test_id` with outcome `acked.outcome`; otherwise what is
 // missing ("the store ends at test 41, but test 44 (PASS, serial M-7) was acknowledged ...").

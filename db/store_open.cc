@@ -249,7 +249,10 @@ std::unique_ptr<Store> Store::Open(const std::string& path, Role role, const Ope
   sqlite3_busy_timeout(store->db_, kBusyTimeoutMs);
   CheckIdentity(store->db_, path, role, file == FileState::kHasBytes && !options.create_if_empty);
   if (role == Role::kReadOnly) {
-    QuickCheck(store->db_, path);
+    store->check_on_open_ =
+        QuickCheck(store->db_, path,
+                   options.quick_check_budget_ms >= 0 ? options.quick_check_budget_ms
+                                                      : kReadOnlyCheckBudgetMs);
     return store;
   }
   // SQLite falls back to read-only when the file is write-protected; the station must write.
@@ -261,7 +264,10 @@ std::unique_ptr<Store> Store::Open(const std::string& path, Role role, const Ope
     const std::string sql = "PRAGMA max_page_count = " + std::to_string(options.max_page_count);
     Exec(store->db_, path, sql.c_str(), "open (PRAGMA max_page_count)");
   }
-  if (role == Role::kWriter && file != FileState::kMissing) QuickCheck(store->db_, path);
+  if (role == Role::kWriter && file != FileState::kMissing)
+    store->check_on_open_ = QuickCheck(
+        store->db_, path,
+        options.quick_check_budget_ms >= 0 ? options.quick_check_budget_ms : kWriterCheckBudgetMs);
   Migrate(store->db_, path);
   if (role != Role::kWriter) return store;
   if (on_disk) store->OpenWriterFiles(options);

@@ -152,6 +152,23 @@ TEST_F(StoreGuardTest, AZeroedPageIsRefusedNamingThePageAndNothingIsWritten) {
   EXPECT_EQ(Bytes(path_), before) << "a refused store was written";
 }
 
+// The check is bounded: past its budget it is interrupted and says so, and the store is used.
+// (The interrupt itself lands at the budget only as the scheduler allows; a budget of 0 skips
+// the check, deterministically.)
+TEST_F(StoreGuardTest, AQuickCheckPastItsBudgetIsCutShortAndSaysSo) {
+  {
+    auto store = Store::Open(path());
+    for (int i = 0; i < 4; ++i) RunTest(*store, "B-" + std::to_string(i));
+  }
+  OpenOptions none;
+  none.quick_check_budget_ms = 0;
+  auto store = Store::Open(path(), Store::Role::kReadOnly, none);
+  EXPECT_EQ(store->check_on_open(), "PRAGMA quick_check not run (its budget is 0 s)");
+  EXPECT_EQ(store->Tests({}).size(), 4u);
+  EXPECT_EQ(Store::Open(path(), Store::Role::kReadOnly)->check_on_open(), "");
+  EXPECT_EQ(Store::Open(path())->check_on_open(), "");
+}
+
 TEST_F(StoreGuardTest, AStoreTruncatedToZeroBytesIsRefusedAndOnlyTheFlagMakesANewOne) {
   std::int64_t last = 0;
   {
