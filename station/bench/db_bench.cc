@@ -1,5 +1,7 @@
 #include "station/bench/db_bench.h"
 
+#include <sqlite3.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "db/clock.h"
+#include "db/last_verdict.h"
 #include "db/store.h"
 #include "station/bench/db_replicate.h"
 
@@ -70,6 +73,19 @@ void MeasureGuards(const DbBenchOptions& o, const db::TestRecord& tmpl, DbBenchS
     std::tie(checkpoint ? s.finish_median_ms : s.finish_no_checkpoint_median_ms,
              checkpoint ? s.finish_p99_ms : s.finish_no_checkpoint_p99_ms) = MedianP99(ms);
   }
+  // The store keeps only the generated tests (their rows cascade with them).
+  sqlite3* raw = nullptr;
+  const int rc = sqlite3_open_v2(o.db.c_str(), &raw, SQLITE_OPEN_READWRITE, nullptr);
+  const bool removed =
+      rc == SQLITE_OK && sqlite3_exec(raw,
+                                      "PRAGMA foreign_keys = ON; DELETE FROM outbox WHERE test_id "
+                                      "IN (SELECT id FROM tests WHERE serial LIKE 'GUARD-%'); "
+                                      "DELETE FROM tests WHERE serial LIKE 'GUARD-%'",
+                                      nullptr, nullptr, nullptr) == SQLITE_OK;
+  const std::string why = raw != nullptr ? sqlite3_errmsg(raw) : "cannot open";
+  sqlite3_close(raw);
+  if (!removed) throw std::runtime_error(o.db + ": removing the GUARD- tests: " + why);
+  std::filesystem::remove(db::LastVerdictPath(o.db));
 }
 
 }  // namespace

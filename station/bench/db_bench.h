@@ -14,7 +14,8 @@
 // the store's guards cost at that size (issue 34): opening it (PRAGMA quick_check, read-only
 // and as the station's writer) and finishing a test as the station does (BeginTest +
 // FinishTest, one at a time), with and without the checkpoint after each verdict; these
-// `finish_samples` x 2 tests are added after every other figure is taken.
+// `finish_samples` x 2 tests ("GUARD-...") are added after every other figure is taken, then
+// removed (with the last-verdict file that names one of them).
 // With replicate K > 1 the generated block is then copied K - 1 times inside SQLite
 // (db_replicate.h: later in time, new serials, the same bytes), so a store of tests x K is
 // measured without generating each test through the Store.
