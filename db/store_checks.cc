@@ -88,7 +88,7 @@ FileState CheckFile(const std::string& path, Store::Role role, const OpenOptions
     if (options.create_if_empty && role != Store::Role::kReadOnly) return FileState::kEmpty;
     throw StoreRefused(
         Message(path, "open",
-                "the file is empty (0 bytes): not a store (truncated or replaced?)" +
+                "the file is empty (0 bytes): not an EOL test store (truncated or replaced?)" +
                     std::string(kUntouched) + "; " +
                     (role == Store::Role::kReadOnly ? "nothing to read" : kInitStoreHint)));
   }
