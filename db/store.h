@@ -3,11 +3,25 @@
 // Contract (the station relies on every line):
 // - Open() creates or migrates the schema (versioned with PRAGMA user_version), turns on WAL
 //   and synchronous=FULL, and marks every test left unfinished by a crash as ABORTED.
+// - Open() refuses a file it must not use, with StoreRefused naming the file and the cause,
+//   before it writes anything (and, for a file that is not a store, before any side file):
+//   a file that is not an SQLite database; an existing file that is empty (0 bytes) or a
+//   database without the store's schema, unless OpenOptions::create_if_empty; a store that
+//   PRAGMA quick_check finds damaged (kWriter and kReadOnly; the first problems it names,
+//   e.g. "Tree 4 page 12: ..."). A new store is created only where no file exists.
 // - BeginTest() writes a row for a test that has started; until FinishTest() it is RUNNING,
 //   which no query ever reports as PASS (queries skip running rows; after a crash they are
 //   ABORTED).
 // - FinishTest() writes the whole record in one transaction and returns only once it is
-//   committed durably: the verdict may be published after it returns, never before.
+//   committed durably and (kWriter) copied from the WAL into the database file (a TRUNCATE
+//   checkpoint) and noted in "<path>.last-verdict": the verdict may be published after it
+//   returns, never before. A deleted or damaged WAL then loses no acknowledged verdict, and a
+//   store that lost one anyway (an older copy restored, a checkpoint readers held off) is
+//   named at the next Open() (loss_on_open()).
+// - A FinishTest() that fails (a full disk, a bad record) leaves no RUNNING row behind: the
+//   test is finished as ERROR "store write failed: <cause>" at once, or, when even that
+//   cannot be written, before the next write, which fails while it cannot
+//   (write_failure() says why until a write succeeds).
 // - Retests: a test of a serial that already has tests links to the first one (retest_of).
 // - Outbox (schema v5): every finished record, and every test recovered as ABORTED, gets an
 //   outbox row in the same transaction; publishers read the rows after their own cursor, in
@@ -34,6 +48,39 @@ class StoreError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// The file is not a store this software may use as it is: damaged (SQLite reports corruption,
+// quick_check finds a problem), not an SQLite database, emptied, or without the store's schema.
+// Restarting does not help: a person must restore, move or initialise the file.
+class StoreRefused : public StoreError {
+ public:
+  using StoreError::StoreError;
+};
+
+// How Open() treats the file.
+struct OpenOptions {
+  // Make an existing empty file (0 bytes, or an SQLite database without tables and without
+  // the store's ids) a new store, and a missing file a new one even where
+  // "<path>.last-verdict" says a store with verdicts was there (`eol station --init-store`).
+  // Without it such a file is refused: a store truncated or replaced by accident must not
+  // start again from nothing without a word.
+  bool create_if_empty = false;
+  // kWriter: copy each finished test from the WAL into the database file (TRUNCATE
+  // checkpoint). Off only to measure what it costs (`eol db-bench`).
+  bool checkpoint_each_test = true;
+  // kWriter, kReader: a cap on the file's size in pages (PRAGMA max_page_count; never below
+  // the current size); 0: SQLite's. Past it a write fails as on a full disk ("database or
+  // disk is full"), which is how the tests fill the disk.
+  std::int64_t max_page_count = 0;
+  // How long PRAGMA quick_check may take at open (its time grows with the file); past it the
+  // check is interrupted, the store is used, and check_on_open() says the check was cut
+  // short. -1: kWriterCheckBudgetMs for kWriter (under systemd's 90 s start timeout),
+  // kReadOnlyCheckBudgetMs for kReadOnly (each `eol query` pays it on a large store).
+  int quick_check_budget_ms = -1;
+};
+
+inline constexpr int kWriterCheckBudgetMs = 20000;
+inline constexpr int kReadOnlyCheckBudgetMs = 2000;
 
 struct TestQuery {
   std::optional<std::string> from;  // ISO 8601, inclusive, on started_at
@@ -117,9 +164,14 @@ class Store {
   // kReadOnly: a reader that never writes (queries, exports, stats): it opens an existing
   // store read-only, so it works on a file it may not write (a copy, a read-only share) and
   // never creates or migrates one; a missing file or another schema version is a StoreError.
+  // PRAGMA quick_check runs for kWriter (on an existing file) and kReadOnly, not for kReader
+  // (the station's further connections, opened after its writer checked the file). Its cost
+  // grows with the file: `eol db-bench` measures it (open_read_only_s, open_writer_s).
+  // kWriter also keeps "<path>.last-verdict" (db/last_verdict.h) beside the file.
   enum class Role { kWriter, kReader, kReadOnly };
 
-  static std::unique_ptr<Store> Open(const std::string& path, Role role = Role::kWriter);
+  static std::unique_ptr<Store> Open(const std::string& path, Role role = Role::kWriter,
+                                     const OpenOptions& options = {});
   ~Store();
   Store(const Store&) = delete;
   Store& operator=(const Store&) = delete;
@@ -127,10 +179,22 @@ class Store {
   const std::string& path() const { return path_; }
   // How many unfinished tests Open() found and marked ABORTED.
   int aborted_on_open() const { return aborted_on_open_; }
+  // kWriter: verdicts acknowledged earlier that Open() found missing from the store, named
+  // ("the store ends at test 41, but test 44 (PASS, serial M-7) was acknowledged at ...");
+  // empty when none. Found from "<path>.last-verdict" (the newest acknowledged test and its
+  // outcome) and the outbox cursors (a publisher that delivered rows the outbox no longer
+  // has). New tests then get ids above every acknowledged one, so no id is used twice.
+  const std::string& loss_on_open() const { return loss_on_open_; }
+  // "" when Open() checked the whole file (or created it); otherwise that PRAGMA quick_check
+  // ran out of its budget (OpenOptions::quick_check_budget_ms) before the file's end.
+  const std::string& check_on_open() const { return check_on_open_; }
+  // The last write that failed (e.g. "... database or disk is full"), until a write
+  // succeeds; empty while writes work. The station shows it as the reason it is not ready.
+  const std::string& write_failure() const { return write_failure_; }
 
   // Sets record.id and record.retest_of; writes serial, station, recipe, times.
   void BeginTest(TestRecord& record);
-  // record.id must come from BeginTest. Durable when it returns.
+  // record.id must come from BeginTest. Durable when it returns (see the contract above).
   void FinishTest(const TestRecord& record);
   // BeginTest + FinishTest, for records made elsewhere (imports, tests).
   void Insert(TestRecord& record);
@@ -177,10 +241,25 @@ class Store {
 
  private:
   explicit Store(std::string path);
+  void OpenWriterFiles(const OpenOptions& options);
+  // Finishes as ERROR the tests whose FinishTest failed (failed_finishes_); throws while it
+  // cannot. Every write calls it first.
+  void FinishFailedWrites();
+  void AfterVerdict(const TestRecord& record);
+  void Failed(const StoreError& e);
+
   std::string path_;
   sqlite3* db_ = nullptr;
   int aborted_on_open_ = 0;
-  int lock_fd_ = -1;  // kWriter: "<path>.lock", flock'ed exclusively while the store is open
+  int lock_fd_ = -1;     // kWriter: "<path>.lock", flock'ed exclusively while the store is open
+  int verdict_fd_ = -1;  // kWriter: "<path>.last-verdict" (db/last_verdict.h)
+  bool checkpoint_each_test_ = false;
+  std::int64_t id_floor_ = 0;  // new tests get ids >= this (above every acknowledged one)
+  std::string loss_on_open_;
+  std::string check_on_open_;
+  std::string write_failure_;
+  // Tests whose FinishTest failed and that are still RUNNING: id and the failure.
+  std::vector<std::pair<std::int64_t, std::string>> failed_finishes_;
 };
 
 }  // namespace eol::db

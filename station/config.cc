@@ -66,6 +66,7 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
     c.station_id = root.String("station_id", c.station_id);
     c.recipe_path = Resolve(base_dir, root.RequiredString("recipe"));
     c.db_path = Resolve(base_dir, root.RequiredString("db"));
+    c.init_store = root.Bool("init_store", false);
     if (auto http = root.OptionalObject("http")) {
       c.http_listen = http->String("listen", c.http_listen);
       c.http_port = http->Integer("port", c.http_port);

@@ -92,6 +92,10 @@ struct StationConfig {
   std::string station_id = "eol-1";
   std::string recipe_path;
   std::string db_path;
+  // Make an existing empty file at db_path a new store (db::OpenOptions::create_if_empty;
+  // config "init_store", `--init-store`). Without it such a file is refused; a missing file
+  // is always created.
+  bool init_store = false;
   std::string http_listen = "127.0.0.1";
   int http_port = 8080;
   std::vector<ApiToken> tokens;

@@ -56,10 +56,16 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
   if (!recipe_problem_.empty()) spdlog::error("{}", recipe_problem_);
   spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_->id, recipe_->version, config_.recipe_path,
                recipe_->hash.substr(0, 12));
-  store_ = db::Store::Open(config_.db_path);
+  db::OpenOptions store_options;
+  store_options.create_if_empty = config_.init_store;
+  store_ = db::Store::Open(config_.db_path, db::Store::Role::kWriter, store_options);
   if (store_->aborted_on_open() > 0)
     spdlog::warn("store {}: {} test(s) interrupted by a previous stop recorded as ABORTED",
                  config_.db_path, store_->aborted_on_open());
+  if (!store_->check_on_open().empty())
+    spdlog::warn("store {}: {}", config_.db_path, store_->check_on_open());
+  if (!store_->loss_on_open().empty())
+    spdlog::error("store {}: VERDICTS LOST: {}", config_.db_path, store_->loss_on_open());
   drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench));
   board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_->id, recipe_->hash);
   std::string not_ready;
@@ -76,6 +82,13 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
   if (!recipe_problem_.empty()) {
     board_->SetMessage(recipe_problem_);
     not_ready += (not_ready.empty() ? "" : "; ") + std::string("recipe does not load");
+  }
+  if (!store_->loss_on_open().empty()) {
+    // Named until the first test; the journal keeps it. Tests go on: refusing them would not
+    // bring the lost records back, and new tests get ids of their own.
+    const std::string lost = "store lost acknowledged verdicts: " + store_->loss_on_open();
+    board_->SetMessage(lost);
+    not_ready += (not_ready.empty() ? "" : "; ") + lost;
   }
   board_->SetReadiness(not_ready.empty(), not_ready);
   const std::string simulation = SimulationReason(config_);
@@ -245,7 +258,23 @@ int Station::http_port() const { return http_ ? http_->port() : 0; }
 db::TestRecord Station::RunTest(const std::string& serial) {
   db::TestRecord r = sequencer_->RunTest(serial);
   metrics_.OnTest(r);
+  ShowStoreFailure();
   return r;
+}
+
+// A write that failed (a full disk): the station is not ready, and says why, until a write
+// succeeds (the next test's BeginTest first finishes the failed test as ERROR).
+void Station::ShowStoreFailure() {
+  const std::string& failure = store_->write_failure();
+  if (failure.empty()) {
+    if (showing_store_failure_) board_->SetMessage("");  // the test's own readiness stands
+    showing_store_failure_ = false;
+    return;
+  }
+  showing_store_failure_ = true;
+  spdlog::error("store write failed, station not ready: {}", failure);
+  board_->SetMessage("store write failed: " + failure);
+  board_->SetReadiness(false, "store write failed: " + failure);
 }
 
 LiveMetrics Station::LiveValues() {
@@ -374,6 +403,7 @@ void Station::ServeQueue() {
     }
     const db::TestRecord r = sequencer_->RunTest(request.serial, request.work);
     metrics_.OnTest(r);
+    ShowStoreFailure();
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),
                  r.reasons.empty() ? "" : r.reasons.front().text);
     std::lock_guard<std::mutex> lock(queue_mu_);

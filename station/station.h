@@ -30,7 +30,9 @@ class Station {
   // Loads and validates the recipe (when the configured file does not load, the newest kept
   // version beside it is loaded and tests are refused until a valid recipe is installed;
   // with none, it throws), opens the store (recovering interrupted tests as
-  // ABORTED), makes the drivers and connects them. A fixture or DAQ that does not answer
+  // ABORTED; a damaged, emptied or foreign file throws db::StoreRefused; acknowledged
+  // verdicts the store lost are logged and shown, db::Store::loss_on_open), makes the drivers
+  // and connects them. A fixture or DAQ that does not answer
   // yet is not fatal: the station says so and retries at the next test. A bad recipe,
   // config or database is fatal (throws with the cause).
   // `bench`: a simulated bench shared with a fixture emulator (the demo); normally null.
@@ -113,6 +115,9 @@ class Station {
   bool stop_ = false;
 
   void ServeQueue();
+  // After each test: a failed store write makes the station not ready, naming the cause.
+  void ShowStoreFailure();
+  bool showing_store_failure_ = false;
   // What /metrics reads at scrape time (board, queue, driver and sequencer counters).
   LiveMetrics LiveValues();
   void HealthLoop(const std::atomic<bool>& serving);

@@ -1,5 +1,7 @@
 #include "station/bench/db_bench.h"
 
+#include <sqlite3.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "db/clock.h"
+#include "db/last_verdict.h"
 #include "db/store.h"
 #include "station/bench/db_replicate.h"
 
@@ -43,6 +46,46 @@ db::TestRecord Template(const std::string& path) {
   std::optional<db::TestRecord> r = store->Test(newest.front().id, /*with_curves=*/true);
   if (!r) throw std::runtime_error(path + ": the newest test could not be read");
   return *r;
+}
+
+// 5. What opening the store and finishing a test cost at this size (db_bench.h).
+void MeasureGuards(const DbBenchOptions& o, const db::TestRecord& tmpl, DbBenchSummary& s) {
+  const auto open_start = Clock::now();
+  (void)db::Store::Open(o.db);
+  s.open_writer_s = Seconds(open_start);
+  for (const bool checkpoint : {true, false}) {
+    db::OpenOptions options;
+    options.checkpoint_each_test = checkpoint;
+    auto writer = db::Store::Open(o.db, db::Store::Role::kWriter, options);
+    std::vector<double> ms;
+    for (int i = 0; i < o.finish_samples; ++i) {
+      db::TestRecord r = tmpl;
+      r.id = 0;
+      r.retest_of.reset();
+      r.serial = "GUARD-" + std::string(checkpoint ? "C" : "N") + std::to_string(i);
+      r.started_at = db::UtcNowIso8601();
+      const auto t = Clock::now();
+      writer->BeginTest(r);
+      r.finished_at = db::UtcNowIso8601();
+      writer->FinishTest(r);
+      ms.push_back(1e3 * Seconds(t));
+    }
+    std::tie(checkpoint ? s.finish_median_ms : s.finish_no_checkpoint_median_ms,
+             checkpoint ? s.finish_p99_ms : s.finish_no_checkpoint_p99_ms) = MedianP99(ms);
+  }
+  // The store keeps only the generated tests (their rows cascade with them).
+  sqlite3* raw = nullptr;
+  const int rc = sqlite3_open_v2(o.db.c_str(), &raw, SQLITE_OPEN_READWRITE, nullptr);
+  const bool removed =
+      rc == SQLITE_OK && sqlite3_exec(raw,
+                                      "PRAGMA foreign_keys = ON; DELETE FROM outbox WHERE test_id "
+                                      "IN (SELECT id FROM tests WHERE serial LIKE 'GUARD-%'); "
+                                      "DELETE FROM tests WHERE serial LIKE 'GUARD-%'",
+                                      nullptr, nullptr, nullptr) == SQLITE_OK;
+  const std::string why = raw != nullptr ? sqlite3_errmsg(raw) : "cannot open";
+  sqlite3_close(raw);
+  if (!removed) throw std::runtime_error(o.db + ": removing the GUARD- tests: " + why);
+  std::filesystem::remove(db::LastVerdictPath(o.db));
 }
 
 }  // namespace
@@ -107,7 +150,9 @@ DbBenchSummary RunDbBench(const DbBenchOptions& o) {
   s.tests = o.tests * o.replicate;
 
   // 2. Size: the database file (closing the writer checkpointed the WAL into it).
+  const auto open_start = Clock::now();
   auto store = db::Store::Open(o.db, db::Store::Role::kReadOnly);
+  s.open_read_only_s = Seconds(open_start);
   s.file_bytes = static_cast<double>(std::filesystem::file_size(o.db));
   if (std::filesystem::exists(o.db + "-wal"))
     s.file_bytes += static_cast<double>(std::filesystem::file_size(o.db + "-wal"));
@@ -158,6 +203,8 @@ DbBenchSummary RunDbBench(const DbBenchOptions& o) {
   const auto t = Clock::now();
   s.day_measurement_rows = static_cast<std::int64_t>(store->MeasurementRows(mq).size());
   s.day_measurements_s = Seconds(t);
+  store.reset();
+  MeasureGuards(o, tmpl, s);
   return s;
 }
 

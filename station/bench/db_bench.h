@@ -10,7 +10,12 @@
 //     (LatestOfSerial) for `queries` random serials: median and 99th percentile latency;
 //   - the export of one day of tests (Tests, keyset pages of 10,000, with and without curves)
 //     and of one day's measurement rows (MeasurementRows): rows per second;
-// and the file's size: bytes per test and the growth per year at the line's rate.
+// and the file's size: bytes per test and the growth per year at the line's rate. Last, what
+// the store's guards cost at that size (issue 34): opening it (PRAGMA quick_check, read-only
+// and as the station's writer) and finishing a test as the station does (BeginTest +
+// FinishTest, one at a time), with and without the checkpoint after each verdict; these
+// `finish_samples` x 2 tests ("GUARD-...") are added after every other figure is taken, then
+// removed (with the last-verdict file that names one of them).
 // With replicate K > 1 the generated block is then copied K - 1 times inside SQLite
 // (db_replicate.h: later in time, new serials, the same bytes), so a store of tests x K is
 // measured without generating each test through the Store.
@@ -33,7 +38,8 @@ struct DbBenchOptions {
   double retest_share = 0.03;  // tests that repeat the previous serial
   int queries = 1000;          // random serials looked up
   std::uint64_t seed = 1;
-  int replicate = 1;  // copies of the generated block in the store (1: the block alone)
+  int replicate = 1;        // copies of the generated block in the store (1: the block alone)
+  int finish_samples = 50;  // tests finished one at a time, each way
   analysis::ProgressCallback progress;
 };
 
@@ -52,7 +58,11 @@ struct DbBenchSummary {
   double day_export_curves_s = 0.0;  // the same with curves
   std::int64_t day_measurement_rows = 0;
   double day_measurements_s = 0.0;
-  std::string template_serial;  // whose record was the template
+  std::string template_serial;    // whose record was the template
+  double open_read_only_s = 0.0;  // Store::Open kReadOnly (quick_check): eol query, eol export
+  double open_writer_s = 0.0;     // Store::Open kWriter (quick_check, checks): the station
+  double finish_median_ms = 0.0, finish_p99_ms = 0.0;  // BeginTest + FinishTest, checkpointed
+  double finish_no_checkpoint_median_ms = 0.0, finish_no_checkpoint_p99_ms = 0.0;
 };
 
 // Throws std::runtime_error (or db::StoreError) naming the cause.

@@ -42,7 +42,14 @@ int RunDbBenchCommand(DbBenchArgs& a) {
                                 {"day_export_s", s.day_export_s},
                                 {"day_export_curves_s", s.day_export_curves_s},
                                 {"day_measurement_rows", s.day_measurement_rows},
-                                {"day_measurements_s", s.day_measurements_s}}
+                                {"day_measurements_s", s.day_measurements_s},
+                                {"open_read_only_s", s.open_read_only_s},
+                                {"open_writer_s", s.open_writer_s},
+                                {"finish_median_ms", s.finish_median_ms},
+                                {"finish_p99_ms", s.finish_p99_ms},
+                                {"finish_no_checkpoint_median_ms",
+                                 s.finish_no_checkpoint_median_ms},
+                                {"finish_no_checkpoint_p99_ms", s.finish_no_checkpoint_p99_ms}}
                      .dump(2)
               << std::endl;
     return 0;
@@ -65,6 +72,13 @@ int RunDbBenchCommand(DbBenchArgs& a) {
       "in %.2f s\n",
       static_cast<long long>(s.day_tests), s.day_export_s, s.day_export_curves_s,
       static_cast<long long>(s.day_measurement_rows), s.day_measurements_s);
+  std::printf("open with PRAGMA quick_check: read-only %.2f s, as the station's writer %.2f s\n",
+              s.open_read_only_s, s.open_writer_s);
+  std::printf(
+      "finish a test (BeginTest + FinishTest): median %.2f ms, p99 %.2f ms with the checkpoint "
+      "after each verdict; median %.2f ms, p99 %.2f ms without (%d tests each)\n",
+      s.finish_median_ms, s.finish_p99_ms, s.finish_no_checkpoint_median_ms,
+      s.finish_no_checkpoint_p99_ms, a.o.finish_samples);
   return 0;
 }
 
@@ -99,6 +113,10 @@ void AddDbBenchCommand(CLI::App& app) {
                   "time, new serials, the same bytes): --tests 100000 --replicate 50 measures "
                   "5 million tests")
       ->check(CLI::Range(1, 10000));
+  cmd->add_option("--finish-samples", args->o.finish_samples,
+                  "Tests finished one at a time with and without the checkpoint")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100000));
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args] { RunGuarded("db-bench", [&] { return RunDbBenchCommand(*args); }); });
 }

@@ -34,6 +34,7 @@ struct DemoArgs {
   double time_scale = 0.0;
   bool verbose = false;
   bool publish_before_release = false;
+  bool init_store = false;
   drivers::SimBenchSettings timing;  // the simulated fixture's clamp travel and heartbeat
   std::string fixture = "modbus";
   std::string sim = "time_domain";
@@ -54,6 +55,7 @@ int RunDemo(const DemoArgs& a) {
       {"station_id", "demo"},
       {"recipe", a.recipe},
       {"db", a.db},
+      {"init_store", a.init_store},
       {"http", {{"listen", a.listen}, {"port", a.port}}},
       {"fixture", {{"driver", "sim"}}},
       {"daq", {{"driver", "sim"}, {"time_scale", a.time_scale}, {"model", a.sim}}},
@@ -168,7 +170,9 @@ void AddDemoCommand(CLI::App& app) {
   cmd->add_option("--units", args->units, "Number of simulated units to test")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
-  cmd->add_option("--db", args->db, "SQLite file for the records (created if missing)")
+  cmd->add_option("--db", args->db,
+                  "SQLite file for the records (created if missing; an existing file must be a "
+                  "store)")
       ->capture_default_str();
   cmd->add_option("--recipe", args->recipe, "Recipe JSON")->capture_default_str();
   cmd->add_flag("--json", args->json,
@@ -210,6 +214,8 @@ void AddDemoCommand(CLI::App& app) {
                 "Store and publish each verdict while the clamp opens (the station config's "
                 "publish_before_release)");
   cmd->add_flag("--verbose", args->verbose, "Log every sequencer state (to stderr)");
+  cmd->add_flag("--init-store", args->init_store,
+                "Make an existing empty file (0 bytes) at --db a new store");
   cmd->callback([args] { RunGuarded("demo", [&] { return RunDemo(*args); }); });
 }
 

@@ -23,8 +23,11 @@ namespace eol::station::cli {
 namespace {
 
 constexpr int kExitConfigError = 78;  // EX_CONFIG (sysexits.h)
+// The store is damaged, emptied or not a store (db::StoreRefused): restarting cannot fix it
+// either; the unit's RestartPreventExitStatus names this code too.
+constexpr int kExitStoreRefused = 65;  // EX_DATAERR (sysexits.h)
 
-int RunStation(const std::string& config_path, std::string web_root) {
+int RunStation(const std::string& config_path, std::string web_root, bool init_store) {
   // Block the stop signals in every thread; one thread waits for them with sigwait.
   sigset_t stop_signals;
   sigemptyset(&stop_signals);
@@ -34,12 +37,18 @@ int RunStation(const std::string& config_path, std::string web_root) {
 
   std::unique_ptr<Station> made;
   try {
-    made = std::make_unique<Station>(LoadStationConfig(config_path));
+    StationConfig config = LoadStationConfig(config_path);
+    config.init_store = config.init_store || init_store;
+    made = std::make_unique<Station>(std::move(config));
   } catch (const io::ConfigError& e) {
     // Restarting cannot fix a file: the unit's RestartPreventExitStatus names this code.
     std::cerr << "eol station: configuration error: " << e.what() << " (exit " << kExitConfigError
               << ": fix the file, then start the station again)" << std::endl;
     return kExitConfigError;
+  } catch (const db::StoreRefused& e) {
+    std::cerr << "eol station: store refused: " << e.what() << " (exit " << kExitStoreRefused
+              << ": the station does not start on this file)" << std::endl;
+    return kExitStoreRefused;
   }
   Station& station = *made;
   if (web_root.empty()) web_root = DefaultWebRoot();
@@ -98,14 +107,19 @@ int RunStation(const std::string& config_path, std::string web_root) {
 void AddStationCommand(CLI::App& app) {
   auto config = std::make_shared<std::string>();
   auto web_root = std::make_shared<std::string>();
+  auto init_store = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand(
       "station",
       "Run the station as a daemon with the JSON config FILE (see deploy/station.json): serve\n"
       "the HTTP API and operator page, test each serial that arrives, stop cleanly on SIGTERM.");
   cmd->add_option("--config", *config, "Station config JSON")->required()->check(CLI::ExistingFile);
   cmd->add_option("--web-root", *web_root, "Folder of the operator page (default: built in)");
-  cmd->callback([config, web_root] {
-    RunGuarded("station", [&] { return RunStation(*config, *web_root); });
+  cmd->add_flag("--init-store", *init_store,
+                "Make an existing empty file (0 bytes, or an SQLite file without tables) at the "
+                "config's \"db\" a new store; without it such a file is refused (a missing "
+                "file is always created)");
+  cmd->callback([config, web_root, init_store] {
+    RunGuarded("station", [&] { return RunStation(*config, *web_root, *init_store); });
   });
 }
 

@@ -58,23 +58,32 @@ TEST(StoreOutbox, EveryStoredRecordQueuesOnceInOrderAndCursorsAreIndependent) {
   EXPECT_EQ(store->OutboxCursor("central"), 0);
 }
 
-TEST(StoreOutbox, AFailedFinishQueuesNothingAndRecoveredTestsAreQueued) {
+// A refused finish writes none of the record, but the test does not stay RUNNING: it is
+// finished as ERROR and queued as such (issue 34); a test cut short by a crash is recovered
+// as ABORTED at the next open and queued then.
+TEST(StoreOutbox, AFailedFinishQueuesItsErrorAndRecoveredTestsAreQueued) {
   eol::testing::TempDir dir;
   const std::string path = dir / "o.sqlite";
+  std::int64_t refused_id = 0;
   {
     auto store = Store::Open(path);
     TestRecord r = Record("R", "2025-01-01T00:00:00.000Z");
     store->BeginTest(r);
+    refused_id = r.id;
     TestRecord bad = r;
     bad.finished_at.clear();  // refused: the transaction is rolled back whole
     EXPECT_THROW(store->FinishTest(bad), StoreError);
-    EXPECT_EQ(store->OutboxPending("mqtt"), 0);
-  }  // "crash": the test stays RUNNING
+    EXPECT_EQ(store->OutboxPending("mqtt"), 1);
+    EXPECT_EQ(store->Test(r.id)->outcome, analysis::Outcome::kError);
+    TestRecord cut = Record("C", "2025-01-01T00:01:00.000Z");
+    store->BeginTest(cut);
+  }  // "crash": C stays RUNNING
   auto store = Store::Open(path);
   EXPECT_EQ(store->aborted_on_open(), 1);
   const auto rows = store->OutboxAfterCursor("mqtt", 10);
-  ASSERT_EQ(rows.size(), 1u);
-  EXPECT_EQ(store->Test(rows[0].test_id)->outcome, analysis::Outcome::kAborted);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].test_id, refused_id);
+  EXPECT_EQ(store->Test(rows[1].test_id)->outcome, analysis::Outcome::kAborted);
 }
 
 TEST(StoreOutbox, AVersionFourFileUpgradesWithAnEmptyOutbox) {
