@@ -75,7 +75,8 @@ TEST(Clipping, StatedFullScaleCountsEverySampleAtIt) {
   EXPECT_TRUE(c.at_full_scale);
   EXPECT_EQ(c.level, 1.5005);
   EXPECT_GT(c.samples, 0u);
-  EXPECT_EQ(ClippingMessage("voltage", "V", c, x.size()).rfind("voltage clipped at 1.501 V: ", 0),
+  EXPECT_EQ(ClippingMessage("voltage", "V", c, x.size())
+                .rfind("voltage clipped at 1.5 V: 21 of 1000 samples at or beyond", 0),
             0u)
       << ClippingMessage("voltage", "V", c, x.size());
   EXPECT_FALSE(FindClipping(x, 2.0).clipped);  // a smooth peak passes its extreme once
