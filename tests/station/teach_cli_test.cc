@@ -4,6 +4,7 @@
 // that name the file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -239,6 +240,18 @@ TEST_F(TeachCli, RefusesGoldenUnitsOfAnotherMotorUnlessForcedAndRelearnsTheWindi
   EXPECT_NE(r.out.find("--force-foreign"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "o.json"));
 
+  // Forced. Golden units that differ by noise alone leave f0 so steady that the bond index's
+  // exponent leaves its valid range; that index is not this test's subject, so the forced
+  // teaching uses the ten-pole recipe without it.
+  nlohmann::json no_index = nlohmann::json::parse(std::ifstream(kRecipe));
+  no_index.erase("bond_index");
+  nlohmann::json& limits = no_index["limits"];
+  limits.erase(
+      std::remove_if(limits.begin(), limits.end(),
+                     [](const nlohmann::json& l) { return l["name"] == "bond_index_pct"; }),
+      limits.end());
+  std::ofstream(dir_ / "no-index.json") << no_index.dump(2);
+  args[2] = dir_ / "no-index.json";
   args.push_back("--force-foreign");
   r = Eol(args);
   ASSERT_EQ(r.code, 0) << r.out;
