@@ -63,7 +63,14 @@ std::vector<std::string> EvaluateConditions(const ConditionWindows& w,
   if (w.r_ref_ohm > 0.0 && r_ohm && std::isfinite(*r_ohm)) {
     const double t_c = WindingTemperatureC(*r_ohm, w.r_ref_ohm, w.t_ref_c);
     conditions["winding_temperature_c"] = t_c;
-    check(Outside("winding temperature", t_c, w.winding_temperature_c, "degC", 1));
+    std::string line = Outside("winding temperature", t_c, w.winding_temperature_c, "degC", 1);
+    // No winding gets that hot or cold on a test station: the reference is another motor's.
+    if (!line.empty() && (t_c < kImplausibleWindingLoC || t_c > kImplausibleWindingHiC))
+      line += " (R " + Fixed(*r_ohm, 4) + " ohm against the recipe's r_ref_ohm " +
+              Fixed(w.r_ref_ohm, 4) + " ohm at " + Fixed(w.t_ref_c, 1) +
+              " degC: implausible for any winding, the reference is likely another motor's; "
+              "eol teach relearns it from golden units)";
+    check(line);
   }
   conditions["conditions_in_window"] = out.empty();
   return out;

@@ -36,6 +36,10 @@
 namespace eol::station {
 
 inline constexpr double kCopperAlphaPerK = 0.00393;  // at 20 degC
+// A winding temperature outside this range cannot be a winding's on a test station: the
+// condition's reason then also names R and the recipe's reference (likely another motor's).
+inline constexpr double kImplausibleWindingLoC = -20.0;
+inline constexpr double kImplausibleWindingHiC = 120.0;
 
 // The recipe's "conditions" section:
 //   "conditions": {"winding_temperature_c": {"r_ref_ohm": 0.5, "t_ref_c": 20, "lo": 0, "hi": 45},

@@ -30,7 +30,7 @@ PairJudgement JudgePair(const Recipe& recipe, const PairMeasurement& p, nlohmann
   PairJudgement j;
   if (!a.usable) {
     j.outcome = Outcome::kError;
-    j.reasons.push_back({ReasonCode::kAnalysis, a.message});
+    j.reasons.push_back({a.frf.clipped ? ReasonCode::kClipped : ReasonCode::kAnalysis, a.message});
     return j;
   }
   std::map<std::string, analysis::Estimate> values = a.values;

@@ -3,8 +3,10 @@
 // recording gets the same verdict and reasons wherever it is judged.
 //
 // Per phase pair, in the recipe's order:
-//   1. analysis not usable                 -> ERROR, reason "analysis" (the analysis's message);
-//                                             nothing else is judged for that pair.
+//   1. analysis not usable                 -> ERROR, reason "analysis" (the analysis's message),
+//                                             or "clipped" when a channel reached the DAQ's
+//                                             range (analysis/signal/clipping.h); nothing else
+//                                             is judged for that pair.
 //   2. scalar limits (recipe "limits")     -> FAIL "limit" outside; ERROR "analysis" when a
 //                                             declared value is missing or not finite.
 //                                             bond_index_pct is computed here from f0 and the

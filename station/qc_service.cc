@@ -1,17 +1,24 @@
 #include "station/qc_service.h"
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <string_view>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/text.h"
 #include "db/clock.h"
 #include "station/serial_number.h"
 
 namespace eol::station {
 
+using analysis::Fixed;
 using nlohmann::json;
 
 json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
-                      const analysis::TeachOptions& o) {
+                      const analysis::TeachOptions& o,
+                      const std::vector<std::string>& forced_foreign) {
   Recipe taught = r;
   taught.version = r.version + 1;
   for (analysis::MeasurementSpec& l : taught.limits) {
@@ -32,6 +39,8 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
   });
   for (const analysis::MeasurementSpec& spec : s.limits)
     if (spec.name == analysis::names::kResonanceFRefPressureHz) taught.limits.push_back(spec);
+  const WindingReference winding = RelearnWindingReference(r, s);
+  if (winding.relearned) taught.conditions.r_ref_ohm = winding.r_ref_ohm;
   std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
                      std::to_string(s.units_used) + " golden units (" +
                      analysis::ToString(o.method) + ", allocation " + o.allocation +
@@ -42,10 +51,113 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
   if (s.few_units_forced)
     note += " FORCED: " + std::to_string(s.units_used) + " golden units where " +
             std::to_string(s.units_needed) + " are needed.";
+  note += " " + winding.note;
+  std::string approval_note;
+  if (!forced_foreign.empty()) {
+    note += " FORCED (--force-foreign): golden units of another motor than the recipe expects:";
+    for (const std::string& f : forced_foreign) note += " " + f + ";";
+    approval_note = "taught from golden units of another motor, forced (--force-foreign)";
+  }
   taught.description += note;
   // A proposal until an engineer approves it (recipe.h, RecipeApproval).
-  taught.approval = RecipeApproval{"proposed", "eol teach", db::UtcNowIso8601(), ""};
+  taught.approval = RecipeApproval{"proposed", "eol teach", db::UtcNowIso8601(), approval_note};
   return RecipeToJson(taught);
+}
+
+WindingReference RelearnWindingReference(const Recipe& r, const analysis::TeachSummary& s) {
+  WindingReference w;
+  w.old_r_ref_ohm = w.r_ref_ohm = r.conditions.r_ref_ohm;
+  w.t_ref_c = r.conditions.t_ref_c;
+  w.golden_c_with_old = std::nan("");
+  if (!(r.conditions.r_ref_ohm > 0.0)) {
+    w.note = "The recipe has no winding-temperature reference: none relearned.";
+    return w;
+  }
+  const auto it = std::find_if(s.statistics.begin(), s.statistics.end(), [](const auto& t) {
+    return t.name == analysis::names::kWindingROhm;
+  });
+  if (it == s.statistics.end() || !(it->centre > 0.0) || !std::isfinite(it->centre)) {
+    w.note = "Winding reference r_ref_ohm " + Fixed(w.old_r_ref_ohm, 4) +
+             " ohm kept: no winding_r_ohm limit was taught to relearn it from.";
+    return w;
+  }
+  w.relearned = true;
+  w.r_ref_ohm = it->centre;
+  w.golden_c_with_old = WindingTemperatureC(it->centre, w.old_r_ref_ohm, w.t_ref_c);
+  w.note = "Winding reference r_ref_ohm relearned: " + Fixed(w.old_r_ref_ohm, 4) + " -> " +
+           Fixed(w.r_ref_ohm, 4) + " ohm at t_ref_c " + Fixed(w.t_ref_c, 1) +
+           " degC (the golden units' winding_r_ohm centre; golden units are taken to be at "
+           "t_ref_c).";
+  if (w.golden_c_with_old < kImplausibleWindingLoC || w.golden_c_with_old > kImplausibleWindingHiC)
+    w.warning = "the recipe's /conditions/winding_temperature_c/r_ref_ohm " +
+                Fixed(w.old_r_ref_ohm, 4) + " ohm read its golden units as " +
+                Fixed(w.golden_c_with_old, 1) + " degC (outside " +
+                Fixed(kImplausibleWindingLoC, 0) + ".." + Fixed(kImplausibleWindingHiC, 0) +
+                " degC): it was another motor's reference; the taught recipe has " +
+                Fixed(w.r_ref_ohm, 4) + " ohm";
+  return w;
+}
+
+namespace {
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// What the recipe expects of `name`: its two-sided limit's centre, else the nominal's value.
+std::optional<double> Expected(const Recipe& r, std::string_view name) {
+  for (const analysis::MeasurementSpec& l : r.limits)
+    if (l.name == name && l.limit.lo && l.limit.hi) return 0.5 * (*l.limit.lo + *l.limit.hi);
+  if (!r.excitation_design) return std::nullopt;
+  const analysis::MotionalImpedance& n = r.excitation_design->nominal;
+  namespace names = analysis::names;
+  if (name == names::kResonanceFHz) return n.f0_hz;
+  if (name == names::kWindingROhm) return n.r_ohm;
+  if (name == names::kWindingLH) return n.l_h;
+  if (name == names::kMotionalResidueOhmPerS) return n.ResidueOhmPerS();
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::vector<std::string> ForeignGoldenUnits(const Recipe& r,
+                                            const std::vector<analysis::GoldenUnit>& golden) {
+  namespace names = analysis::names;
+  std::vector<std::string> out;
+  for (std::string_view name : {names::kResonanceFHz, names::kWindingROhm, names::kWindingLH,
+                                names::kMotionalResidueOhmPerS}) {
+    std::vector<double> v;
+    for (const analysis::GoldenUnit& u : golden)
+      if (const auto it = u.values.find(std::string(name));
+          it != u.values.end() && std::isfinite(it->second) && it->second > 0.0)
+        v.push_back(it->second);
+    const std::optional<double> expected = Expected(r, name);
+    if (v.empty() || !expected || !(*expected > 0.0)) continue;
+    const double median = Median(v);
+    const std::string unit(names::UnitOf(name));
+    std::ostringstream m = analysis::MessageStream();
+    m.precision(4);
+    m << name << ": the golden units' median " << median << " " << unit;
+    if (name == names::kResonanceFHz) {
+      const double off = median / *expected - 1.0;
+      const auto& fit = r.analysis.fit;
+      const bool outside = median <= fit.f0_min_hz || median >= fit.f0_max_hz;
+      if (std::abs(off) <= kForeignF0Share && !outside) continue;
+      m << " is " << Fixed(100.0 * off, 0) << " % from the recipe's " << *expected << " " << unit
+        << " (more than " << Fixed(100.0 * kForeignF0Share, 0) << " %"
+        << (outside ? ", at or beyond its analysis f0 window" : "") << ")";
+    } else {
+      const double factor = std::max(median / *expected, *expected / median);
+      if (factor <= kForeignFactor) continue;
+      m << " is " << Fixed(factor, 2) << " x " << (median > *expected ? "above" : "below")
+        << " the recipe's " << *expected << " " << unit << " (more than a factor "
+        << Fixed(kForeignFactor, 1) << ")";
+    }
+    out.push_back(m.str());
+  }
+  return out;
 }
 
 json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOptions& o) {
@@ -150,7 +262,9 @@ TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe&
       if (full) golden.push_back(GoldenFromRecord(*full, serial));
     }
   }
-  const analysis::TeachSummary summary = analysis::TeachLimits(recipe.limits, golden, options);
+  analysis::TeachOptions for_motor = options;  // the bond index for the recipe's motor
+  if (recipe.bond_index) for_motor.bond_residue_to_f0 = recipe.bond_index->residue_to_f0;
+  const analysis::TeachSummary summary = analysis::TeachLimits(recipe.limits, golden, for_motor);
   result.report = TeachSummaryJson(summary, options);
   result.report["skipped"] = skipped;
   result.report["previous"] = {

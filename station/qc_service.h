@@ -16,9 +16,45 @@
 
 namespace eol::station {
 
-// The recipe's JSON with the taught limits and masks, version + 1, a note in the description.
+// The winding-temperature reference (recipe "conditions.winding_temperature_c", station/
+// conditions.h) relearned from the golden units, so a recipe taught for a new motor does not
+// keep another motor's R (every unit ERROR "winding temperature 384.6 degC"). The rule: the
+// golden units are taken to be at the reference temperature t_ref_c (teach at it, or set
+// t_ref_c to their temperature first), so r_ref_ohm becomes their taught centre of
+// winding_r_ohm (mean, or median for --method mad; outliers left out); a warning when the old
+// reference read them outside kImplausibleWindingLoC..HiC (conditions.h). Only when the recipe has
+// a winding reference and a winding_r_ohm limit was taught; kept otherwise (the note says why).
+struct WindingReference {
+  bool relearned = false;
+  double old_r_ref_ohm = 0.0;
+  double r_ref_ohm = 0.0;
+  double t_ref_c = 20.0;
+  // The golden units' temperature read with the old reference (NaN when not relearned).
+  double golden_c_with_old = 0.0;
+  std::string note;     // one sentence: what was done, for the description and the report
+  std::string warning;  // set when the old reference read the golden units as implausible
+};
+WindingReference RelearnWindingReference(const Recipe& recipe,
+                                         const analysis::TeachSummary& summary);
+
+// Golden units of another motor (issue 37): the medians of the golden units' resonance_f_hz,
+// winding_r_ohm, winding_l_h and motional_residue_ohm_per_s against what the recipe expects:
+// the centre of its two-sided limit on each (else its excitation_design nominal motor), and
+// for f0 also its analysis f0 window. One sentence per quantity that disagrees: f0 more than
+// kForeignF0Share from the recipe's centre or outside the window; the others more than a factor
+// kForeignFactor. Empty when they belong to the recipe's motor (or it expects nothing).
+inline constexpr double kForeignF0Share = 0.15;
+inline constexpr double kForeignFactor = 1.5;
+std::vector<std::string> ForeignGoldenUnits(const Recipe& recipe,
+                                            const std::vector<analysis::GoldenUnit>& golden);
+
+// The recipe's JSON with the taught limits and masks, the winding reference relearned
+// (RelearnWindingReference), version + 1, a note in the description. `forced_foreign` holds
+// ForeignGoldenUnits' sentences when teaching from them was forced: the description and the
+// approval note record it (the audit of the proposal).
 nlohmann::json TaughtRecipeJson(const Recipe& recipe, const analysis::TeachSummary& summary,
-                                const analysis::TeachOptions& options);
+                                const analysis::TeachOptions& options,
+                                const std::vector<std::string>& forced_foreign = {});
 
 // The summary as JSON: usable, bounds, k, units given/used/needed, rejected, limits, masks.
 nlohmann::json TeachSummaryJson(const analysis::TeachSummary& summary,

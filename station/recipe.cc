@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string_view>
 #include <tuple>
 
@@ -118,16 +119,28 @@ void ParseFixture(const JsonObject& f, Recipe& r) {
   f.RejectUnknown();
 }
 
+// How to move the band with the window (the excitation is then designed again for it).
+constexpr const char* kMoveBandToo =
+    " too (the band and the window move together; with an \"excitation_design\" block, run eol "
+    "design-excitation on the edited recipe to design the excitation for the new band)";
+
 void ParseAnalysis(const JsonObject& a, Recipe& r) {
   analysis::ResonanceFitOptions& fit = r.analysis.fit;
   fit.f0_min_hz = a.Number("f0_min_hz", r.excitation.f_lo_hz);
   fit.f0_max_hz = a.Number("f0_max_hz", r.excitation.f_hi_hz);
   fit.q_min = a.Number("q_min", fit.q_min);
   fit.q_max = a.Number("q_max", fit.q_max);
+  const std::string band = "[" + Fixed(r.excitation.f_lo_hz, 1) + ", " +
+                           Fixed(r.excitation.f_hi_hz, 1) + "] Hz (/excitation/f_lo_hz, f_hi_hz)";
   a.Require(fit.f0_min_hz >= r.excitation.f_lo_hz, "f0_min_hz",
-            "must lie inside the excited band [f_lo_hz, f_hi_hz]");
-  a.Require(fit.f0_max_hz <= r.excitation.f_hi_hz && fit.f0_max_hz > fit.f0_min_hz, "f0_max_hz",
-            "must lie inside the excited band and above f0_min_hz");
+            "must lie inside the excited band " + band + ": the fit only sees excited lines; " +
+                "move /excitation/f_lo_hz down to " + Fixed(fit.f0_min_hz, 1) + " Hz or below" +
+                kMoveBandToo);
+  a.Require(fit.f0_max_hz <= r.excitation.f_hi_hz, "f0_max_hz",
+            "must lie inside the excited band " + band + ": the fit only sees excited lines; " +
+                "move /excitation/f_hi_hz up to " + Fixed(fit.f0_max_hz, 1) + " Hz or above" +
+                kMoveBandToo);
+  a.Require(fit.f0_max_hz > fit.f0_min_hz, "f0_max_hz", "must be above f0_min_hz");
   a.Require(fit.q_min > 0 && fit.q_max > fit.q_min, "q_max", "must be above q_min > 0");
   std::string why;
   a.Require(fit.IsValid(&why), "f0_min_hz", why);
@@ -136,6 +149,26 @@ void ParseAnalysis(const JsonObject& a, Recipe& r) {
   a.Require(analysis::ParseFrfMethod(method, &r.analysis.frf_method), "frf_method",
             "must be \"discard_transient\" or \"transient_lpm\"");
   a.RejectUnknown();
+}
+
+// A resonance limit outside the analysis' f0 window (itself inside the excited band) can never
+// be met or never fail: the fit reports no f0 outside the window.
+void RequireInsideF0Window(const JsonObject& l, const analysis::MeasurementSpec& s,
+                           const Recipe& r) {
+  if (s.name != analysis::names::kResonanceFHz &&
+      s.name != analysis::names::kResonanceFRefPressureHz)
+    return;
+  const analysis::ResonanceFitOptions& fit = r.analysis.fit;
+  for (auto [key, bound] : {std::pair{"lo", s.limit.lo}, std::pair{"hi", s.limit.hi}}) {
+    if (!bound) continue;
+    l.Require(*bound >= fit.f0_min_hz && *bound <= fit.f0_max_hz, key,
+              "is " + Fixed(*bound, 3) + " Hz, outside the analysis f0 window [" +
+                  Fixed(fit.f0_min_hz, 1) + ", " + Fixed(fit.f0_max_hz, 1) +
+                  "] Hz (/analysis/f0_min_hz, f0_max_hz) inside the excited band [" +
+                  Fixed(r.excitation.f_lo_hz, 1) + ", " + Fixed(r.excitation.f_hi_hz, 1) +
+                  "] Hz: the fit reports no resonance there; put the limit inside the window, "
+                  "or move the window and the band around the motor's resonance");
+  }
 }
 
 void ParseLimits(const nlohmann::json& limits, const std::string& path, Recipe& r) {
@@ -151,7 +184,14 @@ void ParseLimits(const nlohmann::json& limits, const std::string& path, Recipe& 
     l.Require(std::find(all.begin(), all.end(), s.name) != all.end(), "name",
               "is not a measurement the analysis produces (known: " + known + ")");
     for (const auto& other : r.limits) l.Require(other.name != s.name, "name", "is declared twice");
+    // The measurement owns its unit: a limit may leave it out (or empty), or state the same.
+    const std::string unit(analysis::names::UnitOf(s.name));
     s.unit = l.String("unit", "");
+    l.Require(s.unit.empty() || s.unit == unit, "unit",
+              "is \"" + s.unit + "\", but " + s.name + " is measured in \"" + unit +
+                  "\": give lo and hi in " + unit + " with \"unit\": \"" + unit +
+                  "\" (or leave unit out; the measurement owns its unit)");
+    s.unit = unit;
     s.doc = l.String("doc", "");
     s.limit.lo = l.OptionalNumber("lo");
     s.limit.hi = l.OptionalNumber("hi");
@@ -160,6 +200,7 @@ void ParseLimits(const nlohmann::json& limits, const std::string& path, Recipe& 
     l.Require(!(s.limit.lo && s.limit.hi) || *s.limit.hi > *s.limit.lo, "hi",
               "must be greater than lo");
     l.Require(s.limit.marginal >= 0, "marginal", "must not be negative");
+    RequireInsideF0Window(l, s, r);
     l.RejectUnknown();
     r.limits.push_back(s);
   }
@@ -251,6 +292,10 @@ void ParseBondIndex(const JsonObject& o, Recipe& r) {
   d.f0_ref_hz = o.RequiredNumber("f0_ref_hz");
   d.residue_ref_ohm_per_s = o.RequiredNumber("residue_ref_ohm_per_s");
   d.f0_name = o.String("f0", d.f0_name);
+  d.residue_to_f0 = o.Number("residue_to_f0", d.residue_to_f0);
+  o.Require(d.residue_to_f0 > 0.0 && d.residue_to_f0 <= analysis::kMaxResidueToF0, "residue_to_f0",
+            "must be in (0, 1000]: d ln(residue) / -d ln(f0) of this motor's softer bonds (12 for "
+            "the ten-pole motor; analysis/qc/bond_index.h)");
   o.Require(d.f0_name == analysis::names::kResonanceFHz ||
                 d.f0_name == analysis::names::kResonanceFRefPressureHz,
             "f0", "must be resonance_f_hz or resonance_f_ref_pressure_hz");
@@ -273,6 +318,64 @@ void ParseF0Pressure(const JsonObject& o, Recipe& r) {
   o.Require(d.IsValid(&why), "pressure_ref_bar", why);
   o.RejectUnknown();
   r.f0_pressure = d;
+}
+
+// What sigma_f0_hz is and how to choose it for a motor (the refusal's second half).
+std::string HowToChooseSigmaF0(const Recipe& r) {
+  std::string text =
+      "sigma_f0_hz is the std(f0) one test must reach at the nominal motor, chosen per motor "
+      "(the ten-pole recipes' 0.0085 Hz is their 5 s recipe's bound, not a rule): for a new "
+      "motor state it as a fraction of what the test must resolve, e.g. 1/10 of the good "
+      "units' std(f0) (the test's noise then widens their spread by 0.5 %) or 1/3 of the f0 "
+      "shift of the smallest defect worth catching";
+  for (const analysis::MeasurementSpec& s : r.limits)
+    if (s.name == analysis::names::kResonanceFHz && s.limit.lo && s.limit.hi)
+      text += " (the resonance limits [" + Fixed(*s.limit.lo, 1) + ", " + Fixed(*s.limit.hi, 1) +
+              "] Hz taken as +-3 std of good units give 1/10 of it = " +
+              Fixed((*s.limit.hi - *s.limit.lo) / 60.0, 4) + " Hz)";
+  return text;
+}
+
+// The nominal motor is the good motor the recipe expects: it must pass the recipe's own
+// limits (those the nominal determines: f0, Q, R, L, Rp, residue, bond index) and lie inside
+// its winding-temperature window; otherwise limits and nominal describe different motors.
+void RequireNominalPasses(const JsonObject& o, const Recipe& r,
+                          const analysis::MotionalImpedance& n) {
+  namespace names = analysis::names;
+  std::map<std::string, analysis::Estimate> values = {
+      {std::string(names::kResonanceFHz), {n.f0_hz, 0.0}},
+      {std::string(names::kResonanceFRefPressureHz), {n.f0_hz, 0.0}},
+      {std::string(names::kResonanceQ), {n.q, 0.0}},
+      {std::string(names::kWindingROhm), {n.r_ohm, 0.0}},
+      {std::string(names::kWindingLH), {n.l_h, 0.0}},
+      {std::string(names::kMotionalRpOhm), {n.rp_ohm, 0.0}},
+      {std::string(names::kMotionalResidueOhmPerS), {n.ResidueOhmPerS(), 0.0}}};
+  if (r.bond_index) analysis::AddBondIndex(values, *r.bond_index);
+  std::vector<analysis::MeasurementSpec> judged;
+  for (const analysis::MeasurementSpec& s : r.limits)
+    if (values.count(s.name)) judged.push_back(s);
+  const analysis::Verdict v = analysis::Judge(judged, values);
+  std::string why;
+  for (const analysis::Reason& reason : v.reasons) why += (why.empty() ? "" : "; ") + reason.text;
+  o.Require(v.outcome == analysis::Outcome::kPass, "nominal",
+            "the recipe's own nominal motor (the good motor it expects) fails its limits: " + why +
+                ". The limits and the nominal describe different motors: teach the limits from "
+                "this motor's golden units (eol teach) or correct the nominal");
+  const ConditionWindows& w = r.conditions;
+  if (w.r_ref_ohm <= 0.0) return;
+  const double t = WindingTemperatureC(n.r_ohm, w.r_ref_ohm, w.t_ref_c);
+  const bool inside = (!w.winding_temperature_c.lo || t >= *w.winding_temperature_c.lo) &&
+                      (!w.winding_temperature_c.hi || t <= *w.winding_temperature_c.hi);
+  o.Require(inside, "nominal",
+            "the nominal winding r_ohm " + Fixed(n.r_ohm, 4) +
+                " ohm reads as a winding "
+                "temperature of " +
+                Fixed(t, 1) +
+                " degC against /conditions/winding_temperature_c "
+                "(r_ref_ohm " +
+                Fixed(w.r_ref_ohm, 4) + " ohm at " + Fixed(w.t_ref_c, 1) +
+                " degC), outside its window: r_ref_ohm is another motor's; set it to this motor's "
+                "winding R at t_ref_c (eol teach relearns it from golden units)");
 }
 
 // After the excitation and the analysis: the recipe's own excitation must meet the requirement
@@ -316,13 +419,14 @@ void ParseExcitationDesign(const JsonObject& o, Recipe& r, bool check_excitation
             ? d.max_peak_v / (analysis::kCurrentHeadroom * d.current_full_scale_a)
             : 0.0;
   }
+  RequireNominalPasses(o, r, d.nominal);
   if (!check_excitation) return;
   const double predicted = analysis::PredictedSigmaF0Hz(r.excitation, r.AnalysedPeriods(), d);
   o.Require(predicted <= d.RequiredSigmaF0Hz() * (1.0 + 1e-6), "sigma_f0_hz",
             "the excitation reaches std(f0) " + Fixed(predicted, 5) +
                 " Hz at the nominal motor (Cramer-Rao bound), more than the " +
-                Fixed(d.RequiredSigmaF0Hz(), 5) +
-                " Hz required: eol design-excitation designs one that meets it");
+                Fixed(d.RequiredSigmaF0Hz(), 5) + " Hz required. " + HowToChooseSigmaF0(r) +
+                "; then eol design-excitation designs the shortest excitation that meets it");
 }
 
 void ParseSequential(const JsonObject& o, Recipe& r) {
@@ -556,6 +660,7 @@ nlohmann::json BondIndexJson(const analysis::BondIndexDefinition& d) {
                       {"f0_ref_hz", d.f0_ref_hz},
                       {"residue_ref_ohm_per_s", d.residue_ref_ohm_per_s}};
   if (d.f0_name != analysis::BondIndexDefinition{}.f0_name) j["f0"] = d.f0_name;
+  if (d.residue_to_f0 != analysis::kResidueToF0) j["residue_to_f0"] = d.residue_to_f0;
   return j;
 }
 

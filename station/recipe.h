@@ -18,6 +18,10 @@
 //   "retest":     {"max_tests_per_serial": 3},                                    optional
 //   "limits": [ {"name": "resonance_f_hz", "unit": "Hz", "lo": 370, "hi": 420,
 //                "marginal": 3, "doc": "..."}, ... ],
+//                "unit" is optional: the measurement owns it (analysis/qc/measurement_names.h
+//                UnitOf); a limit stating another ("kHz" on resonance_f_hz) is refused naming
+//                both. Limits on resonance_f_hz and resonance_f_ref_pressure_hz lie inside the
+//                analysis f0 window (itself inside the excited band).
 //   "masks": [ {"name": "re_z_low_band", "quantity": "re_ohm" | "abs_ohm",
 //               "max_lines_outside": 0, "guard_sigma": 3,
 //               "points": [{"f_hz": 300, "hi": 0.75}, {"f_hz": 365, "hi": 0.75}]} ]  optional
@@ -26,9 +30,12 @@
 //                  "out_of_window": "error" | "record"}       optional, station/conditions.h
 //   "instructions": {"fail": "...", "error": "...", "aborted": "..."}  optional, each optional
 //   "bond_index": {"f0_exponent": 5.3, "f0_ref_hz": 390, "residue_ref_ohm_per_s": 25.6,
-//                  "f0": "resonance_f_hz" (default) | "resonance_f_ref_pressure_hz"}
+//                  "f0": "resonance_f_hz" (default) | "resonance_f_ref_pressure_hz",
+//                  "residue_to_f0": 12}
 //                  optional; required by a limit on bond_index_pct (analysis/qc/bond_index.h;
-//                  eol teach writes it from the golden units)
+//                  eol teach writes it from the golden units). residue_to_f0 is the motor's
+//                  defect direction, d ln(residue) / -d ln(f0) of softer bonds, in (0, 1000]
+//                  (default 12, the ten-pole motor's): eol teach weighs the index for it
 //   "f0_pressure": {"exponent": 0.114, "pressure_ref_bar": 5.5}
 //                  optional; required by a limit on resonance_f_ref_pressure_hz
 //                  (analysis/qc/f0_pressure.h; eol teach writes it when the golden units' f0
@@ -42,10 +49,14 @@
 //                  "nominal": {"r_ohm": 0.5, "l_h": 0.002, "rp_ohm": 0.53, "f0_hz": 390, "q": 50}}
 //                  optional (analysis/signal/excitation_design.h): the std(f0) the excitation
 //                  must reach at the nominal motor (the Cramer-Rao bound with the DAQ's noise);
-//                  a recipe whose excitation does not is refused. The amplitude limits are
-//                  max_peak_v, max_v_rms and max_a_rms (heating; optional) and 0.8 of the
-//                  current channel's full scale (optional).
-//                  `eol design-excitation` writes the shortest excitation that meets it.
+//                  a recipe whose excitation does not is refused, saying how to choose it for
+//                  a motor (a stated fraction of the good units' std(f0), e.g. 1/10). The
+//                  nominal is the good motor the recipe expects: it must pass the recipe's own
+//                  limits (f0, Q, R, L, Rp, residue, bond index) and read inside the winding-
+//                  temperature window, or the recipe is refused naming what disagrees. The
+//                  amplitude limits are max_peak_v, max_v_rms and max_a_rms (heating; optional) and
+//                  0.8 of the current channel's full scale (optional). `eol design-excitation`
+//                  writes the shortest excitation that meets it.
 // }
 // Validated on load: every message names the JSON path and the rule broken, and a recipe
 // that fails validation is never used. The hash is the SHA-256 of the canonical JSON (keys

@@ -25,6 +25,8 @@ bool BondIndexDefinition::IsValid(std::string* why) const {
   if (!PositiveFinite(f0_ref_hz)) return fail("f0_ref_hz must be positive and finite");
   if (!PositiveFinite(residue_ref_ohm_per_s))
     return fail("residue_ref_ohm_per_s must be positive and finite");
+  if (!PositiveFinite(residue_to_f0) || residue_to_f0 > kMaxResidueToF0)
+    return fail("residue_to_f0 must be positive, finite and at most 1000");
   return true;
 }
 
@@ -47,7 +49,10 @@ void AddBondIndex(std::map<std::string, Estimate>& values, const BondIndexDefini
   if (const auto index = BondIndex(values, d)) values[std::string(names::kBondIndexPct)] = *index;
 }
 
-BondIndexDefinition TeachBondIndex(const std::vector<std::pair<double, double>>& f0_and_residue) {
+BondIndexDefinition TeachBondIndex(const std::vector<std::pair<double, double>>& f0_and_residue,
+                                   double residue_to_f0) {
+  if (!PositiveFinite(residue_to_f0) || residue_to_f0 > kMaxResidueToF0)
+    throw std::invalid_argument("bond index: residue_to_f0 must be positive and at most 1000");
   const double n = static_cast<double>(f0_and_residue.size());
   double mean_f = 0.0, mean_a = 0.0;
   for (const auto& [f0, a] : f0_and_residue) {
@@ -57,6 +62,7 @@ BondIndexDefinition TeachBondIndex(const std::vector<std::pair<double, double>>&
     mean_a += std::log(a) / n;
   }
   BondIndexDefinition d;
+  d.residue_to_f0 = residue_to_f0;
   d.f0_ref_hz = std::exp(mean_f);
   d.residue_ref_ohm_per_s = std::exp(mean_a);
   if (f0_and_residue.size() < 3) return d;
@@ -67,10 +73,10 @@ BondIndexDefinition TeachBondIndex(const std::vector<std::pair<double, double>>&
     saa += y * y;
     sfa += x * y;
   }
-  // w = S^-1 d with d = (-1, kResidueToF0); S^-1 = [saa -sfa; -sfa sff] / det (det > 0 for
+  // w = S^-1 d with d = (-1, residue_to_f0); S^-1 = [saa -sfa; -sfa sff] / det (det > 0 for
   // units that are not collinear; the common factor 1/det and 1/(n-1) cancel in m).
-  const double w_f = -saa - sfa * kResidueToF0;
-  const double w_a = sfa + sff * kResidueToF0;
+  const double w_f = -saa - sfa * residue_to_f0;
+  const double w_a = sfa + sff * residue_to_f0;
   const double det = sff * saa - sfa * sfa;
   if (!(det > 0.0) || !(w_a > 0.0)) return d;
   d.f0_exponent = std::max(0.0, -w_f / w_a);

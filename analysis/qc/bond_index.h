@@ -6,9 +6,10 @@
 //
 // Why: in good units the two vary for different reasons (f0 with the clamp and the bridges,
 // A with the torque constant squared) and are nearly uncorrelated, while a soft bond moves
-// both at once along the physics direction d = (d ln f0, d ln A) = (-1, kResidueToF0) per unit
-// of softness (all ten bonds: A rises about twelve times faster than f0 falls, on the
-// project's line model and on tests/peers/independent_population.py alike). The linear
+// both at once along the physics direction d = (d ln f0, d ln A) = (-1, residue_to_f0) per unit
+// of softness (the ten-pole motor, all ten bonds: A rises about twelve times faster than f0
+// falls, on the project's line model and on tests/peers/independent_population.py alike; the
+// recipe states the ratio of its own motor, kResidueToF0 below by default). The linear
 // statistic with the most separation for a shift along d among good units with covariance S
 // (of ln f0, ln A) is w = S^-1 d (Fisher's discriminant); scaled so that ln A has weight 1,
 // the exponent is m = -w_f0 / w_A. m = 0 is the residue alone; m grows when f0 varies little
@@ -33,8 +34,13 @@
 
 namespace eol::analysis {
 
-// d ln A / (-d ln f0) of a softer bond (all magnets): the physics direction of the defect.
+// d ln A / (-d ln f0) of a softer bond (all magnets): the physics direction of the defect, of
+// the ten-pole motor (its chain and the independent generator). A property of the motor's
+// chain, not a constant: another chain has another ratio (a heavier rotor with another
+// winding: 3.5-4 near its detection limit, issue 37). The recipe states it per motor
+// ("bond_index": {"residue_to_f0": ...}); this value is its default.
 inline constexpr double kResidueToF0 = 12.0;
+inline constexpr double kMaxResidueToF0 = 1000.0;
 
 struct BondIndexDefinition {
   double f0_exponent = 0.0;            // m, >= 0
@@ -46,6 +52,8 @@ struct BondIndexDefinition {
   // losses 0.88-0.96, seed 5, 40 golden units drawn 200 times: median z of the index 4.84 ->
   // 5.53, m 4.9 -> 7.7).
   std::string f0_name = std::string(names::kResonanceFHz);
+  // The defect direction m was taught for (d ln A / -d ln f0 of the motor's softer bonds).
+  double residue_to_f0 = kResidueToF0;
 
   bool IsValid(std::string* why) const;
   bool operator==(const BondIndexDefinition&) const = default;
@@ -64,6 +72,8 @@ void AddBondIndex(std::map<std::string, Estimate>& values, const BondIndexDefini
 // from their covariance of logs (m = 0 when the discriminant does not weigh A positively, e.g.
 // fewer than 3 units), references their geometric means. Throws std::invalid_argument when a value
 // is not positive and finite.
-BondIndexDefinition TeachBondIndex(const std::vector<std::pair<double, double>>& f0_and_residue);
+// `residue_to_f0` is the motor's defect direction (above), kept in the definition.
+BondIndexDefinition TeachBondIndex(const std::vector<std::pair<double, double>>& f0_and_residue,
+                                   double residue_to_f0 = kResidueToF0);
 
 }  // namespace eol::analysis

@@ -73,12 +73,14 @@ const char* ToString(ReasonCode c) {
       return "internal";
     case ReasonCode::kLegacy:
       return "legacy";
+    case ReasonCode::kClipped:
+      return "clipped";
   }
   return "internal";
 }
 
 std::optional<ReasonCode> ParseReasonCode(const std::string& s) {
-  for (int i = 0; i <= static_cast<int>(ReasonCode::kLegacy); ++i)
+  for (int i = 0; i <= static_cast<int>(ReasonCode::kClipped); ++i)
     if (s == ToString(static_cast<ReasonCode>(i))) return static_cast<ReasonCode>(i);
   return std::nullopt;
 }

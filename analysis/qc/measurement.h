@@ -47,6 +47,8 @@ enum class ReasonCode {
   kInternal,     // "internal": a programming error caught at the sequencer's edge
   kLegacy,       // "legacy": read from a record stored before reasons had codes; the text
                  //   is the stored string (no code is guessed from old text)
+  kClipped,      // "clipped": the recording's voltage or current reached the converter's range
+                 //   (analysis/signal/clipping.h); nothing was fitted (ERROR)
 };
 const char* ToString(ReasonCode c);
 std::optional<ReasonCode> ParseReasonCode(const std::string& s);

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <string_view>
+#include <utility>
 
 namespace eol::analysis::names {
 
@@ -40,5 +41,27 @@ inline constexpr std::array<std::string_view, 10> kAll = {kResonanceFHz,
                                                           kBondIndexPct,
                                                           kSecondModeChi2Drop,
                                                           kResonanceFRefPressureHz};
+
+// The unit each measurement is produced in ("1": dimensionless), as the analysis writes it;
+// "" for a name the analysis does not produce. A recipe's limit states values in this unit
+// and nothing else (station/recipe.h refuses another).
+constexpr std::string_view UnitOf(std::string_view name) {
+  constexpr std::array<std::pair<std::string_view, std::string_view>, 11> kUnits = {{
+      {kResonanceFHz, "Hz"},
+      {kResonanceQ, "1"},
+      {kWindingROhm, "ohm"},
+      {kWindingLH, "H"},
+      {kMotionalRpOhm, "ohm"},
+      {kFitChi2PerDof, "1"},
+      {kMotionalResidueOhmPerS, "ohm/s"},
+      {kBondIndexPct, "%"},
+      {kSecondModeChi2Drop, "1"},
+      {kResonanceFRefPressureHz, "Hz"},
+      {kClampPressureBar, "bar"},
+  }};
+  for (const auto& [n, unit] : kUnits)
+    if (n == name) return unit;
+  return "";
+}
 
 }  // namespace eol::analysis::names

@@ -215,6 +215,8 @@ bool TeachOptions::IsValid(std::string* why) const {
   if (!(marginal_scales >= 0.0)) return fail("marginal_scales must not be negative");
   if (!(known_bad_max_donation >= 0.0 && known_bad_max_donation <= 1.0))
     return fail("known_bad_max_donation must be in [0, 1]");
+  if (!(bond_residue_to_f0 > 0.0 && bond_residue_to_f0 <= kMaxResidueToF0))
+    return fail("bond_residue_to_f0 must be in (0, 1000]");
   return true;
 }
 
@@ -719,7 +721,7 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared_in,
       }
       f0_and_residue.emplace_back(f0->second, a->second);
     }
-    index = TeachBondIndex(f0_and_residue);
+    index = TeachBondIndex(f0_and_residue, o.bond_residue_to_f0);
     index->f0_name = f0_name;
   }
   const auto prepared = [&](std::vector<GoldenUnit> units) {

@@ -148,6 +148,9 @@ struct TeachOptions {
   // to the f0 lower bound. Below 1 because a bound none of the known-bad units trips may still
   // catch a defect they do not represent (chi2 and one soft magnet).
   double known_bad_max_donation = 0.5;
+  // The motor's bond-defect direction the bond index is taught for (bond_index.h): the
+  // recipe's bond_index.residue_to_f0 (eol teach and POST /api/teach set it from the recipe).
+  double bond_residue_to_f0 = kResidueToF0;
 
   bool IsValid(std::string* why) const;
 };

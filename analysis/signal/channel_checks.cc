@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <sstream>
+#include <tuple>
+
+#include "analysis/signal/clipping.h"
 
 namespace eol::analysis {
 namespace {
@@ -13,42 +16,34 @@ long FirstNonFinite(std::span<const double> x) {
   return -1;
 }
 
-std::size_t CountClipped(std::span<const double> x, double full_scale) {
-  if (full_scale <= 0.0) return 0;
-  std::size_t n = 0;
-  for (double v : x)
-    if (std::abs(v) >= 0.999 * full_scale) ++n;
-  return n;
-}
-
 }  // namespace
 
-std::string CheckChannels(const ChannelPair& p) {
+ChannelProblem CheckChannels(const ChannelPair& p) {
   if (p.x.size() != p.y.size())
-    return p.y_name + " and " + p.x_name + " have different lengths (" +
-           std::to_string(p.y.size()) + " vs " + std::to_string(p.x.size()) + " samples)";
+    return {p.y_name + " and " + p.x_name + " have different lengths (" +
+            std::to_string(p.y.size()) + " vs " + std::to_string(p.x.size()) + " samples)"};
   for (auto [name, s] : {std::pair{&p.y_name, p.y}, {&p.x_name, p.x}}) {
     const long bad = FirstNonFinite(s);
-    if (bad >= 0) return *name + " sample " + std::to_string(bad) + " is not finite (NaN or inf)";
+    if (bad >= 0) return {*name + " sample " + std::to_string(bad) + " is not finite (NaN or inf)"};
   }
-  const std::size_t clipped_y = CountClipped(p.y, p.y_full_scale);
-  const std::size_t clipped_x = CountClipped(p.x, p.x_full_scale);
-  if (clipped_y + clipped_x > 0) {
-    std::ostringstream m;
-    m << "clipping: " << clipped_y << ' ' << p.y_name << " and " << clipped_x << ' ' << p.x_name
-      << " samples at full scale; lower the excitation level or raise the range";
-    return m.str();
+  std::string clipped;
+  for (auto [name, unit, s, fs] : {std::tuple{&p.y_name, &p.y_unit, p.y, p.y_full_scale},
+                                   std::tuple{&p.x_name, &p.x_unit, p.x, p.x_full_scale}}) {
+    const ChannelClipping c = FindClipping(s, fs);
+    if (c.clipped)
+      clipped += (clipped.empty() ? "" : "; ") + ClippingMessage(*name, *unit, c, s.size());
   }
-  return "";
+  if (!clipped.empty()) return {clipped + "; lower the excitation level or raise the range", true};
+  return {};
 }
 
-std::string CheckPeriodicPair(const ChannelPair& pair, const std::vector<std::size_t>& lines) {
+ChannelProblem CheckPeriodicPair(const ChannelPair& pair, const std::vector<std::size_t>& lines) {
   const std::size_t n = pair.period_samples;
-  if (n < 2 || lines.empty()) return "recording is not periodic or no lines are excited";
-  if (!(pair.sample_rate_hz > 0.0)) return "sample rate must be positive";
+  if (n < 2 || lines.empty()) return {"recording is not periodic or no lines are excited"};
+  if (!(pair.sample_rate_hz > 0.0)) return {"sample rate must be positive"};
   if (lines.front() == 0 || lines.back() >= n / 2)
-    return "excited line " + std::to_string(lines.front() == 0 ? 0 : lines.back()) +
-           " is DC or above Nyquist";
+    return {"excited line " + std::to_string(lines.front() == 0 ? 0 : lines.back()) +
+            " is DC or above Nyquist"};
   return CheckChannels(pair);
 }
 

@@ -80,8 +80,9 @@ FrfSummary EstimatePeriodicTransfer(const ChannelPair& pair, const std::vector<s
     out.message = "invalid options: " + why;
     return out;
   }
-  if (const std::string bad = CheckPeriodicPair(pair, lines); !bad.empty()) {
-    out.message = bad;
+  if (const ChannelProblem bad = CheckPeriodicPair(pair, lines); !bad.empty()) {
+    out.message = bad.message;
+    out.clipped = bad.clipped;
     return out;
   }
   const std::size_t n = pair.period_samples;

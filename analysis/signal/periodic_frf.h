@@ -50,7 +50,10 @@ struct PeriodicFrfOptions {
 struct FrfSummary {
   bool usable = false;
   std::string message;  // why it cannot be used, or a short description
-  Frf frf;              // the pair's quantity, method "periodic-eiv"
+  // Not usable because a channel reached its range (clipping.h); the judge's reason code is
+  // then "clipped" (analysis/qc/measurement.h), not "analysis".
+  bool clipped = false;
+  Frf frf;  // the pair's quantity, method "periodic-eiv"
   std::size_t periods_used = 0;
   std::size_t periods_dropped = 0;
   // Complex degrees of freedom of the noise (co)variances behind sigma (after pooling over

@@ -18,7 +18,8 @@ struct Recording {
   std::vector<double> voltage_v;
   std::vector<double> current_a;
   // Full-scale of each channel (the ADC range after gains); samples at or beyond 0.999 of it
-  // count as clipped. 0 means unknown (no clipping check).
+  // count as clipped. 0 means unknown: clipping is then found from samples repeated at a rail
+  // (analysis/signal/clipping.h).
   double voltage_full_scale_v = 0.0;
   double current_full_scale_a = 0.0;
 
@@ -31,7 +32,7 @@ struct Recording {
 // input x (the excitation side, e.g. current), output y (e.g. voltage, or a motor angle with
 // output_jw_power = 1 to get angular velocity per current). The spans view the caller's
 // samples, which must outlive the pair. Names appear in every message ("current sample 12 is
-// not finite"). Full scales as in Recording (0: no clipping check).
+// not finite"). Full scales as in Recording (0: unknown; clipping.h then looks for a rail).
 struct ChannelPair {
   double sample_rate_hz = 0.0;
   std::size_t period_samples = 0;  // 0 when not periodic
@@ -39,6 +40,8 @@ struct ChannelPair {
   std::span<const double> y;
   std::string x_name = "input";
   std::string y_name = "output";
+  std::string x_unit;  // in messages ("current clipped at 2 A"); may be empty
+  std::string y_unit;
   double x_full_scale = 0.0;
   double y_full_scale = 0.0;
   Quantity quantity = Quantity::kImpedanceOhm;  // what H is
@@ -56,6 +59,8 @@ inline ChannelPair ChannelPair::Impedance(const Recording& r) {
   p.y = r.voltage_v;
   p.x_name = "current";
   p.y_name = "voltage";
+  p.x_unit = "A";
+  p.y_unit = "V";
   p.x_full_scale = r.current_full_scale_a;
   p.y_full_scale = r.voltage_full_scale_v;
   p.quantity = Quantity::kImpedanceOhm;

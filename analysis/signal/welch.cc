@@ -71,8 +71,9 @@ WelchSummary EstimateWelchFrf(const ChannelPair& pair, const WelchOptions& o) {
     out.message = "sample rate must be positive";
     return out;
   }
-  if (const std::string bad = CheckChannels(pair); !bad.empty()) {
-    out.message = bad;
+  if (const ChannelProblem bad = CheckChannels(pair); !bad.empty()) {
+    out.message = bad.message;
+    out.clipped = bad.clipped;
     return out;
   }
   const std::size_t m = o.segment_samples;

@@ -53,6 +53,7 @@ struct WelchOptions {
 struct WelchSummary {
   bool usable = false;
   std::string message;              // why it cannot be used, or a short description
+  bool clipped = false;             // not usable because a channel clipped (clipping.h)
   Frf frf;                          // the pair's quantity, method "welch-h1" or "welch-h2"
   std::vector<double> coherence;    // g^2 on frf.freq_hz, in [0, 1]
   std::size_t segments = 0;         // K

@@ -60,6 +60,9 @@ analysis::Recording ReplayDaq::DoAcquire(const AcquisitionRequest& req,
                       " samples, the excitation has " + std::to_string(req.excitation_v.size()));
   rec.sample_rate_hz = req.sample_rate_hz;
   rec.period_samples = req.period_samples;
+  // A CSV that does not state its range gets the configured one (a WAV's is its gains).
+  if (rec.voltage_full_scale_v == 0.0) rec.voltage_full_scale_v = settings_.voltage_full_scale_v;
+  if (rec.current_full_scale_a == 0.0) rec.current_full_scale_a = settings_.current_full_scale_a;
   return rec;
 }
 

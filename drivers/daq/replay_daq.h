@@ -24,6 +24,10 @@ struct ReplayDaqSettings {
   bool repeat = false;             // the one file for every acquisition
   double voltage_v_per_fs = 1.0;   // WAV gains
   double current_a_per_fs = 1.0;
+  // The converter's range of CSV recordings that do not state it (recording_files.h);
+  // 0: unknown, clipping is then found from samples repeated at a rail (clipping.h).
+  double voltage_full_scale_v = 0.0;
+  double current_full_scale_a = 0.0;
   Calibration calibration;  // what the recordings were measured with
 };
 

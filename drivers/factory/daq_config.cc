@@ -80,6 +80,13 @@ ReplayDaqSettings ParseReplayDaqSettings(const io::JsonObject& o) {
     s.current_a_per_fs = PositiveGain(*g, "current_a_per_fs", s.current_a_per_fs);
     g->RejectUnknown();
   }
+  if (auto f = o.OptionalObject("full_scale")) {
+    s.voltage_full_scale_v = PositiveGain(*f, "voltage_v", 1.0);
+    s.current_full_scale_a = PositiveGain(*f, "current_a", 1.0);
+    f->Require(f->Has("voltage_v") && f->Has("current_a"), "voltage_v",
+               "give both voltage_v and current_a (the converter's range of each channel)");
+    f->RejectUnknown();
+  }
   s.calibration = DaqCalibration(o, s.calibration);
   o.RejectUnknown();
   return s;

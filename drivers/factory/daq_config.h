@@ -10,7 +10,9 @@
 //           "stall_after_frames": 0, "stall_s": 0}          (alsa_daq.h; the stall is a test hook)
 //   "daq": {"driver": "replay", "files": ["a.csv", "b.wav"] | "directory": "runs/" |
 //           "file": "a.csv", "repeat": true,
-//           "gains": {"voltage_v_per_fs": 1.0, "current_a_per_fs": 1.0}}   (replay_daq.h)
+//           "gains": {"voltage_v_per_fs": 1.0, "current_a_per_fs": 1.0},
+//           "full_scale": {"voltage_v": 10, "current_a": 2}}   (replay_daq.h; optional: the
+//           range of CSV recordings that do not state it, so samples at it count as clipped)
 //   sim, added to its keys (sim_daq.h): "load": "fixture_part" | "reference_resistor",
 //           "reference_ohm": 1.0, "injected_gain": 1.0, "injected_channel_delay_s": 0
 //   any driver: "calibration": {...} inline, or "calibration_file": "calibration.json"

@@ -8,6 +8,7 @@
 #include <locale>
 #include <memory>
 #include <sstream>
+#include <string_view>
 
 #include "drivers/io/text_table.h"
 
@@ -18,6 +19,19 @@ struct SndfileCloser {
   void operator()(SNDFILE* f) const { sf_close(f); }
 };
 using SndfilePtr = std::unique_ptr<SNDFILE, SndfileCloser>;
+
+// An optional full-scale column: one positive value repeated in every row; 0 when absent.
+double StatedFullScale(const CsvTable& t, std::string_view name) {
+  const std::size_t c = t.Find(name);
+  if (c == std::string::npos) return 0.0;
+  const std::vector<double>& v = t.columns[c];
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (!(v[k] > 0.0)) throw t.ErrorAt(k, c, std::string(name) + " must be positive");
+    if (v[k] != v.front())
+      throw t.ErrorAt(k, c, std::string(name) + " must be the same in every row (the range)");
+  }
+  return v.front();
+}
 
 }  // namespace
 
@@ -49,6 +63,8 @@ analysis::Recording ReadRecordingCsv(const std::string& path) {
   double fs = 1.0 / dt;
   if (std::abs(fs - std::round(fs)) <= 1e-6 * fs) fs = std::round(fs);
   rec.sample_rate_hz = fs;
+  rec.voltage_full_scale_v = StatedFullScale(t, "u_full_scale_v");
+  rec.current_full_scale_a = StatedFullScale(t, "i_full_scale_a");
   return rec;
 }
 

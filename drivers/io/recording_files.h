@@ -6,7 +6,11 @@
 // (times printed with a few decimals pass), else FileError names the first line off the grid.
 // sample_rate_hz = 1 / dt, snapped to the nearest integer when within 1e-6 of it; FileError
 // when dt or 1 / dt is not finite (times near the ends of double's range).
-// period_samples and full scales are left 0 (the caller knows the excitation).
+// Optional columns u_full_scale_v and i_full_scale_a state the converter's full scale of
+// each channel (one positive value, the same in every row; FileError otherwise): samples at
+// it count as clipped. Without them the full scales are 0 (unknown) and clipping is found
+// from samples repeated at a rail (analysis/signal/clipping.h). period_samples is left 0
+// (the caller knows the excitation).
 //
 // Two-channel WAV (libsndfile; any PCM or float encoding): channel 1 is the voltage, channel 2
 // the current, as fractions of the converter's full scale (integer formats are normalised to

@@ -9,6 +9,10 @@
 // A mobility FRF (f_hz,re,im[,sigma]) is fitted with the two-mass model instead (no verdict).
 // --plot FILE draws |Z| and Re Z with the fitted model and the recipe's resonance window and
 // masks (station/curve_chart.h).
+// A raw recording whose voltage or current reached the converter's range (its full scale from
+// --voltage-full-scale / --current-full-scale, the CSV's u_full_scale_v / i_full_scale_a
+// columns or a WAV's gains; or samples repeated at a rail) is refused before any fit:
+// "current clipped at 2 A: ..." (analysis/signal/clipping.h), reason code "clipped".
 // Exit codes: 0 a usable analysis (whatever the verdict), 1 the data cannot be analysed
 // (reason on stderr and in JSON "error"), 2 usage or file errors.
 #include <cmath>
@@ -49,6 +53,8 @@ struct AnalyzeArgs {
   std::string excitation_band;
   double voltage_gain = 0.0;
   double current_gain = 0.0;
+  double voltage_full_scale = 0.0;  // > 0: the converter's range of a raw recording
+  double current_full_scale = 0.0;
   std::size_t welch_segment = 0;    // > 0: a non-periodic recording, Welch H1
   std::string band;                 // Welch: f_lo,f_hi of the reported lines
   std::string plot;                 // SVG (or .png) of the curve against model and limits
@@ -256,6 +262,10 @@ int RunAnalyze(const AnalyzeArgs& a) {
     if (!a.recipe.empty()) recipe = std::make_unique<Recipe>(LoadRecipe(a.recipe));
     in = io::ReadMeasured(a.measured, {a.voltage_gain, a.current_gain});
     const bool recording = in.kind == io::MeasuredKind::kRecording;
+    if (!recording && (a.voltage_full_scale > 0.0 || a.current_full_scale > 0.0))
+      throw UsageError("--voltage-full-scale and --current-full-scale apply to raw recordings");
+    if (a.voltage_full_scale > 0.0) in.recording.voltage_full_scale_v = a.voltage_full_scale;
+    if (a.current_full_scale > 0.0) in.recording.current_full_scale_a = a.current_full_scale;
     if (recording && a.welch_segment > 0)
       welch = SetUpWelch(a, recipe.get());
     else if (recording)
@@ -292,6 +302,7 @@ int RunAnalyze(const AnalyzeArgs& a) {
       if (recipe) {
         analysis::ImpedanceAnalysis unusable;
         unusable.message = w.message;
+        unusable.frf.clipped = w.clipped;
         out["verdict"] = JudgeJson(*recipe, unusable, nullptr, out);
       }
       return Fail(a, out, 1, "invalid measurement: " + w.message);
@@ -428,6 +439,14 @@ void AddAnalyzeCommand(CLI::App& app) {
                   "The unit's clamp pressure (bar) as the station read it: the judge's\n"
                   "resonance_f_ref_pressure_hz needs it; kept in the output's conditions\n"
                   "(so eol teach finds it in --json outputs)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--voltage-full-scale", args->voltage_full_scale,
+                  "Raw recording: the voltage channel's range (V); samples at it are clipped\n"
+                  "(default: the CSV's u_full_scale_v column, a WAV's gain; without either,\n"
+                  "clipping is found from samples repeated at a rail)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--current-full-scale", args->current_full_scale,
+                  "Raw recording: the current channel's range (A), as --voltage-full-scale")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--voltage-gain", args->voltage_gain, "WAV: volts per unit of full scale");
   cmd->add_option("--current-gain", args->current_gain, "WAV: amperes per unit of full scale");

@@ -4,7 +4,12 @@
 // marginal band replaced by the learned ones, its masks replaced by the learned Re Z mask
 // (kept when no curve was given), version + 1 and a note in the description. It is validated
 // (ParseRecipe) before it is written, and an existing file is never overwritten without
-// --force. Exit: 0 written, 1 nothing could be learned (reason on stderr), 2 usage/file error.
+// --force. Golden units of another motor (station/qc_service.h ForeignGoldenUnits) are refused
+// naming each quantity that disagrees and by how much, unless --force-foreign (then recorded in
+// the taught recipe). The winding-temperature reference is relearned from the golden units
+// (RelearnWindingReference), with a warning when the old one read them as implausible.
+// Exit: 0 written, 1 nothing could be learned or the golden units are another motor's (reason
+// on stderr), 2 usage/file error.
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -29,6 +34,7 @@ struct TeachArgs {
   std::string out;
   analysis::TeachOptions options;
   bool force = false;
+  bool force_foreign = false;
   bool json = false;
 };
 
@@ -44,6 +50,8 @@ int RunTeach(const TeachArgs& a) {
   std::string why;
   if (!a.options.IsValid(&why)) throw std::runtime_error("options: " + why);
   const Recipe recipe = LoadRecipe(a.recipe);
+  analysis::TeachOptions options = a.options;  // the bond index for the recipe's motor
+  if (recipe.bond_index) options.bond_residue_to_f0 = recipe.bond_index->residue_to_f0;
   if (std::filesystem::exists(a.out) && !a.force)
     throw std::runtime_error(a.out +
                              " exists: refusing to overwrite it (choose another --out, or "
@@ -57,16 +65,34 @@ int RunTeach(const TeachArgs& a) {
           ? std::vector<analysis::GoldenUnit>{}
           : ReadGoldenUnits(a.bad, recipe, nullptr, /*known_bad=*/true, progress->Callback());
   progress.reset();  // ends the line before the results
-  const analysis::TeachSummary s = analysis::TeachLimits(recipe.limits, golden, a.options, bad);
+  const std::vector<std::string> foreign = ForeignGoldenUnits(recipe, golden);
+  if (!foreign.empty()) {
+    std::string why = "the golden units are not recipe " + recipe.id + "'s motor:";
+    for (const std::string& f : foreign) why += " " + f + ";";
+    why +=
+        " teach a recipe made for their motor, or --force-foreign to teach this one from them "
+        "(recorded in the taught recipe)";
+    if (!a.force_foreign) {
+      std::cerr << "eol teach: refused: " << why << std::endl;
+      if (a.json)
+        std::cout << json{{"usable", false}, {"error", why}, {"foreign", foreign}}.dump()
+                  << std::endl;
+      return 1;
+    }
+    std::cerr << "eol teach: warning: forced (--force-foreign): " << why << "\n";
+  }
+  const analysis::TeachSummary s = analysis::TeachLimits(recipe.limits, golden, options, bad);
   for (const std::string& k : skipped) std::cerr << "eol teach: skipped " << k << "\n";
   if (!s.usable) {
     std::cerr << "eol teach: nothing learned: " << s.message << std::endl;
     if (a.json) std::cout << json{{"usable", false}, {"error", s.message}}.dump() << std::endl;
     return 1;
   }
-  const json taught = TaughtRecipeJson(recipe, s, a.options);
+  const json taught = TaughtRecipeJson(recipe, s, a.options, foreign);
   const Recipe next = ParseRecipe(taught, a.out);  // validated before anything is written
   WriteNew(a.out, taught, a.force);
+  const WindingReference winding = RelearnWindingReference(recipe, s);
+  if (!winding.warning.empty()) std::cerr << "eol teach: warning: " << winding.warning << "\n";
 
   if (a.json) {
     json out = TeachSummaryJson(s, a.options);
@@ -74,6 +100,11 @@ int RunTeach(const TeachArgs& a) {
         {"path", a.out}, {"id", next.id}, {"version", next.version}, {"hash", next.hash}};
     out["previous"] = {{"path", a.recipe}, {"version", recipe.version}, {"hash", recipe.hash}};
     out["skipped"] = skipped;
+    out["foreign_forced"] = foreign;
+    out["winding_reference"] = {
+        {"relearned", winding.relearned}, {"old_r_ref_ohm", winding.old_r_ref_ohm},
+        {"r_ref_ohm", winding.r_ref_ohm}, {"t_ref_c", winding.t_ref_c},
+        {"note", winding.note},           {"warning", winding.warning}};
     if (s.known_bad_units > 0)
       out["known_bad"] = {
           {"units", s.known_bad_units},     {"escapes_budget", s.known_bad_escapes_budget},
@@ -86,6 +117,7 @@ int RunTeach(const TeachArgs& a) {
   std::cout << "teach: " << s.message << "\n";
   for (const std::string& r : s.rejected) std::cout << "  rejected golden unit " << r << "\n";
   std::cout << "clamp-pressure-normalised resonance: " << s.f0_pressure.note << "\n";
+  std::cout << winding.note << "\n";
   for (std::size_t i = 0; i < s.limits.size(); ++i) {
     // By name: teach declares or drops resonance_f_ref_pressure_hz itself.
     analysis::Limit old;
@@ -190,6 +222,10 @@ void AddTeachCommand(CLI::App& app) {
                   "Robust z beyond which a golden unit is left out")
       ->capture_default_str();
   cmd->add_flag("--force", args->force, "Overwrite --out if it exists");
+  cmd->add_flag("--force-foreign", args->force_foreign,
+                "Teach from golden units that do not look like the recipe's motor (f0 more\n"
+                "than 15 % from the recipe's, R, L or residue beyond a factor 1.5); the taught\n"
+                "recipe's description and approval note record it");
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args] { RunGuarded("teach", [&] { return RunTeach(*args); }); });
 }

@@ -148,6 +148,8 @@ std::uint16_t PlcReasonCode(analysis::ReasonCode code) {
       return 13;
     case ReasonCode::kLegacy:
       return 14;
+    case ReasonCode::kClipped:
+      return 15;
   }
   return 13;
 }

@@ -107,6 +107,7 @@ PlcResult ToPlcResult(analysis::Outcome outcome);
 //   12  self_check     the verdict of a master part's check of the station
 //   13  internal       a programming error caught at the sequencer's edge (ERROR)
 //   14  legacy         a record stored before reasons had codes
+//   15  clipped        the recording's voltage or current reached the DAQ's range (ERROR)
 std::uint16_t PlcReasonCode(analysis::ReasonCode code);
 
 // input register `refusal`: why a start was refused (nothing was started).

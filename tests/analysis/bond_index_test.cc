@@ -38,6 +38,25 @@ TEST(BondIndex, ExponentIsTheDiscriminantForUncorrelatedSpread) {
   EXPECT_NEAR(d.residue_ref_ohm_per_s, 25.0, 0.05);
 }
 
+// Issue 37: the direction is the motor's (the recipe's residue_to_f0), not a constant: a chain
+// whose residue rises 4 times faster than f0 falls gets m = s_a^2 / (4 s_f^2), three times the
+// ten-pole motor's, and the definition keeps the direction it was taught for.
+TEST(BondIndex, ExponentFollowsTheMotorsOwnDefectDirection) {
+  const double s_f = 0.01, s_a = 0.08;
+  const auto units = Units(20000, s_f, s_a, 0.0, 1);
+  const BondIndexDefinition d = TeachBondIndex(units, 4.0);
+  EXPECT_NEAR(d.f0_exponent, s_a * s_a / (4.0 * s_f * s_f), 0.5);
+  EXPECT_EQ(d.residue_to_f0, 4.0);
+  EXPECT_NEAR(d.f0_exponent / TeachBondIndex(units).f0_exponent, kResidueToF0 / 4.0, 0.1);
+  EXPECT_EQ(TeachBondIndex(units).residue_to_f0, kResidueToF0);
+  EXPECT_THROW(TeachBondIndex(units, 0.0), std::invalid_argument);
+  std::string why;
+  BondIndexDefinition bad = d;
+  bad.residue_to_f0 = -1.0;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("residue_to_f0"), std::string::npos) << why;
+}
+
 TEST(BondIndex, CorrelatedSpreadMovesTheExponent) {
   // rho > 0: f0 and A rise together among good units, so the defect direction (f0 down, A up)
   // is even less like good spread; the discriminant weighs f0 more than without correlation:

@@ -34,7 +34,8 @@ TEST(ReasonCode, NamesAreStableSnakeCaseAndParseBack) {
                                                       {ReasonCode::kRetestLimit, "retest_limit"},
                                                       {ReasonCode::kSelfCheck, "self_check"},
                                                       {ReasonCode::kInternal, "internal"},
-                                                      {ReasonCode::kLegacy, "legacy"}};
+                                                      {ReasonCode::kLegacy, "legacy"},
+                                                      {ReasonCode::kClipped, "clipped"}};
   for (const auto& [code, name] : names) {
     EXPECT_STREQ(ToString(code), name);
     EXPECT_EQ(ParseReasonCode(name), code) << name;

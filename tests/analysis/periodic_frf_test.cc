@@ -149,8 +149,9 @@ TEST(PeriodicFrfTest, ClippingIsNotUsable) {
   for (double& i : rec.current_a) i = std::clamp(i, -0.05, 0.05);
   const FrfSummary s = EstimatePeriodicFrf(rec, e.lines, PeriodicFrfOptions{});
   EXPECT_FALSE(s.usable);
-  EXPECT_CONTAINS(s.message, "clipping: 0 voltage and ");
-  EXPECT_CONTAINS(s.message, "current samples at full scale");
+  EXPECT_TRUE(s.clipped);
+  EXPECT_EQ(s.message.rfind("current clipped at 0.05 A: ", 0), 0u) << s.message;
+  EXPECT_CONTAINS(s.message, "of the converter's full scale; lower the excitation level");
 }
 
 TEST(PeriodicFrfTest, MissingCurrentRelayOpenIsNotUsable) {

@@ -78,7 +78,8 @@ TEST(TransientFrf, RefusesBadData) {
     bad.current_full_scale_a = 0.05;  // far below the current's peak
     const FrfSummary s = EstimateTransientFrf(bad, e.lines, {});
     EXPECT_FALSE(s.usable);
-    EXPECT_EQ(s.message.rfind("clipping: 0 voltage and ", 0), 0u) << s.message;
+    EXPECT_TRUE(s.clipped);
+    EXPECT_EQ(s.message.rfind("current clipped at 0.05 A: ", 0), 0u) << s.message;
   }
   {
     Recording open = rec;  // relay open: the current channel reads its noise only

@@ -4,6 +4,7 @@
 // (0 analysed, 1 cannot be analysed, 2 usage or file error).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -15,6 +16,7 @@
 #include "analysis/model/two_mass.h"
 #include "analysis/signal/chirp_noise.h"
 #include "analysis/sim/steady_state.h"
+#include "analysis/text.h"
 #include "drivers/io/frf_files.h"
 #include "drivers/io/recording_files.h"
 #include "tests/support/child_process.h"
@@ -136,6 +138,66 @@ TEST(AnalyzeCliTest, RawRecordingCsvAndWav) {
                 4.0 * j["resonance"]["f_sigma_hz"].get<double>());
     EXPECT_LT(j["fit"]["chi2_per_dof"].get<double>(), 1.5);
   }
+}
+
+// A raw recording whose current clipped the DAQ's range (16-bit converter, range 0.6 of the
+// current's peak) is ERROR "current clipped at X A" (code "clipped") before any fit, with
+// the range unknown to the file (samples repeated at the rail), stated in the CSV's
+// i_full_scale_a column, or given by --current-full-scale; the unclipped recording of the
+// same motor passes the same way.
+TEST(AnalyzeCliTest, ClippedRecordingIsErrorClippedBeforeAnyFit) {
+  testing::TempDir dir;
+  const analysis::Excitation e = analysis::DesignMultisine(analysis::MultisineOptions{});
+  const analysis::Recording clean =
+      analysis::SimulatePeriodicRecording(kGood, e, 5, 2e-3, 1e-3, 11);
+  double peak = 0.0;
+  for (double i : clean.current_a) peak = std::max(peak, std::abs(i));
+  const double i_fs = 0.6 * peak;
+  analysis::Recording rec = clean;
+  for (auto [x, fs] : {std::pair{&rec.voltage_v, 10.0}, std::pair{&rec.current_a, i_fs}}) {
+    const double lsb = fs / 32768.0;
+    for (double& v : *x) v = std::clamp(std::round(v / lsb), -32768.0, 32767.0) * lsb;
+  }
+  io::WriteRecordingCsv(dir / "clipped.csv", rec);
+  {
+    std::ofstream stated(dir / "stated.csv");
+    stated.precision(17);
+    stated << "t_s,u_v,i_a,u_full_scale_v,i_full_scale_a\n";
+    for (std::size_t k = 0; k < rec.voltage_v.size(); ++k)
+      stated << static_cast<double>(k) / rec.sample_rate_hz << ',' << rec.voltage_v[k] << ','
+             << rec.current_a[k] << ",10," << i_fs << '\n';
+  }
+  io::WriteRecordingCsv(dir / "clean.csv", clean);
+  const auto check = [&](const std::vector<std::string>& args, const std::string& rule) {
+    std::vector<std::string> all = args;
+    for (const char* a : {"--recipe", "--json"}) all.push_back(a);
+    all.insert(all.end() - 1, kRecipe);
+    const CliRun r = Eol(all);
+    EXPECT_EQ(r.code, 1) << r.out;
+    const nlohmann::json j = Json(r);
+    EXPECT_EQ(j["verdict"]["outcome"], "ERROR");
+    ASSERT_EQ(j["verdict"]["reasons"].size(), 1u) << j["verdict"].dump();
+    const nlohmann::json& reason = j["verdict"]["reasons"][0];
+    EXPECT_EQ(reason["code"], "clipped");
+    const std::string text = reason["text"];
+    EXPECT_EQ(text.rfind("invalid measurement: current clipped at ", 0), 0u) << text;
+    EXPECT_CONTAINS(text, rule);
+    EXPECT_EQ(text.find("voltage clipped"), std::string::npos) << text;
+    EXPECT_FALSE(j.contains("params")) << "fitted: " << j.dump();  // before any fit
+    EXPECT_EQ(j["verdict"]["measurements"].size(), 0u);
+  };
+  check({"--measured", dir / "clipped.csv"}, "a converter rail");
+  check({"--measured", dir / "stated.csv"}, "of the converter's full scale");
+  check({"--measured", dir / "clean.csv", "--current-full-scale", analysis::Fixed(i_fs, 6)},
+        "of the converter's full scale");
+  const CliRun text = Eol({"--measured", dir / "clipped.csv", "--recipe", kRecipe}, true);
+  EXPECT_EQ(text.code, 1);
+  EXPECT_CONTAINS(text.out, "eol analyze: invalid measurement: current clipped at ");
+  const CliRun ok = Eol({"--measured", dir / "clean.csv", "--recipe", kRecipe, "--json"});
+  ASSERT_EQ(ok.code, 0) << ok.out;
+  EXPECT_EQ(Json(ok)["verdict"]["outcome"], "PASS") << Json(ok)["verdict"].dump();
+  const CliRun frf = Eol({"--measured", dir / "clean.csv", "--voltage-full-scale", "-1"}, true);
+  EXPECT_EQ(frf.code, 2) << frf.out;
 }
 
 // Random excitation: band-limited noise through the motor (the record's circular steady state,

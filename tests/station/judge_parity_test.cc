@@ -6,6 +6,7 @@
 // mask, ERROR by a test condition.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -16,6 +17,7 @@
 #include "db/store.h"
 #include "drivers/factory/factory.h"
 #include "drivers/io/json_config.h"
+#include "drivers/io/recording_files.h"
 #include "station/recipe.h"
 #include "station/sequencer.h"
 
@@ -53,12 +55,15 @@ class JudgeParityTest : public ::testing::Test {
   // returns the station's record.
   // With `with_pressure` the offline judge gets the clamp pressure the station read
   // (--clamp-pressure-bar, written to round-trip to the same double).
+  // `recording_file` (in the suite's folder) is replayed; `exit_code` is eol analyze's (1: the
+  // recording cannot be analysed).
   db::TestRecord JudgeBothWays(const std::string& name, const nlohmann::json& recipe_json,
-                               bool with_pressure = false) {
+                               bool with_pressure = false,
+                               const std::string& recording_file = "unit.csv", int exit_code = 0) {
     const std::string recipe_path = *dir_ / (name + ".json");
     std::ofstream(recipe_path) << recipe_json.dump(2);
     const Recipe recipe = LoadRecipe(recipe_path);
-    const std::string recording = *dir_ / "unit.csv";
+    const std::string recording = *dir_ / recording_file;
 
     drivers::DriverSet set = drivers::MakeDrivers(
         {{"fixture", {{"driver", "sim"}}},
@@ -81,7 +86,7 @@ class JudgeParityTest : public ::testing::Test {
       args.push_back(station.conditions.at("clamp_pressure_bar").dump());
     }
     const auto cli = RunEol(args, false, 120s);
-    EXPECT_EQ(cli.code, 0) << cli.out;  // analysed, whatever the verdict
+    EXPECT_EQ(cli.code, exit_code) << cli.out;  // 0: analysed, whatever the verdict
     nlohmann::json offline;
     try {
       offline = nlohmann::json::parse(cli.out);
@@ -160,6 +165,24 @@ TEST_F(JudgeParityTest, ErrorByCondition) {
   EXPECT_EQ(r.reasons.front().code, ReasonCode::kCondition);
   EXPECT_EQ(r.reasons.front().text.rfind("condition out of window: excitation level ", 0), 0u)
       << r.reasons.front().text;
+}
+
+// A recording whose current clipped the DAQ's range (the file does not state the range: the
+// samples repeat at the rail) is ERROR "clipped" on the station and offline alike, with the
+// same reason and no measurement (nothing was fitted).
+TEST_F(JudgeParityTest, ErrorByClipping) {
+  analysis::Recording rec = io::ReadRecordingCsv(*dir_ / "unit.csv");
+  double peak = 0.0;
+  for (double i : rec.current_a) peak = std::max(peak, std::abs(i));
+  for (double& i : rec.current_a) i = std::clamp(i, -0.7 * peak, 0.7 * peak);
+  io::WriteRecordingCsv(*dir_ / "clipped.csv", rec);
+  const db::TestRecord r = JudgeBothWays("clipped", BaseRecipe(), false, "clipped.csv", 1);
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  ASSERT_EQ(r.reasons.size(), 1u) << nlohmann::json(r.reasons).dump();
+  EXPECT_EQ(r.reasons.front().code, ReasonCode::kClipped);
+  EXPECT_EQ(r.reasons.front().text.rfind("invalid measurement: current clipped at ", 0), 0u)
+      << r.reasons.front().text;
+  EXPECT_NE(r.reasons.front().text.find(" A: "), std::string::npos) << r.reasons.front().text;
 }
 
 // The resonance at the reference clamp pressure (analysis/qc/f0_pressure.h) is judged from the

@@ -325,3 +325,128 @@ TEST(RecipeInstructions, ShippedTextDefaultsAndStrictValidation) {
 
 }  // namespace
 }  // namespace eol::station
+
+namespace eol::station {
+namespace {
+
+const std::string kFast = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json";
+
+std::string ErrorOfEdited(const std::string& path,
+                          const std::function<void(nlohmann::json&)>& edit) {
+  nlohmann::json j = io::ReadJsonFile(path);
+  edit(j);
+  return ErrorOf(j);
+}
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_PRED_FORMAT2(::testing::IsSubstring, needle, haystack)
+
+// Issue 37: the measurement owns its unit. A limit stating another unit (bounds in kHz on a
+// measurement in Hz) is refused naming the measurement, the unit given and the unit expected;
+// the right unit, or none, loads, and the unit read is the measurement's.
+TEST(RecipeUnits, ALimitInAnotherUnitIsRefused) {
+  const std::string khz = ErrorOfEdited(kRecipe, [](auto& j) {
+    j["limits"][0]["unit"] = "kHz";
+    j["limits"][0]["lo"] = 0.37;
+    j["limits"][0]["hi"] = 0.42;
+  });
+  EXPECT_CONTAINS(khz,
+                  "/limits/0/unit: is \"kHz\", but resonance_f_hz is measured in \"Hz\": "
+                  "give lo and hi in Hz");
+  EXPECT_CONTAINS(ErrorOfEdited(kRecipe, [](auto& j) { j["limits"][2]["unit"] = "mohm"; }),
+                  "/limits/2/unit: is \"mohm\", but winding_r_ohm is measured in \"ohm\"");
+  EXPECT_CONTAINS(ErrorOfEdited(kRecipe, [](auto& j) { j["limits"][1]["unit"] = "%"; }),
+                  "resonance_q is measured in \"1\"");
+  nlohmann::json j = Good();
+  for (auto& l : j["limits"]) l.erase("unit");
+  const Recipe r = ParseRecipe(j, "no-units.json");
+  for (const analysis::MeasurementSpec& s : r.limits)
+    EXPECT_EQ(s.unit, analysis::names::UnitOf(s.name)) << s.name;
+  EXPECT_EQ(RecipeToJson(r)["limits"][0]["unit"], "Hz");
+  for (const std::string& path : {kRecipe, kFast}) EXPECT_EQ(ErrorOf(io::ReadJsonFile(path)), "");
+}
+
+// Issue 37: resonance limits inside the analysis' f0 window (itself inside the excited band),
+// and the window moved alone says what else to move.
+TEST(RecipePlausibility, ResonanceLimitsAndWindowsLieInsideTheExcitedBand) {
+  EXPECT_CONTAINS(ErrorOfEdited(kRecipe, [](auto& j) { j["limits"][0]["hi"] = 750; }),
+                  "/limits/0/hi: is 750.000 Hz, outside the analysis f0 window [250.0, 700.0] Hz "
+                  "(/analysis/f0_min_hz, f0_max_hz) inside the excited band [200.0, 800.0] Hz: "
+                  "the fit reports no resonance there");
+  EXPECT_CONTAINS(ErrorOfEdited(kRecipe, [](auto& j) { j["limits"][0]["lo"] = 100; }),
+                  "/limits/0/lo: is 100.000 Hz, outside the analysis f0 window");
+  const std::string window =
+      ErrorOfEdited(kRecipe, [](auto& j) { j["analysis"]["f0_max_hz"] = 900; });
+  EXPECT_CONTAINS(window,
+                  "/analysis/f0_max_hz: must lie inside the excited band [200.0, 800.0] Hz "
+                  "(/excitation/f_lo_hz, f_hi_hz): the fit only sees excited lines; move "
+                  "/excitation/f_hi_hz up to 900.0 Hz or above too");
+  EXPECT_CONTAINS(window, "run eol design-excitation on the edited recipe");
+  EXPECT_CONTAINS(ErrorOfEdited(kRecipe, [](auto& j) { j["analysis"]["f0_min_hz"] = 150; }),
+                  "move /excitation/f_lo_hz down to 150.0 Hz or below too");
+  // Moving both is accepted.
+  EXPECT_EQ(ErrorOfEdited(kRecipe,
+                          [](auto& j) {
+                            j["analysis"]["f0_max_hz"] = 900;
+                            j["excitation"]["f_hi_hz"] = 1000;
+                          }),
+            "");
+}
+
+// Issue 37: a recipe whose limits cannot pass its own nominal motor, or whose winding
+// reference reads its nominal winding as an implausible temperature, is refused; the
+// precision requirement's refusal says how to choose it for a new motor.
+TEST(RecipePlausibility, TheNominalMotorMustPassItsOwnRecipe) {
+  const std::string foreign = ErrorOfEdited(kFast, [](auto& j) {
+    j["excitation_design"]["nominal"]["f0_hz"] = 600;
+    j["excitation_design"]["nominal"]["r_ohm"] = 1.1;
+  });
+  EXPECT_CONTAINS(foreign,
+                  "/excitation_design/nominal: the recipe's own nominal motor (the good motor it "
+                  "expects) fails its limits: resonance_f_hz = 600");
+  EXPECT_CONTAINS(foreign, "winding_r_ohm = 1.1");
+  EXPECT_CONTAINS(foreign, "teach the limits from this motor's golden units");
+  const std::string r_ref = ErrorOfEdited(
+      kFast, [](auto& j) { j["conditions"]["winding_temperature_c"]["r_ref_ohm"] = 0.1; });
+  EXPECT_CONTAINS(r_ref,
+                  "/excitation_design/nominal: the nominal winding r_ohm 0.5000 ohm reads "
+                  "as a winding temperature of 1037.8 degC");
+  EXPECT_CONTAINS(r_ref, "r_ref_ohm is another motor's");
+  const std::string sigma =
+      ErrorOfEdited(kFast, [](auto& j) { j["excitation_design"]["sigma_f0_hz"] = 0.001; });
+  EXPECT_CONTAINS(sigma, "/excitation_design/sigma_f0_hz: the excitation reaches std(f0) ");
+  EXPECT_CONTAINS(sigma,
+                  "sigma_f0_hz is the std(f0) one test must reach at the nominal motor, "
+                  "chosen per motor");
+  EXPECT_CONTAINS(sigma, "1/10 of the good units' std(f0)");
+  EXPECT_CONTAINS(sigma,
+                  "the resonance limits [370.0, 420.0] Hz taken as +-3 std of good units "
+                  "give 1/10 of it = 0.8333 Hz");
+  EXPECT_CONTAINS(sigma, "eol design-excitation designs the shortest excitation");
+}
+
+}  // namespace
+}  // namespace eol::station
+
+namespace eol::station {
+namespace {
+
+// Issue 37: the bond index's defect direction is the recipe's (its motor's), 12 by default
+// (the ten-pole motor's), validated and written back when it differs.
+TEST(RecipeBondIndex, DefectDirectionIsARecipeParameter) {
+  EXPECT_EQ(LoadRecipe(kRecipe).bond_index->residue_to_f0, analysis::kResidueToF0);
+  nlohmann::json j = Good();
+  j["bond_index"]["residue_to_f0"] = 3.8;
+  const Recipe r = ParseRecipe(j, "other-motor.json");
+  EXPECT_EQ(r.bond_index->residue_to_f0, 3.8);
+  EXPECT_EQ(RecipeToJson(r)["bond_index"]["residue_to_f0"], 3.8);
+  EXPECT_FALSE(RecipeToJson(LoadRecipe(kRecipe))["bond_index"].contains("residue_to_f0"));
+  j["bond_index"]["residue_to_f0"] = 0;
+  EXPECT_NE(ErrorOf(j).find("/bond_index/residue_to_f0: must be in (0, 1000]: d ln(residue) / "
+                            "-d ln(f0) of this motor's softer bonds"),
+            std::string::npos)
+      << ErrorOf(j);
+}
+
+}  // namespace
+}  // namespace eol::station

@@ -131,5 +131,39 @@ TEST(ReplayDaq, RepeatsOneFileAndRefusesMisfits) {
   }
 }
 
+// Issue 37: the DAQ config states the converter's range of CSV recordings that do not state it
+// ("full_scale"), so a replayed recording whose current reaches it is refused as clipped; a
+// half-stated range is refused naming the key.
+TEST(ReplayDaq, ConfiguredFullScaleReachesTheClippingCheck) {
+  Fixture fx;
+  fx.Simulate(fx.dir / "a.csv", "3");
+  auto daq = fx.Replay({{"driver", "replay"},
+                        {"file", fx.dir / "a.csv"},
+                        {"repeat", true},
+                        {"full_scale", {{"voltage_v", 10.0}, {"current_a", 0.05}}}});
+  ASSERT_TRUE(daq->Connect().ok());
+  const std::atomic<bool> abort{false};
+  auto r = daq->Acquire(fx.req, abort);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r.value().voltage_full_scale_v, 10.0);
+  EXPECT_EQ(r.value().current_full_scale_a, 0.05);
+  const analysis::ImpedanceAnalysis a =
+      analysis::AnalyzeRecording(r.value(), fx.ex.lines, fx.recipe.analysis);
+  EXPECT_FALSE(a.usable);
+  EXPECT_TRUE(a.frf.clipped);
+  EXPECT_EQ(a.message.rfind("invalid measurement: current clipped at 0.05 A: ", 0), 0u)
+      << a.message;
+  try {
+    fx.Replay(
+        {{"driver", "replay"}, {"file", fx.dir / "a.csv"}, {"full_scale", {{"voltage_v", 10.0}}}});
+    FAIL() << "a half-stated range was accepted";
+  } catch (const io::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/daq/full_scale/voltage_v: give both voltage_v and "
+                                         "current_a"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace eol
