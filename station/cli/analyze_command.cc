@@ -428,7 +428,7 @@ void AddAnalyzeCommand(CLI::App& app) {
                   "The unit's clamp pressure (bar) as the station read it: the judge's\n"
                   "resonance_f_ref_pressure_hz needs it; kept in the output's conditions\n"
                   "(so eol teach finds it in --json outputs)")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--voltage-gain", args->voltage_gain, "WAV: volts per unit of full scale");
   cmd->add_option("--current-gain", args->current_gain, "WAV: amperes per unit of full scale");
   cmd->callback([args] { RunGuarded("analyze", [&] { return RunAnalyze(*args); }); });
