@@ -36,9 +36,9 @@ std::vector<std::string> Subcommands(const std::string& help) {
     }
     if (!in_list) continue;
     if (line.empty() || line[0] != ' ') break;
-    std::istringstream words(line);
-    std::string name;
-    if (words >> name) names.push_back(name);
+    // "  demo   Run ...": a name two spaces in; a description's wrapped lines are further in.
+    std::smatch m;
+    if (std::regex_search(line, m, std::regex(R"(^  ([a-z][a-z-]*)(\s|$))"))) names.push_back(m[1]);
   }
   return names;
 }
@@ -108,11 +108,12 @@ TEST(HelpNames, OnlyOptionsThatExist) {
          ++it) {
       const std::string name = it->str();
       if (options[what].count(name) || options["eol"].count(name)) continue;
-      // An option of another command the help cites by name ("`eol teach --golden`").
+      // An option of another command the help cites by name ("`eol teach --golden`"); the
+      // list of `eol --help` describes every command.
       bool cited = false;
       for (const auto& [other, names] : options)
         cited = cited || (other != "eol" && names.count(name) &&
-                          help_text.find(other + " ") != std::string::npos);
+                          (what == "eol" || help_text.find(other + " ") != std::string::npos));
       EXPECT_TRUE(cited) << what << " --help names " << name
                          << ", an option neither it nor a command it cites has";
     }
