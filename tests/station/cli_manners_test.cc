@@ -149,6 +149,16 @@ TEST(UsageErrors, AnUnknownOptionIsNamedBeforeAMissingRequiredOne) {
       << command.out;
 }
 
+TEST(UsageErrors, AnUnknownEffectNamesTheCatalogue) {
+  const CliRun r = testing::RunEol(
+      {"gap", "--sim", "a.csv", "--measured", "b.csv", "--effects", "gremlins"}, true, 60s);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--effects: unknown effect 'gremlins'; the effects: series_resistance, "),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("fractional_inductance"), std::string::npos) << r.out;
+}
+
 TEST(UsageErrors, RangeErrorsPrintReadableBounds) {
   struct Case {
     std::vector<std::string> args;
