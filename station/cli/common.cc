@@ -28,9 +28,13 @@ std::string IsoOption(const std::string& option, const std::string& value) {
 
 namespace {
 
+// 1000000 as such, 0.99, 1e+12: whole numbers below 1e9 in full, others with %g.
 std::string Short(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
+  if (v == std::trunc(v) && std::abs(v) < 1e9)
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+  else
+    std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
 }
 

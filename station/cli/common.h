@@ -17,8 +17,9 @@ std::string IsoOption(const std::string& option, const std::string& value);
 
 // Number checks for options, in place of CLI::Range, CLI::PositiveNumber and
 // CLI::NonNegativeNumber (whose messages print std::to_string of the bounds: 309 digits for
-// numeric_limits<double>::max). Help and errors print the bounds with %g:
-//   --runs: 0 is out of range: from 2 to 1e+06
+// numeric_limits<double>::max). Help and errors print whole bounds below 1e9 in full, others
+// with %g:
+//   --runs: 0 is out of range: from 2 to 1000000
 //   --period-s: -1 is out of range: must be >= 0
 CLI::Validator Between(double lo, double hi);
 CLI::Validator Positive();     // > 0

@@ -169,7 +169,7 @@ TEST(UsageErrors, RangeErrorsPrintReadableBounds) {
        "--f-lo-hz: -1 is out of range: must be >= 0"},
       {{"analyze", "--measured", "a.csv", "--clamp-pressure-bar", "0"},
        "--clamp-pressure-bar: 0 is out of range: must be > 0"},
-      {{"fit-bench", "--runs", "1"}, "--runs: 1 is out of range: from 2 to 1e+06"},
+      {{"fit-bench", "--runs", "1"}, "--runs: 1 is out of range: from 2 to 1000000"},
       {{"demo", "--defect-share", "2"}, "--defect-share: 2 is out of range: from 0 to 1"},
       {{"gap", "--sim", "a.csv", "--measured", "b.csv", "--sigma-dof", "3"},
        "3 is out of range: from 4 to 1e+12"}};
