@@ -439,15 +439,15 @@ void AddAnalyzeCommand(CLI::App& app) {
                   "The unit's clamp pressure (bar) as the station read it: the judge's\n"
                   "resonance_f_ref_pressure_hz needs it; kept in the output's conditions\n"
                   "(so eol teach finds it in --json outputs)")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--voltage-full-scale", args->voltage_full_scale,
                   "Raw recording: the voltage channel's range (V); samples at it are clipped\n"
                   "(default: the CSV's u_full_scale_v column, a WAV's gain; without either,\n"
                   "clipping is found from samples repeated at a rail)")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--current-full-scale", args->current_full_scale,
                   "Raw recording: the current channel's range (A), as --voltage-full-scale")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--voltage-gain", args->voltage_gain, "WAV: volts per unit of full scale");
   cmd->add_option("--current-gain", args->current_gain, "WAV: amperes per unit of full scale");
   cmd->callback([args] { RunGuarded("analyze", [&] { return RunAnalyze(*args); }); });

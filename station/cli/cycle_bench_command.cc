@@ -45,15 +45,15 @@ void AddCycleBenchCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--units", o->units, "Simulated units (each tested with both recipes)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 100000));
+      ->check(Between(1, 100000));
   cmd->add_option("--seed", o->seed, "Seed of the simulated population")->capture_default_str();
   cmd->add_option("--defect-share", o->defect_share, "Share of poorly cemented rotors")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(Between(0.0, 1.0));
   cmd->add_option("--time-scale", o->time_scale,
                   "Pace of the simulated excitation: 1 real time, 0 as fast as possible")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(Between(0.0, 10.0));
   cmd->add_option("--sim", o->sim_model,
                   "time_domain (motor from rest, start transient) or steady_state")
       ->capture_default_str()

@@ -98,25 +98,24 @@ void AddDbBenchCommand(CLI::App& app) {
                   "Station store whose newest test is the template (e.g. from eol demo)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--tests", args->o.tests, "Tests to generate")
-      ->check(CLI::Range(1LL, 100000000LL));
-  cmd->add_option("--batch", args->o.batch, "Tests per transaction")->check(CLI::Range(1, 1000000));
+  cmd->add_option("--tests", args->o.tests, "Tests to generate")->check(Between(1, 1e8));
+  cmd->add_option("--batch", args->o.batch, "Tests per transaction")->check(Between(1, 1000000));
   cmd->add_option("--interval-s", args->o.interval_s, "Seconds between tests on the line")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--retest-share", args->o.retest_share, "Share of tests that are retests")
-      ->check(CLI::Range(0.0, 0.99));
+      ->check(Between(0.0, 0.99));
   cmd->add_option("--queries", args->o.queries, "Random serials looked up")
-      ->check(CLI::Range(1, 1000000));
+      ->check(Between(1, 1000000));
   cmd->add_option("--seed", args->o.seed, "Seed of the perturbations and lookups");
   cmd->add_option("--replicate", args->o.replicate,
                   "Copies of the generated block in the store, made inside SQLite (later in "
                   "time, new serials, the same bytes): --tests 100000 --replicate 50 measures "
                   "5 million tests")
-      ->check(CLI::Range(1, 10000));
+      ->check(Between(1, 10000));
   cmd->add_option("--finish-samples", args->o.finish_samples,
                   "Tests finished one at a time with and without the checkpoint")
       ->capture_default_str()
-      ->check(CLI::Range(1, 100000));
+      ->check(Between(1, 100000));
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args] { RunGuarded("db-bench", [&] { return RunDbBenchCommand(*args); }); });
 }

@@ -169,7 +169,7 @@ void AddDemoCommand(CLI::App& app) {
       "JSON status while running, and score the verdicts against the simulator's truth.");
   cmd->add_option("--units", args->units, "Number of simulated units to test")
       ->capture_default_str()
-      ->check(CLI::Range(1, 1000000));
+      ->check(Between(1, 1000000));
   cmd->add_option("--db", args->db,
                   "SQLite file for the records (created if missing; an existing file must be a "
                   "store)")
@@ -179,17 +179,17 @@ void AddDemoCommand(CLI::App& app) {
                 "Print the summary as one JSON object on stdout (unit lines go to stderr)");
   cmd->add_option("--port", args->port, "HTTP port for the JSON status (0: any free port)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 65535));
+      ->check(Between(0, 65535));
   cmd->add_option("--listen", args->listen, "HTTP listen address")->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed of the simulated population")->capture_default_str();
   cmd->add_option("--defect-share", args->defect_share,
                   "Share of poorly cemented rotors in the population")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(Between(0.0, 1.0));
   cmd->add_option("--time-scale", args->time_scale,
                   "Pace of the simulated acquisition: 1 real time, 0 as fast as possible")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
+      ->check(Between(0.0, 10.0));
   cmd->add_option(
          "--fixture", args->fixture,
          "modbus: the station talks Modbus TCP to the fixture emulator (eol fixture-sim's\n"

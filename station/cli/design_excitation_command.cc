@@ -174,7 +174,7 @@ void AddDesignExcitationCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--sigma-f0-hz", args->sigma_f0_hz,
                   "Required std(f0) in Hz (default: the recipe's)")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--crest-for", args->crest_for,
                   "Phases that keep the voltage's or the current's crest factor low (default: "
                   "the recipe's excitation.crest_for)")

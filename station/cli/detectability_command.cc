@@ -181,16 +181,15 @@ void AddDetectabilityCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--gap", args->gap, "`eol gap --json` output with fixture_compliance")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--k-fixture", args->k_fixture, "Fixture stiffness, N m/rad")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--k-fixture", args->k_fixture, "Fixture stiffness, N m/rad")->check(Positive());
   cmd->add_option("--golden", args->golden, "Good units for the spread (as `eol teach`)");
   cmd->add_option("--limit-sigmas", args->limit_sigmas,
                   "Without --golden: the recipe's limits are taken as +- this many sigma")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option("--required-sigmas", args->required_sigmas, "Separation needed")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args] { RunGuarded("detectability", [&] { return RunDetect(*args); }); });
 }

@@ -155,13 +155,13 @@ void AddExportCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "Output file (default: stdout)");
   cmd->add_option("--limit", args->limit, "At most this many tests")
       ->capture_default_str()
-      ->check(CLI::Range(1, 10000));
+      ->check(Between(1, 10000));
   cmd->add_flag("--all", args->all,
                 "Every test that matches, read --page-size at a time (memory stays bounded)")
       ->excludes("--limit");
   cmd->add_option("--page-size", args->page_size, "With --all: tests read at a time")
       ->capture_default_str()
-      ->check(CLI::Range(1, 10000));
+      ->check(Between(1, 10000));
   cmd->add_flag("--schema", args->schema,
                 "Print the columns (Markdown table: column, type, unit, meaning) and exit");
   cmd->callback([args] { RunGuarded("export", [&] { return RunExport(*args); }); });

@@ -230,17 +230,17 @@ void AddFitBenchCommand(CLI::App& app) {
       "measurement time needed for std(f0) = 0.5 Hz.");
   cmd->add_option("--runs", args->runs, "Monte Carlo runs")
       ->capture_default_str()
-      ->check(CLI::Range(2, 1000000));
+      ->check(Between(2, 1000000));
   cmd->add_option("--seed", args->seed, "Seed of the noise")->capture_default_str();
   cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->add_option("--recipe", args->recipe, "Recipe JSON")->capture_default_str();
   cmd->add_option("--check-runs", args->check_runs, "Runs of the measurement-time check (0: skip)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 1000000));
+      ->check(Between(0, 1000000));
   cmd->add_option("--peer-runs", args->peer_runs,
                   "Recordings given to the SciPy pipeline (0: skip it)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 10000));
+      ->check(Between(0, 10000));
   cmd->add_option("--python", args->python, "Python with SciPy")->capture_default_str();
   cmd->add_option("--script", args->script, "The SciPy pipeline")->capture_default_str();
   cmd->add_option("--frf-method", args->frf_method,

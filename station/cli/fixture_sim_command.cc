@@ -178,10 +178,10 @@ void AddFixtureSimCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--listen", opt->listen, "IPv4 address to listen on")->capture_default_str();
   cmd->add_option("--port", opt->port, "TCP port; 0 picks a free port (see --ready-file)")
-      ->check(CLI::Range(0, 65535))
+      ->check(Between(0, 65535))
       ->capture_default_str();
   cmd->add_option("--unit-id", opt->unit_id, "Modbus unit id served")
-      ->check(CLI::Range(1, 247))
+      ->check(Between(1, 247))
       ->capture_default_str();
   cmd->add_option("--rtu", opt->rtu_device,
                   "Also serve Modbus RTU on this serial device (e.g. one end of a socat pty pair)");
@@ -190,7 +190,7 @@ void AddFixtureSimCommand(CLI::App& app) {
       ->check(CLI::IsMember({"N", "E", "O"}))
       ->capture_default_str();
   cmd->add_option("--data-bits", opt->data_bits, "RTU data bits")
-      ->check(CLI::Range(5, 8))
+      ->check(Between(5, 8))
       ->capture_default_str();
   cmd->add_option("--stop-bits", opt->stop_bits, "RTU stop bits")
       ->check(CLI::IsMember({1, 2}))
@@ -202,14 +202,14 @@ void AddFixtureSimCommand(CLI::App& app) {
   cmd->add_option("--fault-after-ms", opt->fault_after_ms,
                   "Delay before the fault shows, from start (or from the next excitation-enable "
                   "edge with --fault-on-excitation)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_flag("--fault-on-excitation", opt->fault_on_excitation,
                 "Count --fault-after-ms from the next excitation-enable edge");
   cmd->add_option("--fault-duration-ms", opt->fault_duration_ms,
                   "How long the fault lasts once shown, then the fixture is healthy again "
                   "(0: until the emulator stops); the fault shows once")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--ready-file", opt->ready_file,
                   "Once serving, write the TCP port number here (written atomically)");
@@ -219,9 +219,9 @@ void AddFixtureSimCommand(CLI::App& app) {
                   "map, if any)");
   cmd->add_option("--node-id", opt->node_id,
                   "CAN node id served (default: the config's fixture node_id, else 1)")
-      ->check(CLI::Range(1, 127));
+      ->check(Between(1, 127));
   cmd->add_option("--status-period-ms", opt->status_period_ms, "CAN status frame period")
-      ->check(CLI::Range(1, 1000))
+      ->check(Between(1, 1000))
       ->capture_default_str();
   cmd->callback([opt] { RunGuarded("fixture-sim", [opt] { return RunFixtureSim(*opt); }); });
 }

@@ -163,7 +163,7 @@ void AddGapBenchCommand(CLI::App& app) {
       "often a strong effect was called 'none' (analysis/bench/gap_bench.h defines each).");
   cmd->add_option("--cases", a->cases, "Number of cases")
       ->capture_default_str()
-      ->check(CLI::Range(1, 100000));
+      ->check(Between(1, 100000));
   cmd->add_option("--seed", a->seed, "Seed (the same seed gives the same cases)")
       ->capture_default_str();
   cmd->add_flag("--json", a->json,

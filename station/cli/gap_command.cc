@@ -10,6 +10,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "analysis/model/effects.h"
 #include "drivers/io/chart.h"
 #include "drivers/io/file_error.h"
 #include "station/cli/commands.h"
@@ -21,6 +22,15 @@
 
 namespace eol::station::cli {
 namespace {
+
+// The effect catalogue's names for a quantity (analysis/model/effects.h EffectsFor), joined
+// with ", ": what --effects takes and the report names.
+std::string EffectNames(analysis::Quantity quantity) {
+  std::string names;
+  for (const analysis::EffectKind kind : analysis::EffectsFor(quantity))
+    names += (names.empty() ? "" : ", ") + std::string(analysis::ToString(kind));
+  return names;
+}
 
 struct GapArgs {
   std::string sim;
@@ -72,7 +82,9 @@ int RunGap(const GapArgs& a) {
   o.try_pairs = !a.no_pairs;
   for (const std::string& name : a.effects) {
     const auto kind = analysis::ParseEffectKind(name);
-    if (!kind) throw std::invalid_argument("--effects: unknown effect '" + name + "'");
+    if (!kind)
+      throw std::invalid_argument("--effects: unknown effect '" + name + "'; the effects: " +
+                                  EffectNames(analysis::Quantity::kImpedanceOhm));
     o.effects.push_back(*kind);
   }
   GapReport r;
@@ -131,9 +143,10 @@ void AddGapCommand(CLI::App& app) {
       "gap",
       "Sim-to-real gap diagnosis: calibrate the nominal model to a simulation, compare it with\n"
       "measured units, find where the residual is significant, which unmodelled effect\n"
-      "(fixture compliance, lossy inductance, stray capacitance, channel delay, second mode,\n"
-      "series resistance, skin effect, adhesive creep, or a pair) explains it, and how far the\n"
-      "gap shrinks, also on held-out lines (one unit) or units (leave-one-unit-out).");
+      "explains it, and how far the gap shrinks, also on held-out lines (one unit) or units\n"
+      "(leave-one-unit-out). The effects (or a pair of them):\n  " +
+          EffectNames(analysis::Quantity::kImpedanceOhm) +
+          "\nfor impedance; for mobility: " + EffectNames(analysis::Quantity::kMobility) + ".");
   cmd->add_option("--sim", a->sim,
                   "Simulation: FRF CSV (f_hz,re_ohm,im_ohm / f_hz,re,im), .zma, motor JSON "
                   "(recipes/motors) or rigid-shaft JSON")
@@ -156,27 +169,27 @@ void AddGapCommand(CLI::App& app) {
   cmd->add_option("--inertia-kg-m2", a->inertia_kg_m2,
                   "Rotor inertia J_r, to express the fixture's stiffness in N m/rad (default: "
                   "from the motor JSON, else the recipe's motor.rotor_inertia_kg_m2)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   cmd->add_option("--recipe", a->recipe, "Recipe giving the default J_r")->capture_default_str();
   cmd->add_option("--f-lo-hz", a->f_lo_hz, "Use only lines at or above this frequency")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   cmd->add_option("--f-hi-hz", a->f_hi_hz, "Use only lines at or below this frequency")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   cmd->add_option("--sigma-pool", a->sigma_pool,
                   "Pool each line's relative variance over +-N lines, for files whose sigma rests "
                   "on few periods and was not pooled (the periodic estimator already pools: 0)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 50));
+      ->check(Between(0, 50));
   cmd->add_option("--sigma-periods", a->sigma_periods,
                   "The measured files' sigma comes from this many periods: each sigma^2 has "
                   "2 (P - 1) degrees of freedom and the residual is tested as F, not chi2 "
                   "(default: the file's sigma_dof column, a raw recording's periodic estimate, "
                   "else read from the line-to-line scatter of sigma itself)")
-      ->check(CLI::Range(4, 100000));
+      ->check(Between(4, 100000));
   auto* dof = cmd->add_option("--sigma-dof", a->sigma_dof,
                               "Degrees of freedom of each line's sigma^2 in the measured files "
                               "(above 4; overrides --sigma-periods)")
-                  ->check(CLI::Range(4.000001, 1e12));
+                  ->check(Between(4.000001, 1e12));
   cmd->add_flag("--sigma-exact", a->sigma_exact,
                 "The measured files' sigma is exact (a noise model's): the residual is tested as "
                 "chi2 whatever sigma's scatter")
@@ -184,7 +197,7 @@ void AddGapCommand(CLI::App& app) {
       ->excludes("--sigma-periods");
   cmd->add_option("--period-s", a->period_s,
                   "Raw recordings: the excitation period (default: detect)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   cmd->add_option("--input-column", a->input_column,
                   "Raw recordings: input column (default i_a, mobility iq_a)");
   cmd->add_option("--output-column", a->output_column,
@@ -192,7 +205,9 @@ void AddGapCommand(CLI::App& app) {
   cmd->add_option("--lines-file", a->lines_file,
                   "Raw recordings: excited lines in Hz, one per line (default: "
                   "<stem>-excited-lines-hz.txt beside the recording, else detected)");
-  cmd->add_option("--effects", a->effects, "Only try these effects (names as in the report)")
+  cmd->add_option("--effects", a->effects,
+                  "Only try these effects, comma-separated (names as listed above and in the "
+                  "report)")
       ->delimiter(',');
   cmd->add_flag("--no-pairs", a->no_pairs, "Do not try pairs of effects");
   cmd->callback([a] { RunGuarded("gap", [&] { return RunGap(*a); }); });

@@ -22,20 +22,20 @@ void AddHttpBenchCommand(CLI::App& app) {
       "HTTP API served in this process on 127.0.0.1.");
   cmd->add_option("--streams", o->streams, "Open event streams")
       ->capture_default_str()
-      ->check(CLI::Range(0, 1000));
+      ->check(Between(0, 1000));
   cmd->add_option("--slow", o->slow,
                   "Slow connections during the poll (a head, a byte every 500 ms)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 700));
+      ->check(Between(0, 700));
   cmd->add_option("--clients", o->clients, "Concurrent clients polling /api/status")
       ->capture_default_str()
-      ->check(CLI::Range(1, 1000));
+      ->check(Between(1, 1000));
   cmd->add_option("--seconds", o->seconds, "Duration of the poll")
       ->capture_default_str()
-      ->check(CLI::Range(0.1, 600.0));
+      ->check(Between(0.1, 600.0));
   cmd->add_option("--chunked-mib", *mib, "Chunked body offered, MiB")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 65536.0));
+      ->check(Between(1.0, 65536.0));
   cmd->add_flag("--json", *json, "Print the figures as JSON");
   cmd->callback([o, json, mib] {
     RunGuarded("http-bench", [&] {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "station/cli/commands.h"
+#include "station/cli/usage_errors.h"
 #include "station/data_files.h"
 #include "station/version.h"
 
@@ -53,14 +54,14 @@ int main(int argc, char** argv) {
   // Exit codes: 0 done; 1 the command's negative answer (e.g. a serial with no tests, a
   // drift alarm; see each command's help); 2 a usage error (unknown option, missing or
   // malformed argument, a file that does not exist) or a failure the command names.
-  // CLI11 would exit 101-115 for usage errors; those all become 2.
+  // CLI11 would exit 101-115 for usage errors; those all become 2. Unknown options are named
+  // first, with the nearest known one (usage_errors.h).
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {
     return e.get_exit_code();  // the command ran and chose its code (RunGuarded)
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);  // prints help, the version or the usage error
-    return code == 0 ? 0 : 2;
+    return eol::station::cli::ReportParseError(app, e);  // help, the version or the usage error
   }
   return 0;
 }

@@ -29,10 +29,10 @@ void AddPlantBenchCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--online", o->online, "Records for the delay figures")
       ->capture_default_str()
-      ->check(CLI::Range(1, 10000));
+      ->check(Between(1, 10000));
   cmd->add_option("--backlog", o->backlog, "Records for the replay and insert rates")
       ->capture_default_str()
-      ->check(CLI::Range(1, 100000));
+      ->check(Between(1, 100000));
   cmd->add_option("--work-dir", o->work_dir, "Where the bench's SQLite file is made")
       ->capture_default_str();
   cmd->add_flag("--json", *json, "Print the figures as JSON");

@@ -8,11 +8,13 @@
 namespace eol::station::cli {
 
 Progress::Progress(std::string command, bool enabled)
-    : command_(std::move(command)), drawing_(enabled && isatty(STDERR_FILENO) == 1) {}
+    : command_(std::move(command)),
+      drawing_(enabled),
+      terminal_(enabled && isatty(STDERR_FILENO) == 1) {}
 
 Progress::~Progress() {
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (drawn_) std::fputs("\n", stderr);
+  if (drawn_ && terminal_) std::fputs("\n", stderr);
 }
 
 std::string Progress::Duration(double s) {
@@ -29,7 +31,7 @@ std::string Progress::Duration(double s) {
 }
 
 std::string Progress::Line(std::string_view command, std::string_view phase, std::int64_t done,
-                           std::int64_t total, double elapsed_s) {
+                           std::int64_t total, double elapsed_s, std::int64_t done0) {
   std::string line =
       "eol " + std::string(command) + ": " + std::string(phase) + "  " + std::to_string(done);
   if (total < 0) return line + "  " + Duration(elapsed_s);  // the total is not known
@@ -38,9 +40,9 @@ std::string Progress::Line(std::string_view command, std::string_view phase, std
   line += "  " + Duration(elapsed_s);
   if (done >= total)
     line += ", done";
-  else if (done > 0)
-    line += ", ETA " +
-            Duration(elapsed_s * static_cast<double>(total - done) / static_cast<double>(done));
+  else if (done > done0 && elapsed_s > 0.0)  // a rate measured since the phase's first update
+    line += ", ETA " + Duration(elapsed_s * static_cast<double>(total - done) /
+                                static_cast<double>(done - done0));
   return line;
 }
 
@@ -49,18 +51,33 @@ void Progress::Update(std::string_view phase, std::int64_t done, std::int64_t to
   const auto now = Clock::now();
   const std::lock_guard<std::mutex> lock(mutex_);
   const bool new_phase = phase != phase_;
+  const bool end = total >= 0 && done >= total;
   if (new_phase) {
-    if (drawn_) std::fputs("\n", stderr);  // the finished phase's line stays
+    if (drawn_ && terminal_) std::fputs("\n", stderr);  // the finished phase's line stays
     phase_ = std::string(phase);
     phase_start_ = now;
-  } else if (done > 1 && (total < 0 || done < total) &&
-             now - last_draw_ < std::chrono::milliseconds(100)) {
+    phase_done0_ = done;
+    last_draw_ = now;
+    if (!terminal_ && !end) return;  // plain: the first line after kPlainPeriod, or the end
+  } else if (terminal_) {
+    if (done > phase_done0_ + 1 && !end && now - last_draw_ < std::chrono::milliseconds(100))
+      return;
+  } else if (!end && now - last_draw_ < kPlainPeriod) {
     return;
   }
+  Draw(phase, done, total, now);
+}
+
+// Under mutex_.
+void Progress::Draw(std::string_view phase, std::int64_t done, std::int64_t total,
+                    Clock::time_point now) {
   last_draw_ = now;
   const double elapsed = std::chrono::duration<double>(now - phase_start_).count();
-  // \r back to the line's start, \033[K clears what a longer earlier line left.
-  std::fprintf(stderr, "\r%s\033[K", Line(command_, phase, done, total, elapsed).c_str());
+  const std::string line = Line(command_, phase, done, total, elapsed, phase_done0_);
+  if (terminal_)  // \r back to the line's start, \033[K clears what a longer earlier line left
+    std::fprintf(stderr, "\r%s\033[K", line.c_str());
+  else
+    std::fprintf(stderr, "%s\n", line.c_str());
   std::fflush(stderr);
   drawn_ = true;
 }

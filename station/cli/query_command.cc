@@ -23,6 +23,20 @@
 namespace eol::station::cli {
 namespace {
 
+// "380 .. 420", ">= 380", "<= 420" or "none": a measurement's limits as the text shows them.
+std::string LimitText(const analysis::Limit& l) {
+  char buf[64];
+  if (l.lo && l.hi)
+    std::snprintf(buf, sizeof buf, "%.6g .. %.6g", *l.lo, *l.hi);
+  else if (l.lo)
+    std::snprintf(buf, sizeof buf, ">= %.6g", *l.lo);
+  else if (l.hi)
+    std::snprintf(buf, sizeof buf, "<= %.6g", *l.hi);
+  else
+    return "none";
+  return buf;
+}
+
 struct QueryArgs {
   std::string db;
   std::string central;
@@ -133,8 +147,9 @@ int RunQuery(const QueryArgs& a) {
                   t.work.order_number.empty() ? "-" : t.work.order_number.c_str());
     for (const auto& m : t.measurements) {
       if (!std::isfinite(m.value)) continue;
-      std::printf("          %-18s %12.6g %-4s [%s] %s\n", m.name.c_str(), m.value, m.unit.c_str(),
-                  analysis::ToString(m.outcome), m.marginal ? "marginal" : "");
+      std::printf("          %-18s %12.6g %-4s limits %-21s [%s] %s\n", m.name.c_str(), m.value,
+                  m.unit.c_str(), LimitText(m.limit).c_str(), analysis::ToString(m.outcome),
+                  m.marginal ? "marginal" : "");
     }
     for (const auto& r : t.reasons)
       std::printf("          reason (%s): %s\n", analysis::ToString(r.code), r.text.c_str());

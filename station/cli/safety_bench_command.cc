@@ -23,11 +23,11 @@ void AddSafetyBenchCommand(CLI::App& app) {
       "on the simulated bench (real-time acquisition). Target: 50 ms.");
   cmd->add_option("--trials", o->trials_per_fault, "Tests per fault type")
       ->capture_default_str()
-      ->check(CLI::Range(1, 10000));
+      ->check(Between(1, 10000));
   cmd->add_option("--seed", o->seed, "Seed of the fault times")->capture_default_str();
   cmd->add_option("--watchdog-period-ms", o->watchdog_period_ms, "Interlock poll period")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 50.0));
+      ->check(Between(1.0, 50.0));
   cmd->add_option("--recipe", o->recipe_path, "Recipe JSON")->capture_default_str();
   cmd->add_option("--fixture", o->fixture,
                   "sim: in-process simulated fixture; modbus: the Modbus TCP driver to the "

@@ -173,17 +173,17 @@ void AddSimulateCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--noise-v", args->noise_v, "Voltage channel noise, V rms per sample")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   cmd->add_option("--noise-a", args->noise_a, "Current channel noise, A rms per sample")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   cmd->add_option("--amplifier-output-ohm", args->amplifier_output_ohm,
                   "Amplifier output resistance in series with the motor")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   cmd->add_option("--shunt-ohm", args->shunt_ohm, "Current shunt in series with the motor")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   cmd->callback([args] { RunGuarded("simulate", [&] { return RunSimulate(*args); }); });
 }
 

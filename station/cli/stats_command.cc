@@ -6,8 +6,12 @@
 // histograms of the resonance and its Q (station/spc_charts.h).
 // Exit 0 when no drift (trend) alarm fired, 1 when one did, 2 on usage or file errors; run-rule
 // alarms are printed and listed under "spc_alarms" but leave the exit code alone.
+#include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <iostream>
+#include <map>
+#include <set>
 
 #include "analysis/qc/measurement_names.h"
 #include "drivers/io/chart.h"
@@ -109,6 +113,55 @@ void WritePlot(db::Store& store, const StatsRequest& req, const std::string& pat
   io::WriteChart(path, chart);
 }
 
+// Serials with more than one test in the request's window (gauge candidates), most tests
+// first, at most `most`: "G-1 (30 tests), G-2 (5 tests)".
+std::string RepeatedSerials(db::Store& store, const StatsRequest& req, std::size_t most) {
+  std::map<std::string, std::set<std::int64_t>> tests;
+  for (const db::RecordKind kind : db::kAllRecordKinds) {
+    db::MeasurementQuery q;
+    q.from = req.from;
+    q.to = req.to;
+    q.recipe_hash = req.recipe_hash;
+    q.kind = kind;
+    for (const auto& r : store.MeasurementRows(q)) tests[r.serial].insert(r.test_id);
+  }
+  std::vector<std::pair<std::size_t, std::string>> repeated;
+  for (const auto& [serial, ids] : tests)
+    if (ids.size() > 1) repeated.emplace_back(ids.size(), serial);
+  std::sort(repeated.begin(), repeated.end(), std::greater<>());
+  if (repeated.empty()) return "none";
+  std::string text;
+  for (std::size_t i = 0; i < repeated.size() && i < most; ++i)
+    text +=
+        (i ? ", " : "") + repeated[i].second + " (" + std::to_string(repeated[i].first) + " tests)";
+  if (repeated.size() > most) text += ", ...";
+  return text;
+}
+
+// --gauge names a serial with measured tests, --reference only measurements of its study;
+// else an error naming the known ones (exit 2).
+void CheckGauge(db::Store& store, const StatsRequest& req, const nlohmann::json& report) {
+  if (!req.gauge_serial) {
+    if (!req.reference.empty()) throw std::runtime_error("--reference needs --gauge SERIAL");
+    return;
+  }
+  const nlohmann::json& g = report["gauge"];
+  if (g["tests"].get<std::size_t>() == 0)
+    throw std::runtime_error("--gauge " + *req.gauge_serial +
+                             ": no PASS or FAIL test of this serial in the window; serials "
+                             "tested more than once: " +
+                             RepeatedSerials(store, req, 10));
+  std::set<std::string> names;
+  for (const auto& m : g["measurements"]) names.insert(m["name"].get<std::string>());
+  for (const auto& [name, value] : req.reference) {
+    if (names.count(name)) continue;
+    std::string known;
+    for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+    throw std::runtime_error("--reference " + name + ": the gauge study of " + *req.gauge_serial +
+                             " has no such measurement; it has: " + known);
+  }
+}
+
 int RunStats(const StatsArgs& a) {
   StatsRequest req;
   if (!a.recipe_hash.empty()) req.recipe_hash = a.recipe_hash;
@@ -127,6 +180,7 @@ int RunStats(const StatsArgs& a) {
     throw std::runtime_error(bad);
   auto store = db::Store::Open(a.db, db::Store::Role::kReadOnly);
   const nlohmann::json report = StatsReport(*store, req);
+  CheckGauge(*store, req, report);
   if (!a.plot.empty()) WritePlot(*store, req, a.plot);
   if (a.json)
     std::cout << report.dump(2) << std::endl;
@@ -148,7 +202,8 @@ void AddStatsCommand(CLI::App& app) {
       "alarms (trend over the passing tests), and with --gauge a type-1 gauge study of one\n"
       "serial tested repeatedly. Self-check (master) tests are excluded. --plot draws the\n"
       "control charts and histograms of resonance_f_hz and resonance_q.\n"
-      "Exit code 1 when a drift (trend) alarm fired.");
+      "Exit code 1 when a drift (trend) alarm fired; 2 when --gauge names a serial without\n"
+      "tests in the window or --reference a measurement its study lacks.");
   cmd->add_option("--db", args->db, "SQLite file of the station")
       ->required()
       ->check(CLI::ExistingFile);
