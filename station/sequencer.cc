@@ -165,6 +165,10 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
                   {ReasonCode::kAcquisition, "acquisition unavailable: " + s.message()}};
     }
   }
+  // The controller latches interlock drops until read (safety.h): the first read clears
+  // those from while the station stood idle between tests; from the second on, every drop
+  // counts.
+  (void)ReadInputs("check interlocks");
   const drivers::FixtureInputs in = ReadInputs("check interlocks");
   board_.SetReadiness(true, "");
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
