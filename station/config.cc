@@ -118,6 +118,15 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
           s->Number("heartbeat_timeout_ms", c.safety.heartbeat_timeout_ms);
       c.safety.poll_period_ms = s->Number("poll_period_ms", c.safety.poll_period_ms);
       c.safety.safe_state_retry_s = s->Number("safe_state_retry_s", c.safety.safe_state_retry_s);
+      c.safety.watchdog_reaction_ms =
+          s->Number("watchdog_reaction_ms", c.safety.watchdog_reaction_ms);
+      c.safety.alive_period_ms = s->Number("alive_period_ms", c.safety.alive_period_ms);
+      s->Require(c.safety.watchdog_reaction_ms == 0 ||
+                     (c.safety.watchdog_reaction_ms >= 20 && c.safety.watchdog_reaction_ms <= 1000),
+                 "watchdog_reaction_ms", "must be 0 (the default) or in [20, 1000] ms");
+      s->Require(c.safety.alive_period_ms >= 10 && c.safety.alive_period_ms <= 100,
+                 "alive_period_ms",
+                 "must be in [10, 100] ms (the controller's alive timeout is 250 ms)");
       s->Require(c.safety.watchdog_period_ms >= 1 && c.safety.watchdog_period_ms <= 50,
                  "watchdog_period_ms", "must be in [1, 50] ms (the reaction target is 50 ms)");
       s->Require(c.safety.heartbeat_timeout_ms >= 600, "heartbeat_timeout_ms",

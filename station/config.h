@@ -17,7 +17,7 @@
 //   "daq": {"driver": "sim" | ...},
 //   "sim": {...},                                    the simulated bench, when a driver is sim
 //   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500, "poll_period_ms": 10,
-//              "safe_state_retry_s": 3},
+//              "safe_state_retry_s": 3, "watchdog_reaction_ms": 0, "alive_period_ms": 50},
 //   "serial_from_stdin": false,                      a scanner typing serials into stdin
 //                                                    (its line format: station/test_request.h)
 //   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
@@ -61,6 +61,12 @@ struct SafetyOptions {
   double heartbeat_timeout_ms = 1500;  // controller heartbeat must change within this
   double poll_period_ms = 10.0;        // clamp/release confirmation polling
   double safe_state_retry_s = 3.0;     // on a fault, excitation off and unclamp retried this long
+  // Longest gap between two successful interlock reads during excitation before the
+  // watchdog calls it a stall (ERROR); 0: 4 x watchdog_period_ms, at least 100 ms.
+  double watchdog_reaction_ms = 0.0;
+  // station_alive is written this often during excitation; the controller drops the relay
+  // 250 ms after the last change (drivers/fixture/modbus_map.h).
+  double alive_period_ms = 50.0;
 };
 
 // What a token may do. Operators start tests; engineers also change and teach recipes.

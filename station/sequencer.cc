@@ -79,33 +79,6 @@ const char* ToString(SeqState s) {
   return "unknown";
 }
 
-bool HeartbeatMonitor::Update(std::uint32_t beat, Clock::time_point now) {
-  if (!last_ || *last_ != beat) {
-    last_ = beat;
-    changed_at_ = now;
-    return true;
-  }
-  return now - changed_at_ <= timeout_;
-}
-
-double HeartbeatMonitor::stale_ms(Clock::time_point now) const {
-  return std::chrono::duration<double, std::milli>(now - changed_at_).count();
-}
-
-std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& r, bool require_clamp) {
-  if (!in.estop_ok) return "emergency stop chain open";
-  if (!in.door_closed) return "door open";
-  if (!in.part_present) return "no part present";
-  if (require_clamp) {
-    if (!in.clamped) return "clamp not confirmed (clamped sensor off)";
-    if (in.clamp_pressure_bar < r.clamp_pressure_lo_bar ||
-        in.clamp_pressure_bar > r.clamp_pressure_hi_bar)
-      return "clamp pressure " + Fixed(in.clamp_pressure_bar, 2) + " bar outside " +
-             Fixed(r.clamp_pressure_lo_bar, 2) + ".." + Fixed(r.clamp_pressure_hi_bar, 2) + " bar";
-  }
-  return "";
-}
-
 // A fault that ends the test: ERROR (station fault) or ABORTED (stop requested).
 struct Sequencer::Fault {
   analysis::Outcome outcome;
@@ -123,83 +96,6 @@ struct Sequencer::MeasuredPair {
   Clock::time_point analysis_end{};
 };
 
-// Polls the interlocks while the stator is excited. On the first broken interlock it opens
-// the excitation relay itself (not waiting for the sequencer thread), then tells the DAQ
-// to stop through the shared abort flag.
-class Sequencer::Watchdog {
- public:
-  Watchdog(Sequencer& seq) : seq_(seq), thread_([this] { Run(); }) {}
-  ~Watchdog() { Stop(); }
-  // Stops the thread now, not after the rest of its period; idempotent. fault() and
-  // pressure_range() are final once it returns.
-  void Stop() {
-    {
-      std::lock_guard<std::mutex> lock(mu_);
-      stop_ = true;
-    }
-    wake_.notify_all();
-    if (thread_.joinable()) thread_.join();
-  }
-  std::optional<std::string> fault() {
-    std::lock_guard<std::mutex> lock(mu_);
-    return fault_;
-  }
-  // Clamp pressure seen during excitation (bar): {min, max}; empty before the first read.
-  std::optional<std::pair<double, double>> pressure_range() {
-    std::lock_guard<std::mutex> lock(mu_);
-    return pressure_;
-  }
-
- private:
-  void Run() {
-    const auto period =
-        std::chrono::duration<double, std::milli>(seq_.options_.safety.watchdog_period_ms);
-    while (!stop_) {
-      std::string why;
-      auto in = seq_.fixture_.ReadInputs();
-      const auto now = Clock::now();
-      if (!in.ok()) {
-        why = "fixture not answering during excitation: " + in.status().message();
-      } else {
-        {
-          std::lock_guard<std::mutex> lock(mu_);
-          const double p = in.value().clamp_pressure_bar;
-          pressure_ = pressure_ ? std::make_pair(std::min(pressure_->first, p),
-                                                 std::max(pressure_->second, p))
-                                : std::make_pair(p, p);
-        }
-        why = InterlockFault(in.value(), *seq_.recipe_, true);
-        if (why.empty() && !seq_.heartbeat_.Update(in.value().heartbeat, now))
-          why = FrozenHeartbeat(seq_.heartbeat_, now);
-      }
-      if (!why.empty()) {
-        const drivers::Status off = seq_.fixture_.Write(FixtureOutput::kExcitationEnable, false);
-        {
-          // The cause is stored before the abort wakes the sequencer, which reads it.
-          std::lock_guard<std::mutex> lock(mu_);
-          fault_ = "interlock lost during excitation: " + why;
-        }
-        seq_.abort_.store(true);
-        seq_.watchdog_trips_.fetch_add(1);
-        spdlog::error("watchdog: {}; excitation off{}", why,
-                      off.ok() ? "" : " command failed (" + off.message() + ")");
-        return;
-      }
-      std::unique_lock<std::mutex> lock(mu_);
-      wake_.wait_until(lock, now + std::chrono::duration_cast<Clock::duration>(period),
-                       [this] { return stop_.load(); });
-    }
-  }
-
-  Sequencer& seq_;
-  std::atomic<bool> stop_{false};
-  std::mutex mu_;
-  std::condition_variable wake_;
-  std::optional<std::string> fault_;
-  std::optional<std::pair<double, double>> pressure_;
-  std::thread thread_;  // last: starts after the members it uses exist
-};
-
 Sequencer::Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& store,
                      std::shared_ptr<const Recipe> recipe, StatusBoard& board,
                      SequencerOptions options)
@@ -210,6 +106,7 @@ Sequencer::Sequencer(drivers::Fixture& fixture, drivers::Daq& daq, db::Store& st
       board_(board),
       options_(std::move(options)),
       excitation_(analysis::DesignMultisine(recipe_->excitation)),
+      alive_(fixture_),
       heartbeat_(
           std::chrono::milliseconds(static_cast<long>(options_.safety.heartbeat_timeout_ms))) {}
 
@@ -268,6 +165,10 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
                   {ReasonCode::kAcquisition, "acquisition unavailable: " + s.message()}};
     }
   }
+  // The controller latches interlock drops until read (safety.h): the first read clears
+  // those from while the station stood idle between tests; from the second on, every drop
+  // counts.
+  (void)ReadInputs("check interlocks");
   const drivers::FixtureInputs in = ReadInputs("check interlocks");
   board_.SetReadiness(true, "");
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
@@ -333,24 +234,21 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size
   std::optional<drivers::StatusOr<analysis::Recording>> result;
   std::optional<std::string> watchdog_fault;
   {
-    Watchdog watchdog(*this);
-    if (const drivers::Status s = fixture_.Write(FixtureOutput::kExcitationEnable, true); !s.ok()) {
+    ExcitationWatchdog watchdog(
+        {fixture_, *recipe_, heartbeat_, alive_, options_.safety, abort_, watchdog_trips_});
+    // A fresh station_alive right before the relay closes: the controller closes it only then.
+    drivers::Status s = alive_.Fresh();
+    if (s.ok()) s = fixture_.Write(FixtureOutput::kExcitationEnable, true);
+    if (!s.ok()) {
       (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
       throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
     }
     result.emplace(daq_.Acquire(req, abort_));
+    const auto excitation_off = Clock::now();
     (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
-    watchdog.Stop();  // a trip in flight has stored its cause before this returns
+    watchdog.Stop(excitation_off);  // a trip in flight has stored its cause before this returns
     watchdog_fault = watchdog.fault();
-    // From the check right before the relay closed through the watchdog's reads (a very
-    // short acquisition may end before the watchdog's first read).
-    double p_min = in.clamp_pressure_bar, p_max = in.clamp_pressure_bar;
-    if (const auto range = watchdog.pressure_range()) {
-      p_min = std::min(p_min, range->first);
-      p_max = std::max(p_max, range->second);
-    }
-    record.conditions["clamp_pressure_min_bar"] = p_min;
-    record.conditions["clamp_pressure_max_bar"] = p_max;
+    RecordWatchdog(record, watchdog, in.clamp_pressure_bar);
   }
   record.calibration = drivers::CalibrationToJson(daq_.calibration());
   record.calibration["daq"] = daq_.name();
@@ -487,6 +385,24 @@ void Sequencer::ExtendWhileUndecided(db::TestRecord& record, drivers::PhasePair 
   }
   record.conditions["looks" + suffix] = looks;
   if (!undecided_seen.empty()) record.conditions["undecided" + suffix] = undecided_seen;
+}
+
+// From the check right before the relay closed through the watchdog's reads (a very short
+// acquisition may end before the watchdog's first read); the longest gap of its loop, the
+// largest over the test's excitations.
+void Sequencer::RecordWatchdog(db::TestRecord& record, const ExcitationWatchdog& watchdog,
+                               double pressure_before_bar) {
+  double p_min = pressure_before_bar, p_max = pressure_before_bar;
+  if (const auto range = watchdog.pressure_range()) {
+    p_min = std::min(p_min, range->first);
+    p_max = std::max(p_max, range->second);
+  }
+  record.conditions["clamp_pressure_min_bar"] = p_min;
+  record.conditions["clamp_pressure_max_bar"] = p_max;
+  const double gap = watchdog.max_gap_ms();
+  const auto& before = record.conditions["watchdog_max_gap_ms"];
+  record.conditions["watchdog_max_gap_ms"] =
+      before.is_number() ? std::max(before.get<double>(), gap) : gap;
 }
 
 void Sequencer::Judge(db::TestRecord& record, const std::vector<MeasuredPair>& measured) {

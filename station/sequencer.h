@@ -10,8 +10,10 @@
 //
 // Safety: the excitation relay is closed only after the clamp is confirmed with the pressure
 // in the recipe's window, the door closed, the emergency stop healthy and the controller's
-// heartbeat alive; a watchdog thread re-checks all of them every watchdog_period_ms while
-// the stator is excited and opens the relay the moment one drops. ERROR is never a PASS,
+// heartbeat alive; a watchdog thread (station/safety.h) re-checks all of them every
+// watchdog_period_ms while the stator is excited, writes the station-alive signal without
+// which the controller drops the relay by itself, checks its own loop for stalls, and
+// opens the relay the moment anything fails. ERROR is never a PASS,
 // and the verdict is published only after the record is durably stored.
 #pragma once
 
@@ -31,6 +33,7 @@
 #include "drivers/fixture/fixture.h"
 #include "station/config.h"
 #include "station/recipe.h"
+#include "station/safety.h"
 #include "station/status_board.h"
 
 namespace eol::station {
@@ -50,25 +53,6 @@ enum class SeqState {
   kConfirmRelease,  // after publish, with SequencerOptions::publish_before_release only
 };
 const char* ToString(SeqState s);
-
-// Tracks the fixture controller's heartbeat counter: alive while it keeps changing.
-class HeartbeatMonitor {
- public:
-  explicit HeartbeatMonitor(std::chrono::milliseconds timeout) : timeout_(timeout) {}
-  // Returns false once the counter has not changed for longer than the timeout.
-  bool Update(std::uint32_t beat, std::chrono::steady_clock::time_point now);
-  double stale_ms(std::chrono::steady_clock::time_point now) const;
-
- private:
-  std::chrono::milliseconds timeout_;
-  std::optional<std::uint32_t> last_;
-  std::chrono::steady_clock::time_point changed_at_{};
-};
-
-// Empty when every interlock for exciting the stator holds; otherwise the first one broken,
-// named with its value ("door open", "clamp pressure 3.10 bar outside 4.50..6.50 bar").
-std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& recipe,
-                           bool require_clamp);
 
 struct SequencerOptions {
   std::string station_id = "eol-1";
@@ -119,7 +103,6 @@ class Sequencer {
 
  private:
   struct Fault;
-  class Watchdog;
 
   void Enter(db::TestRecord& record, SeqState s, const std::string& detail = "");
   drivers::FixtureInputs ReadInputs(const char* purpose);
@@ -147,6 +130,9 @@ class Sequencer {
   // The verdict of every pair measured, by the one judge (station/judge.h): the sequencer
   // decides nothing about the motor itself.
   void Judge(db::TestRecord& record, const std::vector<MeasuredPair>& measured);
+  // The watchdog's pressure range and longest loop gap into the conditions.
+  void RecordWatchdog(db::TestRecord& record, const ExcitationWatchdog& watchdog,
+                      double pressure_before_bar);
   // Commands the release and polls until the controller's heartbeat after excitation has
   // been seen and, when `until_released`, the clamp reads released.
   void Unclamp(db::TestRecord& record, bool until_released);
@@ -172,6 +158,7 @@ class Sequencer {
   StatusBoard& board_;
   SequencerOptions options_;
   analysis::Excitation excitation_;  // designed from the recipe
+  AliveSignal alive_;                // the fixture's station_alive counter
   HeartbeatMonitor heartbeat_;
   // The heartbeat read right after the last excitation ended; Unclamp waits for a newer one.
   std::optional<std::uint32_t> beat_after_excitation_;

@@ -86,7 +86,7 @@ void CanFixtureNode::Serve() {
         next_status += period;
         if (next_status < Clock::now()) next_status = Clock::now() + period;
       }
-      const std::uint32_t beat = bench_->ReadInputs().heartbeat;
+      const std::uint32_t beat = bench_->PeekInputs().heartbeat;  // latches: status frames
       const bool frozen = bench_->FaultActive(SimFault::kHeartbeatFreezes);
       if (!frozen && (!last_beat || beat != *last_beat || Clock::now() >= next_heartbeat)) {
         SendHeartbeat(beat);
@@ -129,8 +129,14 @@ void CanFixtureNode::Apply(const CanFrame& f) {
     spdlog::info("fixture server: clamp closing on an empty fixture: loaded part {}", serial);
   }
   bench_->SelectPhasePair(static_cast<PhasePair>(pair));
+  // Before the outputs: a frame that sets excitation_enable carries the fresh alive value.
+  bench_->WriteAlive(static_cast<std::uint16_t>(GetField(d, m.station_alive)));
   bench_->Write(FixtureOutput::kClampCmd, clamp);
-  bench_->Write(FixtureOutput::kExcitationEnable, GetField(d, m.excitation_enable) != 0);
+  // Every frame carries excitation_enable: only its rising edge is a command to close the
+  // relay (can_map.h), so a relay the alive rule opened stays open until commanded again.
+  const bool excite = GetField(d, m.excitation_enable) != 0;
+  if (!excite || !excitation_cmd_) bench_->Write(FixtureOutput::kExcitationEnable, excite);
+  excitation_cmd_ = excite;
   bench_->Write(FixtureOutput::kLampPass, GetField(d, m.lamp_pass) != 0);
   bench_->Write(FixtureOutput::kLampFail, GetField(d, m.lamp_fail) != 0);
 }

@@ -105,6 +105,37 @@ const ModbusSignalSpec* OutputAt(const ModbusMap& map, ModbusTable table, int ad
   return nullptr;
 }
 
+// The addresses a read request covers; nullopt for anything else.
+struct ReadRequest {
+  ModbusTable table;
+  int first;
+  int count;
+};
+std::optional<ReadRequest> ReadRange(const std::uint8_t* pdu, int n) {
+  if (n < 5) return std::nullopt;
+  const int first = (pdu[1] << 8) | pdu[2], count = (pdu[3] << 8) | pdu[4];
+  switch (pdu[0]) {
+    case MODBUS_FC_READ_COILS:
+      return ReadRequest{ModbusTable::kCoil, first, count};
+    case MODBUS_FC_READ_DISCRETE_INPUTS:
+      return ReadRequest{ModbusTable::kDiscreteInput, first, count};
+    case MODBUS_FC_READ_HOLDING_REGISTERS:
+      return ReadRequest{ModbusTable::kHoldingRegister, first, count};
+    case MODBUS_FC_READ_INPUT_REGISTERS:
+      return ReadRequest{ModbusTable::kInputRegister, first, count};
+    default:
+      return std::nullopt;
+  }
+}
+
+// The clear-on-read interlock latches (modbus_map.h), by signal.
+constexpr std::pair<ModbusSignal ModbusMap::*, SimLatch> kLatchedInputs[] = {
+    {&ModbusMap::clamped, SimLatch::kClamped},
+    {&ModbusMap::door_closed, SimLatch::kDoorClosed},
+    {&ModbusMap::estop_ok, SimLatch::kEstopOk},
+    {&ModbusMap::clamp_pressure, SimLatch::kClampPressure},
+};
+
 }  // namespace
 
 ModbusFixtureServer::ModbusFixtureServer(std::shared_ptr<SimBench> bench,
@@ -289,7 +320,9 @@ void ModbusFixtureServer::Handle(const unsigned char* request, int length) {
     return;
   }
   try {
+    const auto refreshed_at = bench_->now();
     RefreshMapping();
+    ClearLatchesRead(request + header, length - header, refreshed_at);
     const auto writes = DecodeWrites(request + header, length - header);
     const auto in_mapping = [this](const TableWrite& w) {
       const bool coil = w.table == ModbusTable::kCoil;
@@ -312,6 +345,10 @@ void ModbusFixtureServer::Handle(const unsigned char* request, int length) {
           bench_->SelectPhasePair(static_cast<PhasePair>(w.value));
           continue;
         }
+        if (spec->member == &ModbusMap::station_alive) {
+          bench_->WriteAlive(static_cast<std::uint16_t>(w.value));
+          continue;
+        }
         const FixtureOutput output = *OutputOf(*spec);
         const bool on = w.value != 0;
         if (output == FixtureOutput::kClampCmd && on && settings_.load_part_on_clamp &&
@@ -329,8 +366,20 @@ void ModbusFixtureServer::Handle(const unsigned char* request, int length) {
   modbus_reply(ctx_, request, length, mapping_);
 }
 
+void ModbusFixtureServer::ClearLatchesRead(const unsigned char* pdu, int n,
+                                           SimBench::Clock::time_point as_of) {
+  const auto range = ReadRange(pdu, n);
+  if (!range) return;
+  for (const auto& [member, latch] : kLatchedInputs) {
+    const ModbusSignal& s = settings_.map.*member;
+    if (s.table == range->table && s.address >= range->first &&
+        s.address < range->first + range->count)
+      bench_->ClearLatch(latch, as_of);
+  }
+}
+
 void ModbusFixtureServer::RefreshMapping() {
-  const FixtureInputs in = bench_->ReadInputs();
+  const FixtureInputs in = bench_->PeekInputs();
   const ModbusMap& map = settings_.map;
   for (const ModbusSignalSpec& spec : ModbusSignals()) {
     int value = 0;
@@ -339,6 +388,8 @@ void ModbusFixtureServer::RefreshMapping() {
       value = bench_->output(*output) ? 1 : 0;
     } else if (m == &ModbusMap::phase_pair) {
       value = static_cast<int>(bench_->phase_pair());
+    } else if (m == &ModbusMap::station_alive) {
+      value = bench_->alive().value_or(0);
     } else if (m == &ModbusMap::clamped) {
       value = in.clamped;
     } else if (m == &ModbusMap::released) {

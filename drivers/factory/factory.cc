@@ -36,6 +36,11 @@ SimBenchSettings ParseSimBenchSettings(const io::JsonObject& o) {
   o.Require(
       s.clamp_pressure_spread_bar >= 0 && s.clamp_pressure_spread_bar <= 0.1 * s.clamp_pressure_bar,
       "clamp_pressure_spread_bar", "must be in [0, 10 % of clamp_pressure_bar] (bar)");
+  s.alive_timeout_ms = o.Number("alive_timeout_ms", s.alive_timeout_ms);
+  o.Require(
+      s.alive_timeout_ms == 0 || (s.alive_timeout_ms >= 100 && s.alive_timeout_ms <= 1000),
+      "alive_timeout_ms",
+      "must be 0 (no station-alive rule) or in [100, 1000] ms (drivers/fixture/modbus_map.h)");
   s.fixture_pressure_exponent = o.Number("fixture_pressure_exponent", s.fixture_pressure_exponent);
   o.Require(s.fixture_pressure_exponent >= 0 && s.fixture_pressure_exponent <= 1,
             "fixture_pressure_exponent", "must be in [0, 1] (k_fixture ~ p^exponent)");

@@ -16,8 +16,9 @@
 //   "sim":     {"population": {...}, "clamp_close_s": 0.15, ...,   the simulated bench
 //               "masters": [{"serial": "MASTER-G"}, {"serial": "MASTER-L", "defective": true}],
 //               "fixture_wear_per_test": 0.001,
-//               "clamp_pressure_spread_bar": 0.3, "fixture_pressure_exponent": 0.333}
-//                                                                  (sim_bench.h)
+//               "clamp_pressure_spread_bar": 0.3, "fixture_pressure_exponent": 0.333,
+//               "alive_timeout_ms": 250}                          (sim_bench.h; 0 turns the
+//                                                   controller's station-alive rule off)
 //
 // A simulator is chosen exactly as real hardware is. A driver that was not compiled in, or
 // an unknown name, fails with a io::ConfigError naming the path and the known drivers.

@@ -36,7 +36,9 @@ std::optional<SimFault> ParseSimFault(const std::string& s) {
 }
 
 SimBench::SimBench(SimBenchSettings settings, SimClock now)
-    : settings_(std::move(settings)), now_(std::move(now)), born_(now_()) {}
+    : settings_(std::move(settings)), now_(std::move(now)), born_(now_()) {
+  latch_since_.fill(born_);
+}
 
 void SimBench::LoadPart(const std::string& serial) {
   analysis::SimUnit unit;
@@ -100,20 +102,42 @@ bool SimBench::FaultActiveLocked(SimFault fault, Clock::time_point now) const {
   return !fault_->duration || now < *visible + *fault_->duration;
 }
 
+bool SimBench::FaultSeenLocked(SimFault fault, Clock::time_point since,
+                               Clock::time_point now) const {
+  if (!fault_ || fault_->fault != fault) return false;
+  const auto visible = FaultVisibleAtLocked();
+  if (!visible || now < *visible) return false;
+  return !fault_->duration || *visible + *fault_->duration > since;
+}
+
 void SimBench::CheckAnsweringLocked(Clock::time_point now) const {
   if (FaultActiveLocked(SimFault::kStopsAnswering, now))
     throw DeviceError("no answer from the fixture controller (simulated: stops_answering)");
 }
 
-FixtureInputs SimBench::ReadInputs() {
-  std::lock_guard<std::mutex> lock(mu_);
-  const auto now = now_();
-  CheckAnsweringLocked(now);
+bool SimBench::AliveFreshLocked(Clock::time_point now) const {
+  if (settings_.alive_timeout_ms <= 0.0) return true;
+  return alive_changed_at_ && now - *alive_changed_at_ <= std::chrono::duration<double, std::milli>(
+                                                              settings_.alive_timeout_ms);
+}
+
+void SimBench::ExpireAliveLocked(Clock::time_point now) const {
+  if (!excitation_ || AliveFreshLocked(now)) return;
+  excitation_ = false;
+  // The controller opened the relay the moment the alive value went stale.
+  excitation_off_at_ = *alive_changed_at_ +
+                       std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double, std::milli>(settings_.alive_timeout_ms));
+}
+
+// The inputs at `now`, each latched interlock reporting a drop seen since its latch_since_.
+FixtureInputs SimBench::InputsLocked(Clock::time_point now) const {
+  const auto since = [this](SimLatch l) { return latch_since_[static_cast<std::size_t>(l)]; };
   FixtureInputs in;
   const double since_cmd = clamp_cmd_at_
                                ? std::chrono::duration<double>(now - *clamp_cmd_at_).count()
                                : std::numeric_limits<double>::infinity();
-  const bool dropped = FaultActiveLocked(SimFault::kClampDrops, now);
+  const bool dropped = FaultSeenLocked(SimFault::kClampDrops, since(SimLatch::kClamped), now);
   if (clamp_cmd_) {
     in.clamped = part_.has_value() && since_cmd >= settings_.clamp_close_s && !dropped;
     in.released = false;
@@ -127,11 +151,12 @@ FixtureInputs SimBench::ReadInputs() {
         since_cmd >= settings_.clamp_open_s && !FaultActiveLocked(SimFault::kClampSticks, now);
     in.clamp_pressure_bar = 0.0;
   }
-  if (dropped) in.clamp_pressure_bar = 0.0;
-  if (FaultActiveLocked(SimFault::kPressureLow, now)) in.clamp_pressure_bar = 1.0;
+  const auto pressure_since = since(SimLatch::kClampPressure);
+  if (FaultSeenLocked(SimFault::kClampDrops, pressure_since, now)) in.clamp_pressure_bar = 0.0;
+  if (FaultSeenLocked(SimFault::kPressureLow, pressure_since, now)) in.clamp_pressure_bar = 1.0;
   in.part_present = part_.has_value();
-  in.door_closed = !FaultActiveLocked(SimFault::kDoorOpens, now);
-  in.estop_ok = !FaultActiveLocked(SimFault::kEstop, now);
+  in.door_closed = !FaultSeenLocked(SimFault::kDoorOpens, since(SimLatch::kDoorClosed), now);
+  in.estop_ok = !FaultSeenLocked(SimFault::kEstop, since(SimLatch::kEstopOk), now);
   const double alive_s = std::chrono::duration<double>(now - born_).count();
   const auto beat = static_cast<std::uint32_t>(alive_s / settings_.heartbeat_period_s);
   if (FaultActiveLocked(SimFault::kHeartbeatFreezes, now)) {
@@ -141,6 +166,45 @@ FixtureInputs SimBench::ReadInputs() {
     frozen_heartbeat_ = beat;
   }
   return in;
+}
+
+FixtureInputs SimBench::ReadInputs() {
+  std::lock_guard<std::mutex> lock(mu_);
+  const auto now = now_();
+  CheckAnsweringLocked(now);
+  ExpireAliveLocked(now);
+  const FixtureInputs in = InputsLocked(now);
+  latch_since_.fill(now);
+  return in;
+}
+
+FixtureInputs SimBench::PeekInputs() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  const auto now = now_();
+  CheckAnsweringLocked(now);
+  ExpireAliveLocked(now);
+  return InputsLocked(now);
+}
+
+void SimBench::ClearLatch(SimLatch latch, Clock::time_point as_of) {
+  std::lock_guard<std::mutex> lock(mu_);
+  auto& since = latch_since_[static_cast<std::size_t>(latch)];
+  since = std::max(since, as_of);
+}
+
+void SimBench::WriteAlive(std::uint16_t value) {
+  std::lock_guard<std::mutex> lock(mu_);
+  const auto now = now_();
+  CheckAnsweringLocked(now);
+  ExpireAliveLocked(now);  // a stale relay opened before this change, not kept by it
+  if (alive_ && *alive_ == value) return;
+  alive_ = value;
+  alive_changed_at_ = now;
+}
+
+std::optional<std::uint16_t> SimBench::alive() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return alive_;
 }
 
 void SimBench::Write(FixtureOutput output, bool on) {
@@ -156,6 +220,7 @@ void SimBench::Write(FixtureOutput output, bool on) {
     throw DeviceError(std::string("no answer from the fixture controller writing ") +
                       ToString(output) + " (simulated: stops_answering)");
   }
+  ExpireAliveLocked(now);
   switch (output) {
     case FixtureOutput::kClampCmd:
       if (on != clamp_cmd_) {
@@ -164,6 +229,8 @@ void SimBench::Write(FixtureOutput output, bool on) {
       }
       break;
     case FixtureOutput::kExcitationEnable:
+      // Without a fresh alive change the controller does not close the relay.
+      if (on && !excitation_ && !AliveFreshLocked(now)) break;
       if (on && !excitation_ && fault_ && fault_->on_excitation && !fault_->triggered_at)
         fault_->triggered_at = now;
       if (!on && excitation_) excitation_off_at_ = now;
@@ -186,6 +253,7 @@ void SimBench::SelectPhasePair(PhasePair pair) {
 
 bool SimBench::output(FixtureOutput o) const {
   std::lock_guard<std::mutex> lock(mu_);
+  ExpireAliveLocked(now_());
   switch (o) {
     case FixtureOutput::kClampCmd:
       return clamp_cmd_;
@@ -206,11 +274,13 @@ PhasePair SimBench::phase_pair() const {
 
 bool SimBench::excitation_connected() const {
   std::lock_guard<std::mutex> lock(mu_);
+  ExpireAliveLocked(now_());
   return excitation_;
 }
 
 std::optional<SimBench::Clock::time_point> SimBench::last_excitation_off() const {
   std::lock_guard<std::mutex> lock(mu_);
+  ExpireAliveLocked(now_());
   return excitation_off_at_;
 }
 

@@ -50,6 +50,10 @@ struct SimBenchSettings {
   // resonance (analysis/qc/f0_pressure.h) takes out.
   double clamp_pressure_spread_bar = 0.0;
   double fixture_pressure_exponent = 1.0 / 3.0;
+  // The controller's station-alive rule (drivers/fixture/modbus_map.h): the excitation relay
+  // closes, and stays closed, only while the station's alive value changed within this
+  // time; 0 switches the rule off (a controller not programmed for it).
+  double alive_timeout_ms = 250.0;
 };
 
 enum class SimFault {
@@ -70,6 +74,10 @@ inline constexpr std::array<SimFault, 8> kSimFaults = {
 const char* ToString(SimFault f);
 std::optional<SimFault> ParseSimFault(const std::string& s);
 
+// The latched interlock inputs, each with its own clear-on-read latch.
+enum class SimLatch { kClamped = 0, kDoorClosed, kEstopOk, kClampPressure };
+inline constexpr int kSimLatchCount = 4;
+
 class SimBench {
  public:
   using Clock = std::chrono::steady_clock;
@@ -85,12 +93,32 @@ class SimBench {
   std::optional<analysis::SimUnit> part() const;
 
   // Fixture side. ReadInputs throws DeviceError while kStopsAnswering is active.
+  // Interlock latch (the controller's required behaviour, modbus_map.h): a drop of
+  // door_closed, estop_ok or clamped, or clamp pressure out of its steady value, that
+  // happened at any time since the previous ReadInputs is reported by this one even when
+  // it has gone again (clear-on-read). PeekInputs shows the same without clearing the latches
+  // (an emulator's refresh, another observer); ClearLatch clears one (an emulator, when the
+  // station's read request covered that signal).
   FixtureInputs ReadInputs();
+  FixtureInputs PeekInputs() const;
+  // Clears one as of `as_of` (taken before the reply was built, so that a drop after it is
+  // reported again rather than lost).
+  void ClearLatch(SimLatch latch, Clock::time_point as_of);
+  // The bench's clock.
+  Clock::time_point now() const { return now_(); }
+  // The station's alive value (station_alive). A value other than the last one received is
+  // a change; it keeps a closed relay closed for alive_timeout_ms and lets an excitation
+  // command close it.
+  void WriteAlive(std::uint16_t value);
+  std::optional<std::uint16_t> alive() const;
   void Write(FixtureOutput output, bool on);
   void SelectPhasePair(PhasePair pair);
   bool output(FixtureOutput o) const;
   PhasePair phase_pair() const;
   // True while the relay connects the amplifier to the motor: commanded on and not yet cut.
+  // Every observer of the relay (this, output(kExcitationEnable), ReadInputs, Write)
+  // first applies the alive rule at the bench's now: a relay whose alive change is older
+  // than alive_timeout_ms is open, opened at that change + alive_timeout_ms.
   bool excitation_connected() const;
   // When the excitation relay last opened (for reaction-time measurements).
   std::optional<Clock::time_point> last_excitation_off() const;
@@ -108,7 +136,13 @@ class SimBench {
 
  private:
   bool FaultActiveLocked(SimFault fault, Clock::time_point now) const;
+  // True when the fault was active at any time in [since, now].
+  bool FaultSeenLocked(SimFault fault, Clock::time_point since, Clock::time_point now) const;
   void CheckAnsweringLocked(Clock::time_point now) const;
+  FixtureInputs InputsLocked(Clock::time_point now) const;
+  // The alive rule, evaluated lazily: opens a relay whose alive change is too old.
+  void ExpireAliveLocked(Clock::time_point now) const;
+  bool AliveFreshLocked(Clock::time_point now) const;
 
   SimBenchSettings settings_;
   const SimClock now_;
@@ -118,11 +152,15 @@ class SimBench {
   std::uint64_t parts_loaded_ = 0;
   bool clamp_cmd_ = false;
   std::optional<Clock::time_point> clamp_cmd_at_;  // none: never commanded, long released
-  bool excitation_ = false;
+  mutable bool excitation_ = false;
   bool lamp_pass_ = false, lamp_fail_ = false;
   PhasePair pair_ = PhasePair::kUV;
-  std::optional<Clock::time_point> excitation_off_at_;
+  mutable std::optional<Clock::time_point> excitation_off_at_;
   const Clock::time_point born_;
+  std::optional<std::uint16_t> alive_;
+  std::optional<Clock::time_point> alive_changed_at_;
+  // Per SimLatch: the previous ReadInputs (or ClearLatch) of that input.
+  std::array<Clock::time_point, kSimLatchCount> latch_since_;
 
   struct PendingFault {
     SimFault fault;
@@ -134,7 +172,7 @@ class SimBench {
   };
   std::optional<Clock::time_point> FaultVisibleAtLocked() const;
   std::optional<PendingFault> fault_;
-  std::uint32_t frozen_heartbeat_ = 0;
+  mutable std::uint32_t frozen_heartbeat_ = 0;
 };
 
 }  // namespace eol::drivers

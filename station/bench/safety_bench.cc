@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <random>
+#include <thread>
 
 #include "drivers/emulators/modbus_fixture_server.h"
 #include "drivers/fixture/modbus_fixture.h"
 #include "drivers/sim/sim_daq.h"
 #include "drivers/sim/sim_fixture.h"
+#include "station/safety.h"
 #include "station/sequencer.h"
 
 namespace eol::station {
@@ -47,6 +50,60 @@ double Percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   const auto i = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
   return v[std::min(i, v.size() - 1)];
+}
+
+void Summarise(std::vector<double> reactions, ReactionStats* st) {
+  st->measured = static_cast<int>(reactions.size());
+  if (reactions.empty()) return;
+  st->min_ms = *std::min_element(reactions.begin(), reactions.end());
+  st->median_ms = Percentile(reactions, 0.5);
+  st->p95_ms = Percentile(reactions, 0.95);
+  st->max_ms = *std::max_element(reactions.begin(), reactions.end());
+}
+
+// One trial of "station_stops": the station closes the relay, writes station_alive every
+// alive period for 100..400 ms, then stops dead (as a SIGKILL leaves it: nothing more is
+// sent). Returns the ms from its last alive write to the relay seen open by an observer
+// polling the controller every millisecond; nullopt when it stayed closed for 2 s.
+std::optional<double> StationStopsOnce(const SafetyBenchOptions& o, std::mt19937_64& rng) {
+  using Clock = std::chrono::steady_clock;
+  auto bench = std::make_shared<drivers::SimBench>(drivers::SimBenchSettings{});
+  bench->LoadPart("SB-STOP");
+  BenchFixture bench_fixture = MakeFixture(o.fixture, bench);
+  drivers::Fixture& fixture = *bench_fixture.fixture;
+  AliveSignal alive(fixture);
+  if (!fixture.Connect().ok() || !fixture.Activate().ok() || !alive.Fresh().ok() ||
+      !fixture.Write(drivers::FixtureOutput::kExcitationEnable, true).ok())
+    return std::nullopt;
+  const auto live_for =
+      std::chrono::milliseconds(std::uniform_int_distribution<int>(100, 400)(rng));
+  const auto start = Clock::now();
+  auto last_alive = start;
+  while (Clock::now() - start < live_for) {
+    std::this_thread::sleep_for(
+        std::chrono::milliseconds(static_cast<int>(SafetyOptions{}.alive_period_ms)));
+    if (alive.Beat().ok()) last_alive = Clock::now();
+  }
+  while (bench->output(drivers::FixtureOutput::kExcitationEnable)) {
+    if (Clock::now() - last_alive > std::chrono::seconds(2)) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return std::chrono::duration<double, std::milli>(Clock::now() - last_alive).count();
+}
+
+ReactionStats MeasureStationStops(const SafetyBenchOptions& o, std::mt19937_64& rng) {
+  ReactionStats st;
+  st.fault = "station_stops";
+  std::vector<double> reactions;
+  for (int t = 0; t < o.trials_per_fault; ++t) {
+    ++st.trials;
+    if (const auto ms = StationStopsOnce(o, rng)) {
+      ++st.errors;  // here: the controller opened the relay by itself
+      reactions.push_back(*ms);
+    }
+  }
+  Summarise(std::move(reactions), &st);
+  return st;
 }
 
 }  // namespace
@@ -96,15 +153,10 @@ std::vector<ReactionStats> RunSafetyBench(const SafetyBenchOptions& o) {
                                 *bench->last_excitation_off() - *bench->fault_visible_at())
                                 .count());
     }
-    st.measured = static_cast<int>(reactions.size());
-    if (!reactions.empty()) {
-      st.min_ms = *std::min_element(reactions.begin(), reactions.end());
-      st.median_ms = Percentile(reactions, 0.5);
-      st.p95_ms = Percentile(reactions, 0.95);
-      st.max_ms = *std::max_element(reactions.begin(), reactions.end());
-    }
+    Summarise(std::move(reactions), &st);
     out.push_back(st);
   }
+  out.push_back(MeasureStationStops(o, rng));
   store.reset();
   std::filesystem::remove(db_path);
   std::filesystem::remove(db_path + "-wal");

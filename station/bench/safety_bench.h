@@ -2,6 +2,12 @@
 // fault (clamp dropped, pressure out of window, door open, emergency stop) to the excitation
 // relay opening, over many tests on the simulated bench with the real sequencer and watchdog.
 // Target (issue 5): excitation off within 50 ms.
+//
+// A fifth row, "station_stops", measures the controller's side (issue 34): the station
+// closes the relay, writes station_alive for 100..400 ms, then stops dead as a SIGKILL
+// leaves it; the reaction is from its last alive write to the relay seen open (polled every
+// ms), against the controller's alive timeout of 250 ms. Its `errors` counts the trials in
+// which the controller opened the relay by itself (should be all of them).
 #pragma once
 
 #include <cstdint>

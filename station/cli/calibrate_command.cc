@@ -10,6 +10,7 @@
 #include <atomic>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include "analysis/signal/multisine.h"
 #include "analysis/signal/reference_calibration.h"
@@ -21,6 +22,7 @@
 #include "station/cli/common.h"
 #include "station/config.h"
 #include "station/recipe.h"
+#include "station/safety.h"
 
 namespace eol::station::cli {
 namespace {
@@ -33,8 +35,8 @@ struct CalibrateArgs {
 };
 
 // Connects, closes the excitation relay while the interlocks hold, acquires, opens it again.
-analysis::Recording AcquireReference(drivers::DriverSet& d,
-                                     const drivers::AcquisitionRequest& req) {
+analysis::Recording AcquireReference(drivers::DriverSet& d, const drivers::AcquisitionRequest& req,
+                                     const SafetyOptions& safety) {
   if (drivers::Status s = d.fixture->Connect(); !s.ok()) throw std::runtime_error(s.message());
   if (drivers::Status s = d.fixture->Activate(); !s.ok()) throw std::runtime_error(s.message());
   if (drivers::Status s = d.daq->Connect(); !s.ok()) throw std::runtime_error(s.message());
@@ -42,14 +44,22 @@ analysis::Recording AcquireReference(drivers::DriverSet& d,
   if (!in.ok()) throw std::runtime_error(in.status().message());
   if (!in.value().estop_ok) throw std::runtime_error("emergency stop chain open: not exciting");
   if (!in.value().door_closed) throw std::runtime_error("door open: not exciting");
-  if (drivers::Status s = d.fixture->Write(drivers::FixtureOutput::kExcitationEnable, true);
-      !s.ok()) {
+  // The controller keeps the relay closed only while station_alive changes (safety.h).
+  AliveSignal alive(*d.fixture);
+  std::optional<drivers::StatusOr<analysis::Recording>> acquired;
+  {
+    if (drivers::Status s = alive.Fresh(); !s.ok()) throw std::runtime_error(s.message());
+    AlivePump pump(alive, safety.alive_period_ms);
+    if (drivers::Status s = d.fixture->Write(drivers::FixtureOutput::kExcitationEnable, true);
+        !s.ok()) {
+      (void)d.fixture->Write(drivers::FixtureOutput::kExcitationEnable, false);
+      throw std::runtime_error(s.message());
+    }
+    const std::atomic<bool> abort{false};
+    acquired.emplace(d.daq->Acquire(req, abort));
     (void)d.fixture->Write(drivers::FixtureOutput::kExcitationEnable, false);
-    throw std::runtime_error(s.message());
   }
-  const std::atomic<bool> abort{false};
-  auto result = d.daq->Acquire(req, abort);
-  (void)d.fixture->Write(drivers::FixtureOutput::kExcitationEnable, false);
+  auto& result = *acquired;
   (void)d.fixture->Deactivate();
   if (!result.ok()) throw std::runtime_error("acquisition failed: " + result.status().message());
   return std::move(result.value());
@@ -66,7 +76,7 @@ int RunCalibrate(const CalibrateArgs& a) {
   req.excitation_v = excitation.Repeat(recipe.transient_periods + recipe.periods);
 
   const drivers::Calibration used = d.daq->calibration();
-  const analysis::Recording rec = AcquireReference(d, req);
+  const analysis::Recording rec = AcquireReference(d, req, config.safety);
   d.daq->Disconnect();
   d.fixture->Disconnect();
 

@@ -43,12 +43,15 @@ void AddSafetyBenchCommand(CLI::App& app) {
         std::cout << ToJson(stats).dump(2) << std::endl;
         return 0;
       }
-      std::printf("fixture %s, watchdog period %.1f ms; reaction = relay open - fault visible\n",
-                  o->fixture.c_str(), o->watchdog_period_ms);
-      std::printf("%-12s %6s %6s %8s %8s %8s %8s\n", "fault", "tests", "ERROR", "min ms", "median",
+      std::printf(
+          "fixture %s, watchdog period %.1f ms; reaction = relay open - fault visible\n"
+          "(station_stops: relay open - the station's last station_alive write; ERROR = relays "
+          "the controller opened by itself)\n",
+          o->fixture.c_str(), o->watchdog_period_ms);
+      std::printf("%-13s %6s %6s %8s %8s %8s %8s\n", "fault", "tests", "ERROR", "min ms", "median",
                   "p95", "max");
       for (const auto& s : stats)
-        std::printf("%-12s %6d %6d %8.2f %8.2f %8.2f %8.2f\n", s.fault.c_str(), s.trials, s.errors,
+        std::printf("%-13s %6d %6d %8.2f %8.2f %8.2f %8.2f\n", s.fault.c_str(), s.trials, s.errors,
                     s.min_ms, s.median_ms, s.p95_ms, s.max_ms);
       return 0;
     });

@@ -96,6 +96,7 @@ TEST_F(CanFixtureTest, EveryWriteCarriesTheWholeCommand) {
   ASSERT_TRUE(fixture.Activate().ok());
   ASSERT_TRUE(fixture.Write(FixtureOutput::kClampCmd, true).ok());
   ASSERT_TRUE(fixture.SelectPhasePair(PhasePair::kVW).ok());
+  ASSERT_TRUE(fixture.WriteAlive(1).ok());
   ASSERT_TRUE(fixture.Write(FixtureOutput::kExcitationEnable, true).ok());
   EXPECT_EQ(bench_->phase_pair(), PhasePair::kVW) << "each command carries the phase pair";
   ASSERT_TRUE(fixture.Write(FixtureOutput::kLampPass, true).ok());
@@ -178,6 +179,7 @@ TEST_F(CanFixtureTest, StopsAnsweringNamesTheTimeoutAndDropsTheRelay) {
   CanFixture fixture(settings_);
   ASSERT_TRUE(fixture.Connect().ok());
   ASSERT_TRUE(fixture.Activate().ok());
+  ASSERT_TRUE(fixture.WriteAlive(1).ok());
   ASSERT_TRUE(fixture.Write(FixtureOutput::kExcitationEnable, true).ok());
   ASSERT_TRUE(bench_->excitation_connected());
   bench_->InjectFault(SimFault::kStopsAnswering, 0ms, /*on_excitation=*/false);
@@ -206,6 +208,7 @@ TEST_F(CanFixtureTest, LampWriteNeverReenergisesADroppedRelay) {
   CanFixture fixture(settings_);
   ASSERT_TRUE(fixture.Connect().ok());
   ASSERT_TRUE(fixture.Activate().ok());
+  ASSERT_TRUE(fixture.WriteAlive(1).ok());
   ASSERT_TRUE(fixture.Write(FixtureOutput::kExcitationEnable, true).ok());
   bench_->InjectFault(SimFault::kStopsAnswering, 0ms, /*on_excitation=*/false);
   ASSERT_FALSE(ReadUntilError(fixture).ok());
@@ -296,7 +299,7 @@ TEST(CanMapTest, DefaultMapMatchesTheReadme) {
   EXPECT_EQ(m.command_id(), 0x201u);
   EXPECT_EQ(m.status_id(), 0x181u);
   EXPECT_EQ(m.heartbeat_id(), 0x701u);
-  EXPECT_EQ(m.Dlc(CanFrameKind::kCommand), 3);
+  EXPECT_EQ(m.Dlc(CanFrameKind::kCommand), 4);  // with station_alive
   EXPECT_EQ(m.Dlc(CanFrameKind::kStatus), 6);
   EXPECT_EQ(m.Dlc(CanFrameKind::kHeartbeat), 2);
   std::uint8_t d[8] = {};

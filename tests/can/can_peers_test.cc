@@ -124,6 +124,7 @@ TEST(CanPeersTest, DriverAgainstPythonCanNode) {
   EXPECT_FALSE(in.value().released);
   EXPECT_DOUBLE_EQ(in.value().clamp_pressure_bar, 5.37);  // 537 counts of 0.01 bar
   ASSERT_TRUE(fixture.SelectPhasePair(PhasePair::kWU).ok());
+  ASSERT_TRUE(fixture.WriteAlive(1).ok());
   ASSERT_TRUE(fixture.Write(FixtureOutput::kExcitationEnable, true).ok());
   ASSERT_TRUE(fixture.Write(FixtureOutput::kLampFail, true).ok());
   const auto heartbeat = in.value().heartbeat;
@@ -131,13 +132,14 @@ TEST(CanPeersTest, DriverAgainstPythonCanNode) {
   ASSERT_TRUE(in.ok()) << in.status().message();
   EXPECT_NE(in.value().heartbeat, heartbeat);
 
-  node->WaitFor([](const std::string& o) { return Commands(o).size() >= 5; }, 5s);
+  node->WaitFor([](const std::string& o) { return Commands(o).size() >= 6; }, 5s);
   const auto commands = Commands(node->output());
-  // Connect (excitation off), clamp, phase pair, excitation, lamp: the full state each time,
-  // the counter counting.
-  ASSERT_EQ(commands.size(), 5u) << node->output();
-  const std::vector<std::vector<int>> expected = {
-      {0x00, 0, 1}, {0x01, 0, 2}, {0x01, 2, 3}, {0x03, 2, 4}, {0x0B, 2, 5}};
+  // Connect (excitation off), clamp, phase pair, station_alive, excitation, lamp: the full
+  // state each time, the counter counting, the alive value carried on.
+  ASSERT_EQ(commands.size(), 6u) << node->output();
+  const std::vector<std::vector<int>> expected = {{0x00, 0, 1, 0}, {0x01, 0, 2, 0},
+                                                  {0x01, 2, 3, 0}, {0x01, 2, 4, 1},
+                                                  {0x03, 2, 5, 1}, {0x0B, 2, 6, 1}};
   EXPECT_EQ(commands, expected);
 }
 
@@ -266,15 +268,16 @@ TEST(CanPeersTest, FixtureSimAgainstCansendAndCandump) {
   ASSERT_TRUE(sim->WaitFor(
       [](const std::string& o) { return o.find("malformed command frame 0x201") != o.npos; }, 10s))
       << sim->output();
-  EXPECT_CONTAINS(sim->output(), "1 data bytes, expected 3");
+  EXPECT_CONTAINS(sim->output(), "1 data bytes, expected 4");
   dump.Stop(SIGTERM, 5s);
   EXPECT_EQ(sim->Stop(SIGTERM, 10s), 0) << sim->output();
 }
 
 TEST(CanPeersTest, DriverAgainstFixtureSimUntilItStopsAnswering) {
   TempDir dir;
-  auto sim = StartFixtureSim(dir, {"--part", "SN-FS-1", "--fault", "stops_answering",
-                                   "--fault-on-excitation", "--fault-after-ms", "300"});
+  auto sim = StartFixtureSim(
+      dir, {"--part", "SN-FS-1", "--fault", "stops_answering", "--fault-on-excitation",
+            "--fault-after-ms", "100"});  // within the alive timeout
   CanFixtureSettings settings = DriverSettings();
   settings.status_timeout_ms = 1000;
   CanFixture fixture(settings);
@@ -284,6 +287,7 @@ TEST(CanPeersTest, DriverAgainstFixtureSimUntilItStopsAnswering) {
   auto in = ReadUntil(fixture, [](const FixtureInputs& i) { return i.clamped; });
   ASSERT_TRUE(in.ok()) << in.status().message();
   EXPECT_NEAR(in.value().clamp_pressure_bar, 5.5, 0.035);
+  ASSERT_TRUE(fixture.WriteAlive(1).ok());
   ASSERT_TRUE(fixture.Write(FixtureOutput::kExcitationEnable, true).ok());
   const Status s = ReadUntilError(fixture);
   ASSERT_FALSE(s.ok());

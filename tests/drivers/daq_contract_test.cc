@@ -33,6 +33,7 @@ class SimDaqUnderTest final : public DaqUnderTest {
     auto bench =
         std::make_shared<SimBench>(drivers::SimBenchSettings{}, drivers::ManualClock::Of(clock_));
     bench->LoadPart("CONTRACT-DAQ-1");
+    bench->WriteAlive(1);  // the controller closes the relay only after a station_alive
     bench->Write(drivers::FixtureOutput::kExcitationEnable, true);
     daq_ = std::make_unique<drivers::SimDaq>(bench, s);
     // The broken one: its bench's acquisition device fails from the first chunk on.

@@ -8,6 +8,7 @@
 #include "drivers/fixture/modbus_fixture.h"
 
 #include <gtest/gtest.h>
+#include <modbus/modbus.h>
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>
 
@@ -22,6 +23,7 @@
 #include "drivers/fixture/modbus_map.h"
 #include "drivers/sim/sim_bench.h"
 #include "drivers/sim/sim_clock.h"
+#include "tests/support/glitch_proxy.h"
 
 namespace eol::drivers {
 namespace {
@@ -147,6 +149,7 @@ TEST_F(ModbusFixtureTest, StopsAnsweringGivesANamedErrorAndRecoversAfterClearFau
   ModbusFixture& f = Connected();
   auto log = std::make_unique<LogCapture>();  // retries are never silent
   ASSERT_TRUE(f.Activate().ok());
+  ASSERT_TRUE(f.WriteAlive(1).ok());
   ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
   bench_->InjectFault(SimFault::kStopsAnswering, 0ms, /*on_excitation=*/false);
 
@@ -161,14 +164,12 @@ TEST_F(ModbusFixtureTest, StopsAnsweringGivesANamedErrorAndRecoversAfterClearFau
                   "fixture 'modbus-tcp': read inputs: read discrete inputs 0..4 "
                   "(clamped..estop_ok) at " +
                       Endpoint() + " unit 1: ");
-  EXPECT_CONTAINS(m, "(attempt 2, timeout 100 ms)");
-  EXPECT_GE(took_s, 0.2);  // two full response timeouts: the server really kept quiet
+  // In excitation a failed read is an interlock loss at once: never retried.
+  EXPECT_CONTAINS(m, "(attempt 1, timeout 100 ms, in excitation: not retried)");
+  EXPECT_GE(took_s, 0.1);  // one full response timeout: the server really kept quiet
+  EXPECT_LT(took_s, 0.19);
   EXPECT_EQ(f.lifecycle(), Lifecycle::kError);
-
-  ASSERT_EQ(retries.size(), 1u);
-  EXPECT_CONTAINS(retries[0], "[warning]");
-  EXPECT_CONTAINS(retries[0], "read discrete inputs 0..4 (clamped..estop_ok) at " + Endpoint());
-  EXPECT_CONTAINS(retries[0], "(attempt 1, timeout 100 ms); retrying in 10 ms (attempt 2 of 2)");
+  EXPECT_TRUE(retries.empty()) << retries.front();
 
   // The dead controller's relay dropped out on its own (fail-safe wiring).
   const auto deadline = Clock::now() + 1s;
@@ -259,6 +260,123 @@ TEST_F(ModbusFixtureTest, ServerRestartIsBridgedByAReconnectWithinOneCall) {
   EXPECT_EQ(f.lifecycle(), Lifecycle::kInactive);
 }
 
+// A reply spoiled on the wire (another unit id, another function, half a frame) during
+// excitation: the read fails at once with the cause named, the request is not repeated,
+// and the relay can still be commanded off.
+struct Spoiled {
+  testing::GlitchProxy::Glitch glitch;
+  std::string cause;
+};
+
+void PrintTo(const Spoiled& s, std::ostream* os) { *os << s.cause; }
+
+class ModbusGlitchTest : public ModbusFixtureTest, public ::testing::WithParamInterface<Spoiled> {};
+
+TEST_P(ModbusGlitchTest, SpoiledReplyInExcitationFailsWithoutRetryAndTheRelayGoesOff) {
+  testing::GlitchProxy proxy(server_->port());
+  ASSERT_GT(proxy.port(), 0);
+  ModbusFixtureSettings c = ClientSettings();
+  c.link.port = proxy.port();
+  fixture_ = std::make_unique<ModbusFixture>(c);
+  ModbusFixture& f = *fixture_;
+  ASSERT_TRUE(f.Connect().ok());
+  ASSERT_TRUE(f.Activate().ok());
+  ASSERT_TRUE(f.WriteAlive(1).ok());
+  ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
+  ASSERT_TRUE(bench_->excitation_connected());
+
+  proxy.Arm(GetParam().glitch);
+  const int before = proxy.requests();
+  const auto in = f.ReadInputs();
+  ASSERT_FALSE(in.ok()) << "a spoiled reply was taken for inputs";
+  EXPECT_CONTAINS(in.status().message(), GetParam().cause);
+  EXPECT_CONTAINS(in.status().message(), "(attempt 1, timeout 100 ms, in excitation: not retried)");
+  EXPECT_EQ(proxy.requests() - before, 1) << "the failed request was retried in excitation";
+  EXPECT_FALSE(proxy.armed());
+
+  const Status off = f.Write(FixtureOutput::kExcitationEnable, false);
+  ASSERT_TRUE(off.ok()) << off.message();
+  EXPECT_FALSE(bench_->excitation_connected());
+}
+
+INSTANTIATE_TEST_SUITE_P(Replies, ModbusGlitchTest,
+                         ::testing::Values(Spoiled{testing::GlitchProxy::Glitch::kForeignUnit,
+                                                   "reply from unit 7 to a request for unit 1"},
+                                           Spoiled{testing::GlitchProxy::Glitch::kWrongFunction,
+                                                   "malformed reply to function 2"},
+                                           Spoiled{testing::GlitchProxy::Glitch::kTruncated,
+                                                   "timed out"}),
+                         [](const ::testing::TestParamInfo<Spoiled>& info) {
+                           switch (info.param.glitch) {
+                             case testing::GlitchProxy::Glitch::kForeignUnit:
+                               return std::string("ForeignUnit");
+                             case testing::GlitchProxy::Glitch::kWrongFunction:
+                               return std::string("WrongFunction");
+                             default:
+                               return std::string("Truncated");
+                           }
+                         });
+
+// Outside excitation the same spoiled reply is retried (on a fresh connection) and the read
+// succeeds: the retry policy stays for idle reads.
+TEST_F(ModbusFixtureTest, ForeignUnitReplyIsRetriedWhenIdle) {
+  testing::GlitchProxy proxy(server_->port());
+  ModbusFixtureSettings c = ClientSettings();
+  c.link.port = proxy.port();
+  fixture_ = std::make_unique<ModbusFixture>(c);
+  ASSERT_TRUE(fixture_->Connect().ok());
+  proxy.Arm(testing::GlitchProxy::Glitch::kForeignUnit);
+  const int before = proxy.requests();
+  const FixtureInputs in = Read();
+  EXPECT_TRUE(in.part_present);
+  EXPECT_EQ(proxy.requests() - before, 3) << "spoiled, retried, then the registers";
+}
+
+// The controller's alive rule in real time: a client that closes the relay and then just
+// stops (as a killed station does) finds it open 250 ms after its last station_alive, seen
+// by a third client reading the excitation coil; nothing else is sent meanwhile.
+TEST(ModbusAliveTest, RelayDropsWithinAliveTimeoutAfterTheClientStops) {
+  auto bench = std::make_shared<SimBench>(SimBenchSettings{});  // the steady clock
+  bench->LoadPart("ALIVE-1");
+  ModbusFixtureServerSettings s;
+  s.link.port = 0;
+  ModbusFixtureServer server(bench, s);
+  ASSERT_TRUE(server.Start().ok());
+  ModbusFixtureSettings c;
+  c.link.host = "127.0.0.1";
+  c.link.port = server.port();
+  ModbusFixture f(c);
+  ASSERT_TRUE(f.Connect().ok());
+  ASSERT_TRUE(f.Activate().ok());
+  ASSERT_TRUE(f.WriteAlive(1).ok());
+  ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
+  Clock::time_point last_alive = Clock::now();
+  for (std::uint16_t v = 2; v < 8; ++v) {  // 300 ms of a live station
+    std::this_thread::sleep_for(50ms);
+    ASSERT_TRUE(f.WriteAlive(v).ok());
+    last_alive = Clock::now();
+  }
+  ASSERT_TRUE(bench->output(FixtureOutput::kExcitationEnable)) << "dropped with alive changing";
+
+  modbus_t* observer = modbus_new_tcp("127.0.0.1", server.port());
+  ASSERT_NE(observer, nullptr);
+  modbus_set_slave(observer, 1);
+  ASSERT_EQ(modbus_connect(observer), 0);
+  std::uint8_t coil = 1;
+  while (coil != 0 && Clock::now() - last_alive < 2s) {
+    ASSERT_EQ(modbus_read_bits(observer, 1, 1, &coil), 1);
+    if (coil != 0) std::this_thread::sleep_for(2ms);
+  }
+  const double off_ms = Seconds(Clock::now() - last_alive) * 1000.0;
+  modbus_close(observer);
+  modbus_free(observer);
+  EXPECT_EQ(coil, 0) << "the relay stayed closed 2 s after the station stopped";
+  EXPECT_GE(off_ms, 240.0) << "dropped before the alive timeout";
+  EXPECT_LE(off_ms, 350.0) << "dropped late";
+  f.Disconnect();
+  server.Stop();
+}
+
 TEST_F(ModbusFixtureTest, WrongUnitIdIsAnExceptionNotATimeout) {
   ModbusFixtureSettings c = ClientSettings();
   c.link.unit_id = 2;
@@ -305,6 +423,7 @@ TEST_F(ModbusFixtureTest, ServesAndReadsARelocatedMap) {
   FixtureInputs in = Read();
   EXPECT_TRUE(in.released && in.part_present && in.door_closed && in.estop_ok);
   ASSERT_TRUE(f.Write(FixtureOutput::kClampCmd, true).ok());
+  ASSERT_TRUE(f.WriteAlive(1).ok());  // holding register 1, as by default
   ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
   ASSERT_TRUE(f.SelectPhasePair(PhasePair::kWU).ok());
   EXPECT_TRUE(bench_->output(FixtureOutput::kClampCmd));

@@ -25,6 +25,7 @@ struct Measured {
 
 Measured Acquire(SimMotorModel model, std::size_t periods) {
   SimBenchSettings bench_settings;
+  bench_settings.alive_timeout_ms = 0;  // no station here: the controller without the alive rule
   auto bench = std::make_shared<SimBench>(bench_settings);
   bench->LoadPart("SIM-DAQ-1");
   bench->Write(FixtureOutput::kExcitationEnable, true);

@@ -63,7 +63,7 @@ def run_node(a):
         now = time.monotonic()
         if msg is not None and not msg.is_error_frame and not msg.is_remote_frame:
             print(json.dumps({"id": msg.arbitration_id, "data": list(msg.data)}), flush=True)
-            if len(msg.data) == 3 and msg.data[1] <= 2:
+            if len(msg.data) == 4 and msg.data[1] <= 2:
                 b0 = msg.data[0]
                 if (b0 & 1) and not outputs["clamp"]:
                     clamp_at = now
@@ -120,7 +120,7 @@ def run_client(a):
 
     def command(b0, pair, counter):
         bus.send(can.Message(arbitration_id=0x200 + node, is_extended_id=False,
-                             data=bytes([b0, pair, counter])))
+                             data=bytes([b0, pair, counter, counter])))  # alive: the counter
 
     out = {"first": wait_status(lambda s: True, 5.0)}
     command(0x01 | 0x04, 1, 1)  # clamp_cmd + lamp_pass, phase pair V-W

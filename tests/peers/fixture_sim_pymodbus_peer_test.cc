@@ -68,7 +68,7 @@ void ExpectConversation(const std::vector<std::string>& transport, bool tcp) {
       ["read_di", 0, 5], ["read_ir", 0, 2], ["read_coils", 0, 4], ["read_hr", 0, 1],
       ["write_coil", 0, 1], ["read_di", 0, 5], ["sleep", 0.3], ["read_di", 0, 5],
       ["read_ir", 0, 2],
-      ["write_hr", 0, 2], ["read_hr", 0, 1], ["write_hr", 0, 7], ["read_hr", 0, 1],
+      ["write_hrs", 0, [2, 1]], ["read_hr", 0, 1], ["write_hr", 0, 7], ["read_hr", 0, 1],
       ["write_coils", 1, [1, 1, 0]], ["read_coils", 0, 4],
       ["mask_write_hr", 0, 1, 2], ["read_di", 0, 6],
       ["read_di", 0, 5, {"unit": 2}], ["read_di", 0, 5], ["read_di", 0, 5]])");
@@ -87,7 +87,7 @@ void ExpectConversation(const std::vector<std::string>& transport, bool tcp) {
   ASSERT_TRUE(r[8].contains("values")) << r[8].dump();
   EXPECT_NEAR(r[8]["values"][0].get<int>(), 550, 3);  // 5.5 bar in 0.01 bar counts, ripple
   EXPECT_GT(r[8]["values"][1].get<int>(), r[1]["values"][1].get<int>());  // heartbeat moved
-  ExpectOk(r[9]);
+  ExpectOk(r[9]);  // phase_pair 2 and station_alive 1: the relay may close (modbus_map.h)
   ExpectValues(r[10], {2});
   ExpectException(r[11], 3);  // phase_pair 7: illegal data value, and nothing changed
   ExpectValues(r[12], {2});
@@ -127,14 +127,15 @@ TEST(FixtureSimPymodbusPeerTest, StopsAnsweringReallyStopsAnswering) {
   std::string log;
   const json r = peers::RunPymodbusClient(
       {"--tcp", sim.tcp()},
-      json::parse(R"([["read_di", 0, 5], ["write_coil", 1, 1], ["read_di", 0, 5],
-                      ["read_coils", 0, 4]])"),
+      json::parse(R"([["read_di", 0, 5], ["write_hr", 1, 1], ["write_coil", 1, 1],
+                      ["read_di", 0, 5], ["read_coils", 0, 4]])"),
       &log);
   ASSERT_TRUE(r.is_array()) << log;
   ExpectValues(r[0], {0, 1, 1, 1, 1});
-  ExpectOk(r[1]);
-  ExpectNoAnswer(r[2]);
+  ExpectOk(r[1]);  // station_alive: without it the relay does not close (modbus_map.h)
+  ExpectOk(r[2]);
   ExpectNoAnswer(r[3]);
+  ExpectNoAnswer(r[4]);
   EXPECT_EQ(sim.Stop(), 0) << sim.output();
 }
 

@@ -19,7 +19,15 @@ TEST_P(SafetyBenchFixture, EveryFaultEndsInErrorWithAReactionMeasured) {
   o.fixture = GetParam();
   o.recipe_path = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json";
   const auto stats = RunSafetyBench(o);
-  ASSERT_EQ(stats.size(), 4u);
+  ASSERT_EQ(stats.size(), 5u);
+  // The controller's side: the relay opened by itself after the station stopped, no
+  // earlier than its alive timeout (250 ms) and not much later.
+  const ReactionStats& stops = stats.back();
+  EXPECT_EQ(stops.fault, "station_stops");
+  EXPECT_EQ(stops.errors, 2) << "the relay stayed closed after the station stopped";
+  EXPECT_EQ(stops.measured, 2);
+  EXPECT_GE(stops.min_ms, 240.0);
+  EXPECT_LE(stops.max_ms, 400.0);
   for (const auto& s : stats) {
     EXPECT_EQ(s.trials, 2) << s.fault;
     EXPECT_EQ(s.errors, 2) << s.fault << ": a fault during excitation must end ERROR";

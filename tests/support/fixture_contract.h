@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -153,6 +154,7 @@ TEST_P(FixtureContractTest, LifecycleAndWhatEachStateRefuses) {
 
   ASSERT_TRUE(f.Activate().ok());
   EXPECT_EQ(f.lifecycle(), Lifecycle::kActive);
+  ASSERT_TRUE(f.WriteAlive(1).ok());  // the controller closes the relay only after one
   ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
   EXPECT_TRUE(bench_->excitation_connected());
   const drivers::Status d = f.Deactivate();
@@ -217,6 +219,7 @@ TEST_P(FixtureContractTest, ExcitationOffIsAlwaysAllowedAndReadsBackOff) {
   EXPECT_TRUE(s.ok()) << "inactive: " << s.message();
 
   ASSERT_TRUE(f.Activate().ok());
+  ASSERT_TRUE(f.WriteAlive(1).ok());
   ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
   ASSERT_TRUE(bench_->excitation_connected());
   s = f.Write(FixtureOutput::kExcitationEnable, false);
@@ -224,6 +227,7 @@ TEST_P(FixtureContractTest, ExcitationOffIsAlwaysAllowedAndReadsBackOff) {
   EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
 
   // Into the error state by a controller that stopped answering, then back on the bus.
+  ASSERT_TRUE(f.WriteAlive(2).ok());
   ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
   bench_->InjectFault(SimFault::kStopsAnswering, std::chrono::milliseconds(0), false);
   ASSERT_FALSE(ReadUntilError().ok());
@@ -235,6 +239,62 @@ TEST_P(FixtureContractTest, ExcitationOffIsAlwaysAllowedAndReadsBackOff) {
   EXPECT_FALSE(f.Write(FixtureOutput::kExcitationEnable, true).ok())
       << "excitation on accepted in the error state";
   EXPECT_FALSE(bench_->excitation_connected());
+}
+
+// The station-alive rule (drivers/fixture/modbus_map.h): the relay stays closed while
+// station_alive keeps changing, opens by itself alive_timeout_ms after the last change (the
+// same value again is no change), and closes again only when commanded after a fresh one.
+// WriteAlive is allowed in every connected state.
+TEST_P(FixtureContractTest, RelayDropsAfterAliveTimeoutWithoutAliveChanges) {
+  using std::chrono::milliseconds;
+  drivers::Fixture& f = fixture();
+  EXPECT_FALSE(f.WriteAlive(1).ok()) << "station_alive written before connecting";
+  ASSERT_TRUE(f.Connect().ok());
+  ASSERT_TRUE(f.WriteAlive(1).ok()) << "inactive";
+  EXPECT_EQ(bench_->alive(), std::optional<std::uint16_t>(1));
+  ASSERT_TRUE(f.Activate().ok());
+  ASSERT_TRUE(f.WriteAlive(2).ok());
+  ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
+  ASSERT_TRUE(bench_->excitation_connected());
+  for (std::uint16_t v = 3; v < 13; ++v) {  // 2 s of changes every 200 ms
+    clock_->Advance(milliseconds(200));
+    ASSERT_TRUE(f.WriteAlive(v).ok());
+    ASSERT_TRUE(bench_->excitation_connected()) << "dropped with station_alive changing, at " << v;
+  }
+  const auto last_change = clock_->now();
+  clock_->Advance(milliseconds(200));
+  ASSERT_TRUE(f.WriteAlive(12).ok());  // the same value: no change
+  EXPECT_TRUE(bench_->excitation_connected()) << "dropped 200 ms after the last change";
+  clock_->Advance(milliseconds(51));
+  EXPECT_FALSE(bench_->excitation_connected()) << "closed 251 ms after the last change";
+  EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
+  const auto timeout = milliseconds(static_cast<int>(settings_.alive_timeout_ms));
+  EXPECT_EQ(bench_->last_excitation_off(), std::optional(last_change + timeout));
+
+  ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, false).ok());
+  ASSERT_TRUE(f.WriteAlive(13).ok());
+  EXPECT_FALSE(bench_->excitation_connected()) << "a fresh alive alone closed the relay";
+  ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
+  EXPECT_TRUE(bench_->excitation_connected()) << "not closed when commanded after a fresh alive";
+}
+
+// The interlock latch (modbus_map.h): a door that opened and closed again between two reads
+// is reported open by the next read, and only by that one (clear-on-read).
+TEST_P(FixtureContractTest, DoorDropBetweenTwoReadsIsLatched) {
+  Activate();
+  auto in = ReadUntil([](const FixtureInputs& i) { return i.door_closed; });
+  ASSERT_TRUE(in.ok()) << in.status().message();
+  ASSERT_TRUE(in.value().door_closed);
+  bench_->InjectFault(SimFault::kDoorOpens, std::chrono::milliseconds(10), false,
+                      std::chrono::milliseconds(20));
+  clock_->Advance(std::chrono::milliseconds(100));  // opened at 10 ms, closed at 30 ms
+  ASSERT_FALSE(bench_->FaultActive(SimFault::kDoorOpens));
+  in = ReadUntil([](const FixtureInputs& i) { return !i.door_closed; });
+  ASSERT_TRUE(in.ok()) << in.status().message();
+  EXPECT_FALSE(in.value().door_closed) << "a door drop between two reads was lost";
+  in = ReadUntil([](const FixtureInputs& i) { return i.door_closed; });
+  ASSERT_TRUE(in.ok()) << in.status().message();
+  EXPECT_TRUE(in.value().door_closed) << "the latch did not clear on read";
 }
 
 TEST_P(FixtureContractTest, PhasePairSelectionReadsBack) {
