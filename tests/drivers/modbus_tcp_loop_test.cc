@@ -121,6 +121,38 @@ TEST(ModbusTcpLoop, TheCapRefusesTheExtraAtOnceAndFreesASlotOnClose) {
   for (int fd : fds) ::close(fd);
 }
 
+TEST(ModbusTcpLoop, AtTheCapANewClientTakesTheIdlestPlaceAndAPollingPlcKeepsItsOwn) {
+  // Eight idle connections must not lock the line PLC out (the cap alone would refuse it).
+  ModbusTcpLoopSettings s;
+  s.max_clients = 4;
+  s.evict_idle_after = 300ms;
+  LoopUnderTest loop(s);
+  const int plc = ConnectModbus(loop.port());
+  ASSERT_TRUE(ReadsBack(plc, 1));
+  std::vector<int> idle;
+  for (int i = 0; i < 3; ++i) idle.push_back(ConnectModbus(loop.port()));
+  ASSERT_TRUE(eol::testing::WaitUntil([&] { return loop.counts().accepted == 4; }, 2000ms));
+  // Too early: every connection is younger than evict_idle_after, so the extra is refused.
+  const int early = ConnectModbus(loop.port());
+  EXPECT_TRUE(ClosedByServer(early, 1000ms));
+  ::close(early);
+  EXPECT_EQ(loop.counts().refused, 1u);
+  // The PLC keeps polling while the idle ones age; then new clients come one after another.
+  for (int round = 0; round < 4; ++round) {
+    for (int k = 0; k < 4; ++k) {
+      ASSERT_TRUE(ReadsBack(plc, 2)) << "round " << round;
+      std::this_thread::sleep_for(100ms);  // the PLC's own poll period
+    }
+    const int next = ConnectModbus(loop.port());
+    EXPECT_TRUE(ReadsBack(next, 3)) << "round " << round;  // it got a place
+    idle.push_back(next);
+  }
+  EXPECT_GE(loop.counts().closed_evicted, 3u);
+  EXPECT_TRUE(ReadsBack(plc, 4));  // never the PLC
+  ::close(plc);
+  for (int fd : idle) ::close(fd);
+}
+
 TEST(ModbusTcpLoop, ARequestLeftUnfinishedOrAnIdleConnectionIsClosedAfterItsDeadline) {
   ModbusTcpLoopSettings s;
   s.frame_deadline = 200ms;
