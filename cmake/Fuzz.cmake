@@ -23,6 +23,6 @@ set_property(TARGET eol_analysis PROPERTY SOURCES
   ${A}/signal/multisine.cc ${A}/fit/motional_jacobian.cc ${A}/fit/least_squares.cc
   ${A}/fit/resonance_fit.cc ${A}/signal/frf_method.cc ${A}/qc/bond_index.cc
   ${A}/qc/f0_pressure.cc ${A}/signal/excitation_design.cc ${A}/qc/line_measurement.cc ${A}/fit/cramer_rao.cc
-  ${A}/model/motor_model.cc)
+  ${A}/model/motor_model.cc ${A}/qc/measurement.cc)
 add_subdirectory(drivers)
 add_subdirectory(tests/fuzz)

@@ -238,7 +238,8 @@ TEST(CanPeersTest, FixtureSimAgainstCansendAndCandump) {
   auto sim = StartFixtureSim(dir, {"--part", "SN-CU-1", "--fault", "door_opens"});
   ChildProcess dump({"/usr/bin/candump", "-L", std::string(kInterface) + ",181:7FF,701:7FF"});
   std::this_thread::sleep_for(200ms);  // candump binds before the command goes out
-  ChildProcess send({"/usr/bin/cansend", kInterface, "201#050201"});  // clamp, lamp_pass, W-U
+  ChildProcess send(
+      {"/usr/bin/cansend", kInterface, "201#05020101"});  // clamp, lamp_pass, W-U, alive 1
   ASSERT_EQ(send.Wait(10s), 0) << send.output();
   const auto echoed = [](const std::string& o) {
     for (const auto& [id, d] : ParseCandump(o))

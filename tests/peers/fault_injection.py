@@ -296,7 +296,8 @@ def relay_runs(rig, how, runs):
         on = watch.wait(True, 30)
         if on is None:
             watch.close()
-            raise RuntimeError("excitation never seen on the fixture")
+            raise RuntimeError(f"{how}: excitation never seen on the fixture; see "
+                               f"{rig.work}/station-{rig.station.starts:04d}.log")
         time.sleep(0.05)
         sig = signal.SIGKILL if how == "kill" else signal.SIGSTOP
         rig.station.proc.send_signal(sig)
@@ -325,11 +326,18 @@ def stall_runs(rig, fault, runs):
         rig.restart_fixture(["--fault", fault, "--fault-on-excitation", "--fault-after-ms",
                              "150", "--fault-duration-ms", "500"])
         watch = RelayWatch(rig.fixture.port)
-        serial = rig.next_serial()
-        rig.start_test(serial)
-        if watch.wait(True, 30) is None:
+        # The first test after the emulator restarted may find the fixture link broken (the
+        # station reconnects for the next test): it ends ERROR without exciting; test again.
+        for _attempt in range(3):
+            serial = rig.next_serial()
+            rig.start_test(serial)
+            if watch.wait(True, 15) is not None:
+                break
+            wait_verdict(rig.station, serial, 30)
+        else:
             watch.close()
-            raise RuntimeError("excitation never seen on the fixture")
+            raise RuntimeError(f"stall {fault}: excitation never seen on the fixture; see "
+                               f"{rig.work}/station-{rig.station.starts:04d}.log")
         rig.station.proc.send_signal(signal.SIGSTOP)
         time.sleep(1.5)
         rig.station.proc.send_signal(signal.SIGCONT)
@@ -615,7 +623,10 @@ def main():
     only = set(filter(None, a.only.split(",")))
 
     def want(name):
-        return not only or name in only
+        if only and name not in only:
+            return False
+        print(f"fault_injection: {name} ...", file=sys.stderr, flush=True)
+        return True
 
     random.seed(1)
     work = a.out or tempfile.mkdtemp(prefix="eol-faults-")
@@ -657,6 +668,11 @@ def main():
                 failures.append("store")
     except (RuntimeError, OSError) as e:
         print(f"fault_injection: setup failed: {e}", file=sys.stderr)
+        if rig.station is not None:
+            log = os.path.join(work, f"station-{rig.station.starts:04d}.log")
+            if os.path.exists(log):
+                tail = open(log, "rb").read().decode(errors="replace").splitlines()[-15:]
+                print("\n".join(["the station's log ends:"] + tail), file=sys.stderr)
         rig.stop()
         return 2
     finally:
