@@ -126,21 +126,25 @@ TEST(ModbusTcpLoop, AtTheCapANewClientTakesTheIdlestPlaceAndAPollingPlcKeepsItsO
   // Eight idle connections must not lock the line PLC out (the cap alone would refuse it).
   ModbusTcpLoopSettings s;
   s.max_clients = 4;
-  s.evict_idle_after = 300ms;
+  s.evict_idle_after = 1000ms;
   LoopUnderTest loop(s);
+  const auto t0 = std::chrono::steady_clock::now();
   const int plc = ConnectModbus(loop.port());
   ASSERT_TRUE(ReadsBack(plc, 1));
   std::vector<int> idle;
   for (int i = 0; i < 3; ++i) idle.push_back(ConnectModbus(loop.port()));
   ASSERT_TRUE(eol::testing::WaitUntil([&] { return loop.counts().accepted == 4; }, 2000ms));
-  // Too early: every connection is younger than evict_idle_after, so the extra is refused.
+  // Too early: every connection is younger than evict_idle_after, so the extra is refused
+  // (checked only when this machine got here in time).
   const int early = ConnectModbus(loop.port());
-  EXPECT_TRUE(ClosedByServer(early, 1000ms));
+  if (std::chrono::steady_clock::now() - t0 < 700ms) {
+    EXPECT_TRUE(ClosedByServer(early, 1000ms));
+    EXPECT_EQ(loop.counts().refused, 1u);
+  }
   ::close(early);
-  EXPECT_EQ(loop.counts().refused, 1u);
   // The PLC keeps polling while the idle ones age; then new clients come one after another.
-  for (int round = 0; round < 4; ++round) {
-    for (int k = 0; k < 4; ++k) {
+  for (int round = 0; round < 3; ++round) {
+    for (int k = 0; k < 11; ++k) {
       ASSERT_TRUE(ReadsBack(plc, 2)) << "round " << round;
       std::this_thread::sleep_for(100ms);  // the PLC's own poll period
     }
