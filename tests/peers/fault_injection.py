@@ -483,21 +483,19 @@ def http_attacks(rig):
             out["wide_head_reply"] = s.recv(64).split(b"\r\n")[0].decode(errors="replace")
     except OSError as e:
         out["wide_head_reply"] = f"closed: {e.__class__.__name__}"
-    slow, streams = [], []
-    for _ in range(200):
-        try:
-            s = socket.create_connection(("127.0.0.1", port), timeout=2)
-            s.send(b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n")
-            slow.append(s)
-        except OSError:
-            break
-    for _ in range(100):
-        try:
-            s = socket.create_connection(("127.0.0.1", port), timeout=2)
-            s.send(b"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
-            streams.append(s)
-        except OSError:
-            break
+    def open_many(n, head):
+        socks = []
+        for _ in range(n):
+            try:
+                s = socket.create_connection(("127.0.0.1", port), timeout=2)
+                s.send(head)
+                socks.append(s)
+            except OSError:
+                break
+        return socks
+
+    slow = open_many(200, b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # never ends
+    streams = open_many(100, b"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
     times, failed, kinds = [], 0, {}
     for _ in range(100):
         t0 = time.monotonic()
