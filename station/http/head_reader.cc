@@ -13,6 +13,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "station/http/reply.h"
+
 namespace eol::station::http {
 namespace {
 
@@ -264,13 +266,8 @@ bool HeadReader::Read(Waiting& w) {
 }
 
 void HeadReader::Refuse(Waiting& w, int status, const char* reason, const std::string& message) {
-  const std::string body = R"({"error": {"code": "http_)" + std::to_string(status) +
-                           R"(", "message": ")" + message + R"("}})";
-  const std::string reply = "HTTP/1.1 " + std::to_string(status) + " " + reason +
-                            "\r\nContent-Type: application/json\r\nConnection: close\r\n"
-                            "Content-Security-Policy: frame-ancestors 'none'\r\n"
-                            "X-Frame-Options: DENY\r\nContent-Length: " +
-                            std::to_string(body.size()) + "\r\n\r\n" + body;
+  const std::string reply =
+      RawErrorResponse(status, reason, "http_" + std::to_string(status), message, false);
   (void)send(w.fd, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
   {
     std::lock_guard<std::mutex> lock(mu_);

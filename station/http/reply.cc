@@ -48,4 +48,15 @@ void Send(httplib::Response& res, const HttpReply& reply) {
 
 void Send(httplib::Response& res, const ApiError& error) { Send(res, ToReply(error)); }
 
+std::string RawErrorResponse(int status, const char* reason, const std::string& code,
+                             const std::string& message, bool retry_after) {
+  const nlohmann::json error = {{"error", {{"code", code}, {"message", message}}}};
+  const std::string body = error.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return "HTTP/1.1 " + std::to_string(status) + " " + reason +
+         "\r\nContent-Type: application/json\r\n" + (retry_after ? "Retry-After: 1\r\n" : "") +
+         "Connection: close\r\nContent-Security-Policy: frame-ancestors 'none'\r\n"
+         "X-Frame-Options: DENY\r\nContent-Length: " +
+         std::to_string(body.size()) + "\r\n\r\n" + body;
+}
+
 }  // namespace eol::station::http

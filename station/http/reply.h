@@ -47,4 +47,10 @@ HttpReply ToReply(const ApiError& error);
 void Send(httplib::Response& res, const HttpReply& reply);
 void Send(httplib::Response& res, const ApiError& error);
 
+// The whole HTTP/1.1 response for a refusal made before httplib has the connection (the head
+// reader, the worker pool): {"error": {"code", "message"}}, Connection: close, the framing
+// policy every response carries, and Retry-After: 1 when `retry_after`.
+std::string RawErrorResponse(int status, const char* reason, const std::string& code,
+                             const std::string& message, bool retry_after);
+
 }  // namespace eol::station::http

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "station/http/head_reader.h"
+#include "station/http/reply.h"
 
 namespace eol::station::http {
 namespace {
@@ -299,28 +300,22 @@ void LingeringClose(int fd) {
 
 void RefuseOverloaded(int fd, Clock::duration waited) {
   const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(waited).count();
-  const std::string body = R"({"error": {"code": "overloaded", "message": "the station waited )" +
-                           std::to_string(ms) +
-                           R"( ms for a free request worker; the request was not read"}})";
   const std::string reply =
-      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nRetry-After: 1\r\n"
-      "Connection: close\r\nContent-Security-Policy: frame-ancestors 'none'\r\n"
-      "X-Frame-Options: DENY\r\nContent-Length: " +
-      std::to_string(body.size()) + "\r\n\r\n" + body;
+      RawErrorResponse(503, "Service Unavailable", "overloaded",
+                       "the station waited " + std::to_string(ms) +
+                           " ms for a free request worker; the request was not read",
+                       true);
   (void)::send(fd, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
   ::shutdown(fd, SHUT_RDWR);
   ::close(fd);
 }
 
 void RefuseSlowBodies(int fd, const std::string& peer, std::size_t max) {
-  const std::string body = R"({"error": {"code": "overloaded", "message": ")" +
-                           std::to_string(max) + " request bodies of " + peer +
-                           R"( are being read already; the request was not read"}})";
   const std::string reply =
-      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nRetry-After: 1\r\n"
-      "Connection: close\r\nContent-Security-Policy: frame-ancestors 'none'\r\n"
-      "X-Frame-Options: DENY\r\nContent-Length: " +
-      std::to_string(body.size()) + "\r\n\r\n" + body;
+      RawErrorResponse(503, "Service Unavailable", "overloaded",
+                       std::to_string(max) + " request bodies of " + peer +
+                           " are being read already; the request was not read",
+                       true);
   (void)::send(fd, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
   LingeringClose(fd);
 }
