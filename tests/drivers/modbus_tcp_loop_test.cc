@@ -260,11 +260,7 @@ TEST(ModbusFixtureServerCrowd, EightIdleSlowAndMalformedClientsLeaveAWellBehaved
   plan.address = settings.map.heartbeat.address;
   ASSERT_EQ(settings.map.heartbeat.table, ModbusTable::kInputRegister);
   const auto f = eol::testing::RunCrowd(plan);
-  std::cout << "fixture emulator crowd: " << f.idle_connected << " idle, " << plan.slow << " slow ("
-            << f.slow_answered << " answered), " << f.malformed_sent << " malformed frames, "
-            << f.churned << " connect-and-close; good client " << f.good_answered << " of "
-            << plan.good_requests << " answered, p99 " << f.good_p99_ms << " ms, max "
-            << f.good_max_ms << " ms\n";
+  std::cout << "fixture emulator crowd: " << eol::testing::Describe(plan, f) << "\n";
   EXPECT_EQ(f.idle_connected, 8);
   EXPECT_EQ(f.good_answered, plan.good_requests);
   EXPECT_LT(f.good_max_ms, 100.0);

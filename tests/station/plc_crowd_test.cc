@@ -36,11 +36,7 @@ TEST(PlcCrowd, EightIdleSlowAndMalformedClientsLeaveAWellBehavedPlcServed) {
   plan.function = 3;
   plan.address = s.map.serial;
   const auto f = eol::testing::RunCrowd(plan);
-  std::cout << "PLC server crowd: " << f.idle_connected << " idle, " << plan.slow << " slow ("
-            << f.slow_answered << " answered), " << f.malformed_sent << " malformed frames, "
-            << f.churned << " connect-and-close; good client " << f.good_answered << " of "
-            << plan.good_requests << " answered, p99 " << f.good_p99_ms << " ms, max "
-            << f.good_max_ms << " ms\n";
+  std::cout << "PLC server crowd: " << eol::testing::Describe(plan, f) << "\n";
   EXPECT_EQ(f.idle_connected, 8);
   EXPECT_EQ(f.good_answered, plan.good_requests);
   EXPECT_LT(f.good_max_ms, 100.0);

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cstdint>
 #include <random>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -194,6 +195,16 @@ inline CrowdFigures RunCrowd(const CrowdPlan& plan) {
   f.malformed_sent = malformed_sent;
   f.churned = churned;
   return f;
+}
+
+// One line of what a crowd run did, for the test's log.
+inline std::string Describe(const CrowdPlan& plan, const CrowdFigures& f) {
+  std::ostringstream o;
+  o << f.idle_connected << " idle, " << plan.slow << " slow (" << f.slow_answered << " answered), "
+    << f.malformed_sent << " malformed frames, " << f.churned << " connect-and-close; good client "
+    << f.good_answered << " of " << plan.good_requests << " answered, p99 " << f.good_p99_ms
+    << " ms, max " << f.good_max_ms << " ms";
+  return o.str();
 }
 
 }  // namespace eol::testing
