@@ -1,6 +1,7 @@
 // Small helpers shared by the analysis code's messages and search grids.
 #pragma once
 
+#include <charconv>
 #include <cmath>
 #include <locale>
 #include <sstream>
@@ -26,6 +27,14 @@ inline std::string Fixed(double v, int digits) {
   os.precision(digits);
   os << v;
   return os.str();
+}
+
+// v with `digits` significant digits, shortest form ("417.8", "0.0085", "1.2e+06"), classic
+// formatting whatever the locale; "nan", "inf", "-inf" for non-finite values.
+inline std::string Significant(double v, int digits) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
+  return std::string(buf, r.ptr);
 }
 
 // n >= 2 log-spaced points from lo to hi inclusive (lo, hi > 0); the last point is exactly hi.

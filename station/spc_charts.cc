@@ -5,15 +5,14 @@
 #include <cmath>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/text.h"
 
 namespace eol::station {
 namespace {
 
-std::string Num(double v, int digits = 6) {
-  if (!std::isfinite(v)) return "none";
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
-  return std::string(buf, r.ptr);
+// Charts print 4 significant digits ("UCL 417.8"); "none" for a number that does not exist.
+std::string Num(double v, int digits = 4) {
+  return std::isfinite(v) ? analysis::Significant(v, digits) : "none";
 }
 
 std::string WithUnit(double v, const std::string& unit) {
@@ -71,6 +70,23 @@ io::ChartSeries Points(const std::string& label, std::vector<double> x, std::vec
   return s;
 }
 
+// The FAIL units among `points` (one per unit) as orange markers, labelled with their count.
+void AddFailMarks(const SpcSeries& s, const std::vector<double>& x, io::ChartPanel& p) {
+  io::ChartSeries f;
+  f.colour = io::kChartOrange;
+  f.line = false;
+  f.markers = true;
+  f.marker_radius = 3.5;
+  for (std::size_t i = 0; i < s.values.size() && i < s.failed.size(); ++i)
+    if (s.failed[i]) {
+      f.x.push_back(x[i]);
+      f.y.push_back(s.values[i]);
+    }
+  if (f.x.empty()) return;
+  f.label = "FAIL unit (" + std::to_string(f.x.size()) + ")";
+  p.series.push_back(f);
+}
+
 // Alarm points as red rings and their texts as notes (at most 6 listed).
 void AddAlarms(const std::vector<NamedAlarm>& alarms, const std::vector<double>& x,
                const std::vector<double>& y, io::ChartPanel& p) {
@@ -112,8 +128,16 @@ std::string KindName(ChartKind k, std::size_t subgroup) {
   return "";
 }
 
-std::vector<io::ChartPanel> ImrPanels(const SpcSeries& s, const analysis::SpcRuleOptions& rules) {
-  const analysis::IMrChart c = analysis::ComputeIMr(s.values);
+// The baseline's statement and caveat as notes of the chart's first panel.
+void AddBaselineNotes(const Baseline& b, const analysis::PhasedChart& c, io::ChartPanel& p) {
+  p.notes.push_back(b.text);
+  if (!c.caveat.empty()) p.notes.push_back(c.caveat);
+}
+
+std::vector<io::ChartPanel> ImrPanels(const SpcSeries& s, const analysis::SpcRuleOptions& rules,
+                                      std::size_t baseline) {
+  const Baseline b = BaselineOf(s, baseline);
+  const analysis::PhasedChart c = analysis::ComputePhasedChart(s.values, b.values, 1);
   io::ChartPanel i;
   i.title = s.measurement + ": individuals (I chart), " + std::to_string(s.values.size()) + " " +
             PopulationText(s.population);
@@ -122,50 +146,53 @@ std::vector<io::ChartPanel> ImrPanels(const SpcSeries& s, const analysis::SpcRul
   AddSpecLimits(s, i, false);
   const std::vector<double> x = Iota(s.values.size());
   i.series.push_back(Points(s.measurement, x, s.values));
+  AddFailMarks(s, x, i);
   if (!c.usable) {
     i.notes.push_back(c.message);
     return {i};
   }
-  AddControlLines(c.individuals, i, true);
-  AddAlarms(NameAlarms(analysis::ApplyRunRules(s.values, c.individuals, rules), s, 1), x, s.values,
-            i);
+  AddBaselineNotes(b, c, i);
+  AddControlLines(c.centre, i, true);
+  AddAlarms(NameAlarms(analysis::ApplyRunRules(s.values, c.centre, rules), s, 1), x, s.values, i);
   io::ChartPanel mr;
-  mr.title = s.measurement + ": moving range (MR chart), MRbar " + Num(c.mr_bar) +
+  mr.title = s.measurement + ": moving range (MR chart), baseline MRbar " + Num(c.spread.centre) +
              ", sigma within = MRbar/1.128 = " + Num(c.sigma_within);
   mr.x_label = "unit (test order)";
   mr.y_label =
       "moving range" + std::string(s.unit.empty() || s.unit == "1" ? "" : " (" + s.unit + ")");
-  mr.series.push_back(
-      Points("|x(i) - x(i-1)|", Iota(c.moving_ranges.size(), 2.0), c.moving_ranges));
-  AddControlLines(c.moving_range, mr, false);
+  mr.series.push_back(Points("|x(i) - x(i-1)|", Iota(c.spreads.size(), 2.0), c.spreads));
+  AddControlLines(c.spread, mr, false);
   return {i, mr};
 }
 
 std::vector<io::ChartPanel> XbarRPanels(const SpcSeries& s, std::size_t n,
-                                        const analysis::SpcRuleOptions& rules) {
-  const analysis::XbarRChart c = analysis::ComputeXbarR(s.values, n);
+                                        const analysis::SpcRuleOptions& rules,
+                                        std::size_t baseline) {
+  const Baseline b = BaselineOf(s, baseline);
+  const analysis::PhasedChart c = analysis::ComputePhasedChart(s.values, b.values, n);
   io::ChartPanel xb;
-  xb.title = s.measurement + ": subgroup means (X-bar chart), " + std::to_string(c.means.size()) +
+  xb.title = s.measurement + ": subgroup means (X-bar chart), " + std::to_string(c.points.size()) +
              " subgroups of " + std::to_string(n) + " " + PopulationText(s.population);
   xb.x_label = "subgroup (" + std::to_string(n) + " consecutive units)";
   xb.y_label = Axis(s);
-  AddSpecLimits(s, xb, false);
-  const std::vector<double> x = Iota(c.means.size());
-  xb.series.push_back(Points("subgroup mean", x, c.means));
+  const std::vector<double> x = Iota(c.points.size());
+  xb.series.push_back(Points("subgroup mean", x, c.points));
   if (!c.usable) {
     xb.notes.push_back(c.message);
     return {xb};
   }
-  if (!c.message.empty()) xb.notes.push_back(c.message);
-  AddControlLines(c.xbar, xb, true);
-  AddAlarms(NameAlarms(analysis::ApplyRunRules(c.means, c.xbar, rules), s, n), x, c.means, xb);
+  AddBaselineNotes(b, c, xb);
+  if (const std::size_t left = s.values.size() % n; left > 0)
+    xb.notes.push_back("the last " + std::to_string(left) + " units make no whole subgroup");
+  AddControlLines(c.centre, xb, true);
+  AddAlarms(NameAlarms(analysis::ApplyRunRules(c.points, c.centre, rules), s, n), x, c.points, xb);
   io::ChartPanel r;
-  r.title = s.measurement + ": subgroup ranges (R chart), Rbar " + Num(c.r_bar) +
+  r.title = s.measurement + ": subgroup ranges (R chart), baseline Rbar " + Num(c.spread.centre) +
             ", sigma within = Rbar/d2 = " + Num(c.sigma_within);
   r.x_label = xb.x_label;
   r.y_label = "range" + std::string(s.unit.empty() || s.unit == "1" ? "" : " (" + s.unit + ")");
-  r.series.push_back(Points("max - min", x, c.ranges));
-  AddControlLines(c.range, r, c.range.lcl > 0.0);
+  r.series.push_back(Points("max - min", x, c.spreads));
+  AddControlLines(c.spread, r, c.spread.lcl > 0.0);
   return {xb, r};
 }
 
@@ -182,9 +209,18 @@ io::ChartPanel HistogramPanel(const SpcSeries& s, std::size_t subgroup) {
     if (!(b > a)) a -= 0.5, b += 0.5;
     const int bins = std::clamp(
         static_cast<int>(std::ceil(std::sqrt(static_cast<double>(s.values.size())))), 5, 30);
-    io::ChartBars bars = io::Histogram(s.values, a, b, bins);
-    bars.label = s.measurement + " (" + std::to_string(bins) + " bins)";
+    std::vector<double> pass, fail;
+    for (std::size_t i = 0; i < s.values.size(); ++i)
+      (i < s.failed.size() && s.failed[i] ? fail : pass).push_back(s.values[i]);
+    io::ChartBars bars = io::Histogram(pass, a, b, bins);
+    bars.label = "PASS units (" + std::to_string(bins) + " bins)";
     p.bars.push_back(bars);
+    if (!fail.empty()) {
+      io::ChartBars f = io::Histogram(fail, a, b, bins);
+      f.label = "FAIL units (" + std::to_string(fail.size()) + ")";
+      f.colour = io::kChartOrange;
+      p.bars.push_back(f);
+    }
   }
   const analysis::CapabilityIndices c =
       analysis::ComputeCapabilityIndices(s.values, s.limit, subgroup);
@@ -199,6 +235,7 @@ io::ChartPanel HistogramPanel(const SpcSeries& s, std::size_t subgroup) {
     p.notes.push_back("Pp " + opt(c.pp) + "  Ppk " + opt(c.ppk) + "  (overall s " +
                       Num(c.sample.sd, 4) + ")");
   }
+  if (!c.caveat.empty()) p.notes.push_back(c.caveat);
   if (!c.message.empty()) p.notes.push_back(c.message);
   return p;
 }
@@ -234,6 +271,7 @@ std::string ValidateChartRequest(const ChartRequest& r) {
   std::string why;
   if (!r.rules.IsValid(&why)) return "rules: " + why;
   if (r.from && r.to && !(*r.from < *r.to)) return "from must be before to";
+  if (r.baseline < 2) return "baseline must be at least 2 PASS units";
   return "";
 }
 
@@ -271,14 +309,32 @@ std::optional<SpcSeries> ReadSpcSeries(db::Store& store, const ChartRequest& req
     s.values.push_back(*r.value);
     s.serials.push_back(r.serial);
     s.started_at.push_back(r.started_at);
+    s.failed.push_back(r.outcome == analysis::Outcome::kFail);
   }
   if (req.last > 0 && s.values.size() > req.last) {
     const auto drop = static_cast<std::ptrdiff_t>(s.values.size() - req.last);
     s.values.erase(s.values.begin(), s.values.begin() + drop);
     s.serials.erase(s.serials.begin(), s.serials.begin() + drop);
     s.started_at.erase(s.started_at.begin(), s.started_at.begin() + drop);
+    s.failed.erase(s.failed.begin(), s.failed.begin() + drop);
   }
   return s;
+}
+
+Baseline BaselineOf(const SpcSeries& s, std::size_t baseline) {
+  Baseline b;
+  std::string first, last;
+  for (std::size_t i = 0; i < s.values.size() && b.values.size() < baseline; ++i) {
+    if (i < s.failed.size() && s.failed[i]) continue;
+    b.values.push_back(s.values[i]);
+    if (first.empty()) first = s.serials[i];
+    last = s.serials[i];
+  }
+  b.text = "control limits from the first " + std::to_string(b.values.size()) + " PASS units" +
+           (b.values.size() < baseline ? " (all there are; " + std::to_string(baseline) + " asked)"
+                                       : std::string()) +
+           (first.empty() ? std::string() : ", " + first + ".." + last);
+  return b;
 }
 
 std::vector<NamedAlarm> NameAlarms(const std::vector<analysis::SpcAlarm>& alarms,
@@ -319,12 +375,13 @@ nlohmann::json AlarmsJson(const std::vector<NamedAlarm>& alarms) {
 }
 
 std::vector<io::ChartPanel> ChartPanels(const SpcSeries& s, ChartKind kind, std::size_t subgroup,
-                                        const analysis::SpcRuleOptions& rules) {
+                                        const analysis::SpcRuleOptions& rules,
+                                        std::size_t baseline) {
   switch (kind) {
     case ChartKind::kIMr:
-      return ImrPanels(s, rules);
+      return ImrPanels(s, rules, baseline);
     case ChartKind::kXbarR:
-      return XbarRPanels(s, subgroup, rules);
+      return XbarRPanels(s, subgroup, rules, baseline);
     case ChartKind::kHistogram:
       return {HistogramPanel(s, subgroup)};
   }
@@ -337,8 +394,8 @@ io::Chart MeasurementChart(const SpcSeries& s, const ChartRequest& req) {
             " v" + std::to_string(s.recipe_version) + " (" + s.recipe_hash.substr(0, 12) + ")";
   if (!s.started_at.empty()) c.title += ", " + s.started_at.front() + " .. " + s.started_at.back();
   // The histogram's within sigma is MRbar/d2: units come one at a time.
-  c.panels =
-      ChartPanels(s, req.kind, req.kind == ChartKind::kHistogram ? 1 : req.subgroup, req.rules);
+  c.panels = ChartPanels(s, req.kind, req.kind == ChartKind::kHistogram ? 1 : req.subgroup,
+                         req.rules, req.baseline);
   return c;
 }
 

@@ -14,12 +14,11 @@ nlohmann::json Opt(const std::optional<double>& v) {
 }
 
 // One measurement of one recipe: values in test order with the outcome of their test.
+// One measurement's units under one recipe, in test order: the SPC series of every measured
+// unit (PASS and FAIL, `failed` marking the FAILs) and the PASS values for the drift test.
 struct Series {
-  std::string unit;
-  analysis::Limit limit;
-  std::vector<double> measured;  // PASS and FAIL tests
-  std::vector<double> passing;   // PASS tests
-  std::vector<std::string> measured_serials, passing_serials;
+  SpcSeries measured;
+  std::vector<double> passing;
 };
 
 struct Group {
@@ -73,18 +72,18 @@ nlohmann::json GaugeReport(db::Store& store, const StatsRequest& req) {
     if (r.recipe_hash != hash || r.outcome == analysis::Outcome::kError) continue;
     if (g.tests.empty() || g.tests.back() != r.test_id) g.tests.push_back(r.test_id);
     if (!g.series.count(r.name)) g.order.push_back(r.name);
-    Series& s = g.series[r.name];
+    SpcSeries& s = g.series[r.name].measured;
     s.unit = r.unit;
     s.limit.lo = r.lo;
     s.limit.hi = r.hi;
-    if (r.value) s.measured.push_back(*r.value);
+    if (r.value) s.values.push_back(*r.value);
   }
   out["tests"] = g.tests.size();
   for (const std::string& name : g.order) {
-    const Series& s = g.series[name];
+    const SpcSeries& s = g.series[name].measured;
     std::optional<double> ref;
     if (const auto it = req.reference.find(name); it != req.reference.end()) ref = it->second;
-    const analysis::GaugeStudy st = analysis::GaugeType1(s.measured, s.limit, ref, req.gauge);
+    const analysis::GaugeStudy st = analysis::GaugeType1(s.values, s.limit, ref, req.gauge);
     out["measurements"].push_back(
         {{"name", name},
          {"unit", s.unit},
@@ -106,6 +105,65 @@ nlohmann::json GaugeReport(db::Store& store, const StatsRequest& req) {
   return out;
 }
 
+// The control chart of one measurement: limits from its baseline PASS units, the points of every
+// unit against them, and the run-rule alarms (also appended to `spc_alarms`).
+nlohmann::json ControlJson(const SpcSeries& m, const StatsRequest& req, const std::string& who,
+                           nlohmann::json& spc_alarms) {
+  const Baseline b = BaselineOf(m, req.baseline);
+  const analysis::PhasedChart c = analysis::ComputePhasedChart(m.values, b.values, req.subgroup);
+  nlohmann::json control = {{"chart", req.subgroup > 1 ? "xbar_r" : "imr"},
+                            {"baseline_units", b.values.size()},
+                            {"baseline", b.text},
+                            {"caveat", c.caveat},
+                            {"centre", nullptr},
+                            {"lcl", nullptr},
+                            {"ucl", nullptr},
+                            {"alarms", nlohmann::json::array()}};
+  if (!c.usable) return control;
+  const std::vector<NamedAlarm> named =
+      NameAlarms(analysis::ApplyRunRules(c.points, c.centre, req.rules), m, req.subgroup);
+  for (const NamedAlarm& a : named) spc_alarms.push_back(who + a.text);
+  control["centre"] = c.centre.centre;
+  control["lcl"] = c.centre.lcl;
+  control["ucl"] = c.centre.ucl;
+  control["alarms"] = AlarmsJson(named);
+  return control;
+}
+
+// One measurement's figures: capability of the charted units, control chart, drift of the
+// PASS units (a rejected defect is not a trend).
+nlohmann::json MeasurementJson(const Series& s, const StatsRequest& req, const std::string& who,
+                               nlohmann::json& alarms, nlohmann::json& spc_alarms) {
+  const SpcSeries& m = s.measured;
+  const analysis::CapabilityIndices c =
+      analysis::ComputeCapabilityIndices(m.values, m.limit, req.subgroup);
+  const analysis::DriftSummary d =
+      analysis::DetectDrift(s.passing, m.limit, m.measurement, m.unit, req.drift);
+  if (d.alarm) alarms.push_back(who + d.message);
+  const bool have = c.sample.n > 0;
+  return {{"name", m.measurement},
+          {"unit", m.unit},
+          {"lo", Opt(m.limit.lo)},
+          {"hi", Opt(m.limit.hi)},
+          {"population", PopulationText(req.population)},
+          {"n", c.sample.n},
+          {"fail", std::count(m.failed.begin(), m.failed.end(), true)},
+          {"mean", have ? nlohmann::json(c.sample.mean) : nlohmann::json()},
+          {"sd", c.sample.n > 1 ? nlohmann::json(c.sample.sd) : nlohmann::json()},
+          {"min", have ? nlohmann::json(c.sample.min) : nlohmann::json()},
+          {"max", have ? nlohmann::json(c.sample.max) : nlohmann::json()},
+          {"cp", Opt(c.cp)},
+          {"cpk", Opt(c.cpk)},
+          {"pp", Opt(c.pp)},
+          {"ppk", Opt(c.ppk)},
+          {"sigma_within", c.sigma_within > 0 ? nlohmann::json(c.sigma_within) : nlohmann::json()},
+          {"sigma_within_method", c.within_method},
+          {"message", c.message},
+          {"caveat", c.caveat},
+          {"control", ControlJson(m, req, who, spc_alarms)},
+          {"drift", DriftJson(d)}};
+}
+
 }  // namespace
 
 std::string ValidateStatsRequest(const StatsRequest& r) {
@@ -117,6 +175,7 @@ std::string ValidateStatsRequest(const StatsRequest& r) {
   if (!r.rules.IsValid(&why)) return "rules: " + why;
   if (r.gauge_serial && !ValidSerial(*r.gauge_serial, &why)) return "gauge: " + why;
   if (r.from && r.to && !(*r.from < *r.to)) return "from must be before to";
+  if (r.baseline < 2) return "baseline must be at least 2 PASS units";
   return "";
 }
 
@@ -161,17 +220,19 @@ nlohmann::json StatsReport(db::Store& store, const StatsRequest& req) {
       ++g.outcomes[analysis::ToString(r.outcome)];
     }
     if (!g.series.count(r.name)) g.order.push_back(r.name);
-    Series& s = g.series[r.name];
-    s.unit = r.unit;
-    s.limit.lo = r.lo;  // one recipe hash: one set of limits
-    s.limit.hi = r.hi;
-    if (!r.value || r.outcome == analysis::Outcome::kError) continue;
-    s.measured.push_back(*r.value);
-    s.measured_serials.push_back(r.serial);
-    if (r.outcome == analysis::Outcome::kPass) {
-      s.passing.push_back(*r.value);
-      s.passing_serials.push_back(r.serial);
-    }
+    SpcSeries& m = g.series[r.name].measured;
+    m.measurement = r.name;
+    m.unit = r.unit;
+    m.limit.lo = r.lo;  // one recipe hash: one set of limits
+    m.limit.hi = r.hi;
+    m.population = req.population;
+    const bool pass = r.outcome == analysis::Outcome::kPass;
+    if (!r.value || (r.outcome != analysis::Outcome::kFail && !pass)) continue;
+    if (pass) g.series[r.name].passing.push_back(*r.value);
+    if (!pass && req.population == Population::kPass) continue;
+    m.values.push_back(*r.value);
+    m.serials.push_back(r.serial);
+    m.failed.push_back(!pass);
   }
 
   nlohmann::json recipes = nlohmann::json::array();
@@ -179,74 +240,10 @@ nlohmann::json StatsReport(db::Store& store, const StatsRequest& req) {
   nlohmann::json spc_alarms = nlohmann::json::array();
   for (const std::string& hash : hashes) {
     Group& g = groups[hash];
+    const std::string who = g.recipe_id + " v" + std::to_string(g.recipe_version) + ": ";
     nlohmann::json measurements = nlohmann::json::array();
-    for (const std::string& name : g.order) {
-      const Series& s = g.series[name];
-      const bool pass_only = req.population == Population::kPass;
-      SpcSeries pop;
-      pop.measurement = name;
-      pop.unit = s.unit;
-      pop.limit = s.limit;
-      pop.population = req.population;
-      pop.values = pass_only ? s.passing : s.measured;
-      pop.serials = pass_only ? s.passing_serials : s.measured_serials;
-      const analysis::CapabilityIndices c =
-          analysis::ComputeCapabilityIndices(pop.values, s.limit, req.subgroup);
-      const analysis::DriftSummary d =
-          analysis::DetectDrift(s.passing, s.limit, name, s.unit, req.drift);
-      const std::string who = g.recipe_id + " v" + std::to_string(g.recipe_version) + ": ";
-      if (d.alarm) alarms.push_back(who + d.message);
-      nlohmann::json control = {{"chart", req.subgroup > 1 ? "xbar_r" : "imr"},
-                                {"centre", nullptr},
-                                {"lcl", nullptr},
-                                {"ucl", nullptr},
-                                {"alarms", nlohmann::json::array()}};
-      std::optional<analysis::ControlLimits> limits;
-      std::vector<double> points;
-      if (req.subgroup > 1) {
-        const analysis::XbarRChart xr = analysis::ComputeXbarR(pop.values, req.subgroup);
-        if (xr.usable) {
-          limits = xr.xbar;
-          points = xr.means;
-        }
-      } else {
-        const analysis::IMrChart imr = analysis::ComputeIMr(pop.values);
-        if (imr.usable) {
-          limits = imr.individuals;
-          points = pop.values;
-        }
-      }
-      if (limits) {
-        const std::vector<NamedAlarm> named =
-            NameAlarms(analysis::ApplyRunRules(points, *limits, req.rules), pop, req.subgroup);
-        for (const NamedAlarm& a : named) spc_alarms.push_back(who + a.text);
-        control["centre"] = limits->centre;
-        control["lcl"] = limits->lcl;
-        control["ucl"] = limits->ucl;
-        control["alarms"] = AlarmsJson(named);
-      }
-      const bool have = c.sample.n > 0;
-      measurements.push_back(
-          {{"name", name},
-           {"unit", s.unit},
-           {"lo", Opt(s.limit.lo)},
-           {"hi", Opt(s.limit.hi)},
-           {"population", PopulationText(req.population)},
-           {"n", c.sample.n},
-           {"mean", have ? nlohmann::json(c.sample.mean) : nlohmann::json()},
-           {"sd", c.sample.n > 1 ? nlohmann::json(c.sample.sd) : nlohmann::json()},
-           {"min", have ? nlohmann::json(c.sample.min) : nlohmann::json()},
-           {"max", have ? nlohmann::json(c.sample.max) : nlohmann::json()},
-           {"cp", Opt(c.cp)},
-           {"cpk", Opt(c.cpk)},
-           {"pp", Opt(c.pp)},
-           {"ppk", Opt(c.ppk)},
-           {"sigma_within", c.sigma_within > 0 ? nlohmann::json(c.sigma_within) : nlohmann::json()},
-           {"sigma_within_method", c.within_method},
-           {"message", c.message},
-           {"control", control},
-           {"drift", DriftJson(d)}});
-    }
+    for (const std::string& name : g.order)
+      measurements.push_back(MeasurementJson(g.series[name], req, who, alarms, spc_alarms));
     recipes.push_back({{"recipe_id", g.recipe_id},
                        {"recipe_version", g.recipe_version},
                        {"recipe_hash", hash},
@@ -259,7 +256,8 @@ nlohmann::json StatsReport(db::Store& store, const StatsRequest& req) {
       {"to", req.to ? nlohmann::json(*req.to) : nlohmann::json()},
       {"recipe_hash", req.recipe_hash ? nlohmann::json(*req.recipe_hash) : nlohmann::json()},
       {"population", PopulationText(req.population)},
-      {"subgroup", req.subgroup}};
+      {"subgroup", req.subgroup},
+      {"baseline", req.baseline}};
   return {{"window", window},
           {"recipes", recipes},
           {"alarms", alarms},

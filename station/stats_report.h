@@ -1,25 +1,28 @@
 // The statistics report behind `eol stats` and GET /api/stats: the store's measurement rows
 // grouped per recipe (hash) and measurement, fed to analysis/qc/statistics.h and spc.h.
 //
-//   capability over the production tests' PASS units by default, or PASS and FAIL units
-//     (population "all"; ERROR tests said nothing about the motor and never count), against
-//     the limits the units were judged with (stored with each measurement): n, mean, sd, min,
-//     max; Cp/Cpk from the within-subgroup sigma (MRbar/1.128 for subgroup 1, Rbar/d2 for
-//     subgroups of 2..10 consecutive units), Pp/Ppk from the overall sd;
-//   the control chart's limits (I chart, or X-bar with subgroups) over the same units and its
-//     run-rule alarms (rules 1-3 of analysis/qc/spc.h), each naming the unit and serial;
+//   capability over the production tests' PASS and FAIL units by default (population "all";
+//     "pass" for the PASS units only; ERROR tests said nothing about the motor and never
+//     count), against the limits the units were judged with (stored with each measurement):
+//     n, FAIL units, mean, sd, min, max; Cp/Cpk from the within-subgroup sigma (MRbar/1.128
+//     for subgroup 1, Rbar/d2 for subgroups of 2..10 consecutive units), Pp/Ppk from the
+//     overall sd, with a caveat below 30 units;
+//   the control chart (I chart, or X-bar with subgroups): limits from the first `baseline`
+//     PASS units, every unit's point against them, its run-rule alarms (rules 1-3 of
+//     analysis/qc/spc.h), each naming the unit and serial (station/spc_charts.h);
 //   drift (the trend test) over the passing production tests in test order (a rejected
 //     defect is not a trend), with the alarm and its message;
 //   a type-1 gauge study when a serial is given: its PASS/FAIL tests (production or
 //     self-check) under the recipe of its newest test.
 // Self-check (master) tests never enter the production figures.
 //
-// {"window": {"from", "to", "recipe_hash", "population", "subgroup"},
+// {"window": {"from", "to", "recipe_hash", "population", "subgroup", "baseline"},
 //  "recipes": [{"recipe_id", "recipe_version", "recipe_hash", "tests", "outcomes": {...},
-//               "measurements": [{"name", "unit", "lo", "hi", "population", "n", "mean", "sd",
-//                                 "min", "max", "cp", "cpk", "pp", "ppk", "sigma_within",
-//                                 "sigma_within_method", "message",
-//                                 "control": {"chart", "centre", "lcl", "ucl", "alarms": [
+//               "measurements": [{"name", "unit", "lo", "hi", "population", "n", "fail",
+//                                 "mean", "sd", "min", "max", "cp", "cpk", "pp", "ppk",
+//                                 "sigma_within", "sigma_within_method", "message", "caveat",
+//                                 "control": {"chart", "baseline_units", "baseline", "caveat",
+//                                             "centre", "lcl", "ucl", "alarms": [
 //                                   {"rule", "index", "first", "value", "serial", "message"}]},
 //                                 "drift": {...}}]}],
 //  "alarms": ["<recipe id> v<version>: drift alarm: ..."],
@@ -47,8 +50,9 @@ struct StatsRequest {
   std::optional<std::string> to;    // exclusive
   std::optional<std::string> recipe_hash;
   std::optional<std::string> gauge_serial;
-  std::map<std::string, double> reference;    // gauge reference value per measurement name
-  Population population = Population::kPass;  // the units of capability and control charts
+  std::map<std::string, double> reference;        // gauge reference value per measurement name
+  Population population = Population::kMeasured;  // the units of capability and charts
+  std::size_t baseline = kDefaultBaselineUnits;   // control limits from this many PASS units
   std::size_t subgroup = 1;  // 1: I-MR (sigma within MRbar/1.128); 2..10: X-bar/R (Rbar/d2)
   analysis::SpcRuleOptions rules;
   analysis::DriftOptions drift;

@@ -5,6 +5,8 @@
 #include <charconv>
 #include <cmath>
 
+#include "analysis/text.h"
+
 namespace eol::analysis {
 namespace {
 
@@ -20,12 +22,8 @@ constexpr std::array<SpcConstants, 9> kTable = {{
     {10, 0.308, 3.078, 0.223, 1.777},
 }};
 
-// Locale-independent, 6 significant digits.
-std::string Num(double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 6);
-  return std::string(buf, r.ptr);
-}
+// Messages: 4 significant digits (a control limit of 417.765 Hz reads 417.8).
+std::string Num(double v) { return Significant(v, 4); }
 
 double Mean(const std::vector<double>& v) {
   double sum = 0.0;
@@ -188,10 +186,53 @@ CapabilityIndices ComputeCapabilityIndices(const std::vector<double>& values, co
   Indices(c.sample.mean, c.sample.sd, limits, &c.pp, &c.ppk);
   Indices(c.sample.mean, c.sigma_within, limits, &c.cp, &c.cpk);
   c.usable = c.sigma_within > 0.0;
+  if (c.cpk && c.sample.n < kMinCapabilityUnits) {
+    const double n = static_cast<double>(c.sample.n);
+    const double half = 1.96 * std::sqrt(1.0 / (9.0 * n) + *c.cpk * *c.cpk / (2.0 * (n - 1.0)));
+    c.caveat = "only " + std::to_string(c.sample.n) + " units (" +
+               std::to_string(kMinCapabilityUnits) + " or more for a capability index): Cpk " +
+               Num(*c.cpk) + " lies in about [" + Num(*c.cpk - half) + ", " + Num(*c.cpk + half) +
+               "] (95 %)";
+  }
   if (!c.usable)
     c.message = "no within-subgroup spread (" + c.within_method + " is 0): no Cp/Cpk";
   else if (!c.ppk)
     c.message = "no limits";
+  return c;
+}
+
+PhasedChart ComputePhasedChart(const std::vector<double>& values,
+                               const std::vector<double>& baseline, std::size_t subgroup_size) {
+  PhasedChart c;
+  c.subgroup_size = std::max<std::size_t>(subgroup_size, 1);
+  c.baseline_units = baseline.size();
+  if (c.subgroup_size == 1) {
+    const IMrChart base = ComputeIMr(baseline);
+    const IMrChart all = ComputeIMr(values);
+    c.usable = base.usable;
+    c.message = base.usable ? "" : "baseline: " + base.message;
+    c.points = values;
+    c.spreads = all.moving_ranges;
+    c.centre = base.individuals;
+    c.spread = base.moving_range;
+    c.sigma_within = base.sigma_within;
+    c.baseline_points = baseline.size();
+  } else {
+    const XbarRChart base = ComputeXbarR(baseline, c.subgroup_size);
+    const XbarRChart all = ComputeXbarR(values, c.subgroup_size);
+    c.usable = base.usable;
+    c.message = base.usable ? "" : "baseline: " + base.message;
+    c.points = all.means;
+    c.spreads = all.ranges;
+    c.centre = base.xbar;
+    c.spread = base.range;
+    c.sigma_within = base.sigma_within;
+    c.baseline_points = base.means.size();
+  }
+  if (c.usable && c.baseline_points < kMinBaselinePoints)
+    c.caveat = "control limits from only " + std::to_string(c.baseline_points) +
+               (c.subgroup_size == 1 ? " baseline units" : " baseline subgroups") + " (" +
+               std::to_string(kMinBaselinePoints) + " or more for settled limits)";
   return c;
 }
 

@@ -38,7 +38,13 @@
 //   sigma_within is MRbar / 1.128 (subgroup size 1) or Rbar / d2(n); s is the overall sample
 //   standard deviation (divisor N - 1). Cp/Cpk say what the process could do without the
 //   drift between units; Pp/Ppk what it did. A one-sided limit gives no Cp/Pp and a Cpk/Ppk
-//   from its one side.
+//   from its one side. Below 30 units the indices carry a caveat with Cpk's approximate 95 %
+//   interval (Bissell): Cpk +- 1.96 sqrt(1 / (9 N) + Cpk^2 / (2 (N - 1))).
+//
+// Baseline and monitoring (phase I / phase II, as SPC is run): the control limits come from an
+// in-control baseline (the station takes the first PASS units of the window) and every unit,
+// PASS or FAIL, is charted against them, so a run of bad units cannot widen its own limits.
+// Fewer than 20 baseline points (units for I-MR, subgroups for X-bar/R) is stated as a caveat.
 #pragma once
 
 #include <cstddef>
@@ -121,9 +127,30 @@ struct CapabilityIndices {
   std::optional<double> pp, ppk;  // from s
   bool usable = false;            // s > 0 and sigma_within > 0
   std::string message;
+  std::string caveat;  // below kMinCapabilityUnits: the units and Cpk's 95 % interval
 };
+inline constexpr std::size_t kMinCapabilityUnits = 30;
 // `subgroup_size` 1 estimates sigma_within from moving ranges, 2..10 from subgroup ranges.
 CapabilityIndices ComputeCapabilityIndices(const std::vector<double>& values, const Limit& limits,
                                            std::size_t subgroup_size = 1);
+
+// Control limits from `baseline` (the in-control units), points of `values` (every unit)
+// against them: I-MR for subgroup_size 1, X-bar/R for 2..10 (subgroups of consecutive units of
+// each list). Unusable (with the message) when the baseline gives no limits.
+struct PhasedChart {
+  bool usable = false;
+  std::string message;
+  std::size_t subgroup_size = 1;
+  std::vector<double> points;   // the individuals, or the subgroup means, of every unit
+  std::vector<double> spreads;  // moving ranges (first at unit 2) or subgroup ranges
+  ControlLimits centre;         // I or X-bar limits, from the baseline
+  ControlLimits spread;         // MR or R limits, from the baseline
+  double sigma_within = 0.0;    // the baseline's
+  std::size_t baseline_units = 0, baseline_points = 0;
+  std::string caveat;  // fewer than kMinBaselinePoints baseline points
+};
+inline constexpr std::size_t kMinBaselinePoints = 20;
+PhasedChart ComputePhasedChart(const std::vector<double>& values,
+                               const std::vector<double>& baseline, std::size_t subgroup_size = 1);
 
 }  // namespace eol::analysis

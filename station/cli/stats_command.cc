@@ -1,4 +1,4 @@
-// `eol stats --db FILE [--recipe-hash H] [--from T] [--to T] [--population pass|all]
+// `eol stats --db FILE [--recipe-hash H] [--from T] [--to T] [--population all|pass] [--baseline N]
 //  [--subgroup N] [--gauge SERIAL] [--reference NAME=VALUE ...] [--gauge-sigma-span 6|4]
 //  [--drift-t T] [--plot FILE.svg|.png] [--json]`:
 // capability (Cp/Cpk within, Pp/Ppk overall), control-chart run-rule alarms, drift alarms and
@@ -32,8 +32,9 @@ struct StatsArgs {
   std::vector<std::string> references;
   double sigma_span = 6.0;
   double drift_t = 4.0;
-  std::string population = "pass";
+  std::string population = "all";
   std::size_t subgroup = 1;
+  std::size_t baseline = kDefaultBaselineUnits;
   std::string plot;
   bool json = false;
 };
@@ -95,13 +96,14 @@ void WritePlot(db::Store& store, const StatsRequest& req, const std::string& pat
     c.to = req.to;
     c.recipe_hash = req.recipe_hash;
     c.population = req.population;
+    c.baseline = req.baseline;
     const std::optional<SpcSeries> s = ReadSpcSeries(store, c);
     if (!s) continue;
     if (chart.title.empty())
       chart.title = "eol stats: recipe " + s->recipe_id + " v" + std::to_string(s->recipe_version) +
                     " (" + s->recipe_hash.substr(0, 12) + "), " + PopulationText(s->population);
     const ChartKind kind = req.subgroup > 1 ? ChartKind::kXbarR : ChartKind::kIMr;
-    for (auto& p : ChartPanels(*s, kind, req.subgroup, req.rules))
+    for (auto& p : ChartPanels(*s, kind, req.subgroup, req.rules, req.baseline))
       chart.panels.push_back(std::move(p));
     for (auto& p : ChartPanels(*s, ChartKind::kHistogram, 1, req.rules))
       chart.panels.push_back(std::move(p));
@@ -171,8 +173,9 @@ int RunStats(const StatsArgs& a) {
   req.gauge.sigma_span = a.sigma_span;
   req.drift.alarm_t = a.drift_t;
   if (!ParsePopulation(a.population, &req.population))
-    throw std::runtime_error("--population must be pass or all (have '" + a.population + "')");
+    throw std::runtime_error("--population must be all or pass (have '" + a.population + "')");
   req.subgroup = a.subgroup;
+  req.baseline = a.baseline;
   std::string why;
   for (const std::string& r : a.references)
     if (!ParseReference(r, req.reference, &why)) throw std::runtime_error("--reference: " + why);
@@ -197,8 +200,9 @@ void AddStatsCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "stats",
       "Production statistics per recipe: n, mean, sd, Cp/Cpk (within-subgroup sigma) and\n"
-      "Pp/Ppk (overall sd) of every measurement against its limits, over the PASS units (or\n"
-      "--population all), control-chart run-rule alarms (rules 1-3, naming the serial), drift\n"
+      "Pp/Ppk (overall sd) of every measurement against its limits, over the PASS and FAIL\n"
+      "units (or --population pass), control charts with limits from the first --baseline\n"
+      "PASS units and run-rule alarms (rules 1-3, naming the serial), drift\n"
       "alarms (trend over the passing tests), and with --gauge a type-1 gauge study of one\n"
       "serial tested repeatedly. Self-check (master) tests are excluded. --plot draws the\n"
       "control charts and histograms of resonance_f_hz and resonance_q.\n"
@@ -216,7 +220,12 @@ void AddStatsCommand(CLI::App& app) {
   cmd->add_option("--gauge-sigma-span", args->sigma_span, "6 (default) or 4 sigma convention");
   cmd->add_option("--drift-t", args->drift_t, "|t| of the trend slope that raises an alarm (4)");
   cmd->add_option("--population", args->population,
-                  "Units of capability and control charts: pass (default) or all (PASS and FAIL)");
+                  "Units of capability and control charts: all (default: PASS and FAIL) or pass")
+      ->capture_default_str();
+  cmd->add_option("--baseline", args->baseline,
+                  "Control limits from the first N PASS units (every unit is charted against them)")
+      ->check(Between(2, 100000))
+      ->capture_default_str();
   cmd->add_option("--subgroup", args->subgroup,
                   "1 (default): I-MR, sigma within = MRbar/1.128; 2..10: X-bar/R subgroups of\n"
                   "consecutive units, sigma within = Rbar/d2");

@@ -32,10 +32,13 @@ void GetStats(ApiContext& c, const httplib::Request& req, httplib::Response& res
       return Send(res, BadRequest("bad_reference", why));
   if (req.has_param("population") &&
       !ParsePopulation(req.get_param_value("population"), &q.population))
-    return Send(res, BadRequest("bad_population", "population must be pass or all"));
-  long long subgroup = 1;
-  if (const auto e = IntegerParam(req, "subgroup", 1, 10, &subgroup)) return Send(res, *e);
+    return Send(res, BadRequest("bad_population", "population must be all or pass"));
+  long long subgroup = 1, baseline = static_cast<long long>(q.baseline);
+  for (const auto& e : {IntegerParam(req, "subgroup", 1, 10, &subgroup),
+                        IntegerParam(req, "baseline", 2, 100000, &baseline)})
+    if (e) return Send(res, *e);
   q.subgroup = static_cast<std::size_t>(subgroup);
+  q.baseline = static_cast<std::size_t>(baseline);
   if (req.has_param("sigma_span")) {
     const std::string v = req.get_param_value("sigma_span");
     if (v != "4" && v != "6")
@@ -53,17 +56,18 @@ void GetStats(ApiContext& c, const httplib::Request& req, httplib::Response& res
 }
 
 // GET /api/charts/<measurement>.svg?chart=imr|xbar_r|histogram&from=&to=&last=&subgroup=
-//   &population=pass|all&recipe_hash=: the chart as image/svg+xml (station/spc_charts.h).
+//   &population=all|pass&baseline=&recipe_hash=: the chart as image/svg+xml
+//   (station/spc_charts.h).
 // Unknown parameters are refused (a misspelt "subgrup" would otherwise draw the default).
 void GetChart(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
-  static const std::set<std::string> kKnown = {"chart",    "from",       "to",         "last",
-                                               "subgroup", "population", "recipe_hash"};
+  static const std::set<std::string> kKnown = {"chart",    "from",       "to",       "last",
+                                               "subgroup", "population", "baseline", "recipe_hash"};
   for (const auto& [name, value] : req.params)
     if (!kKnown.count(name))
       return Send(res, BadRequest("unknown_parameter",
                                   "unknown parameter '" + name +
                                       "' (chart, from, to, last, subgroup, population, "
-                                      "recipe_hash)"));
+                                      "baseline, recipe_hash)"));
   ChartRequest q;
   q.measurement = req.matches[1];
   if (std::find(analysis::names::kAll.begin(), analysis::names::kAll.end(), q.measurement) ==
@@ -72,18 +76,20 @@ void GetChart(ApiContext& c, const httplib::Request& req, httplib::Response& res
                 ApiError{ApiErrorKind::kNotFound, "unknown_measurement", ValidateChartRequest(q)});
   for (const auto& e : {TimeParam(req, "from", &q.from), TimeParam(req, "to", &q.to)})
     if (e) return Send(res, *e);
-  long long last = 0, subgroup = 5;
+  long long last = 0, subgroup = 5, baseline = static_cast<long long>(q.baseline);
   for (const auto& e : {IntegerParam(req, "last", 1, 100000, &last),
-                        IntegerParam(req, "subgroup", 2, 10, &subgroup)})
+                        IntegerParam(req, "subgroup", 2, 10, &subgroup),
+                        IntegerParam(req, "baseline", 2, 100000, &baseline)})
     if (e) return Send(res, *e);
   q.last = static_cast<std::size_t>(last);
   q.subgroup = static_cast<std::size_t>(subgroup);
+  q.baseline = static_cast<std::size_t>(baseline);
   if (req.has_param("chart") && !ParseChartKind(req.get_param_value("chart"), &q.kind))
     return Send(res, BadRequest("bad_chart", "chart must be imr, xbar_r or histogram (have '" +
                                                  req.get_param_value("chart") + "')"));
   if (req.has_param("population") &&
       !ParsePopulation(req.get_param_value("population"), &q.population))
-    return Send(res, BadRequest("bad_population", "population must be pass or all (have '" +
+    return Send(res, BadRequest("bad_population", "population must be all or pass (have '" +
                                                       req.get_param_value("population") + "')"));
   if (req.has_param("recipe_hash")) q.recipe_hash = req.get_param_value("recipe_hash");
   if (const std::string bad = ValidateChartRequest(q); !bad.empty())

@@ -546,7 +546,7 @@ TEST(EngineerPage, ShowsChartsCapabilityDetectabilityAndFiguresFromFiles) {
                 0.006 * std::abs(f0[key].get<double>()))
         << key;
   }
-  const std::string units = std::to_string(f0["n"].get<int>()) + " PASS units";
+  const std::string units = std::to_string(f0["n"].get<int>()) + " PASS and FAIL units";
   const std::map<std::string, std::vector<std::string>> want = {
       {"chart-imr",
        {"resonance_f_hz individuals / moving range (I-MR)", "individuals (I chart), " + units,
@@ -567,7 +567,7 @@ TEST(EngineerPage, ShowsChartsCapabilityDetectabilityAndFiguresFromFiles) {
   ASSERT_EQ(j["last"]["capability"].size(), 1u);
   EXPECT_EQ(j["last"]["capability"][0]["n"], 5);
   EXPECT_NE(j["last"]["charts"]["chart-imr"]["desc"].get<std::string>().find(
-                "individuals (I chart), 5 PASS units"),
+                "individuals (I chart), 5 PASS and FAIL units"),
             std::string::npos)
       << j["last"]["charts"]["chart-imr"];
   EXPECT_NE(j["last"]["charts"]["chart-imr"]["url"].get<std::string>().find("from="),

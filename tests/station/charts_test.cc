@@ -152,31 +152,43 @@ TEST_F(ChartsTest, StatsPlotDrawsControlChartsAndHistogramsWithLimits) {
   EXPECT_CONTAINS(r.out, "RUN-RULE ALARM pmsm-10pole v1: resonance_f_hz rule 2");
   const Svg s = ParseSvg(svg);
   ExpectSvg(s);
-  EXPECT_CONTAINS(s.title, "eol stats: recipe pmsm-10pole v1 (cccccccccccc), PASS units");
-  EXPECT_CONTAINS(s.words, "resonance_f_hz: individuals (I chart), 30 PASS units");
-  EXPECT_CONTAINS(s.words, "UCL 396.228");
-  EXPECT_CONTAINS(s.words, "LCL 385.772");
+  // Every measured unit by default, the FAIL unit marked, against the PASS units' limits
+  // (4 significant digits).
+  EXPECT_CONTAINS(s.title, "eol stats: recipe pmsm-10pole v1 (cccccccccccc), PASS and FAIL units");
+  EXPECT_CONTAINS(s.words, "resonance_f_hz: individuals (I chart), 31 PASS and FAIL units");
+  EXPECT_CONTAINS(s.words,
+                  "control limits from the first 30 PASS units (all there are; 50 asked), "
+                  "C-001..C-030");
+  EXPECT_CONTAINS(s.words, "FAIL unit (1)");
+  EXPECT_CONTAINS(s.words, "UCL 396.2\n");
+  EXPECT_CONTAINS(s.words, "LCL 385.8\n");
   EXPECT_CONTAINS(s.words, "centre 391\n");
-  EXPECT_CONTAINS(s.words, "UCL 6.42134");  // MR chart
+  EXPECT_CONTAINS(s.words, "UCL 6.421\n");  // MR chart
   EXPECT_CONTAINS(s.words, "LSL 370 Hz");
   EXPECT_CONTAINS(s.words, "USL 420 Hz");
   EXPECT_CONTAINS(s.words,
                   "resonance_f_hz rule 2: 9 points in a row above the centre line 391 at units "
                   "21-29 (serials C-021..C-029)");
-  EXPECT_CONTAINS(s.words, "resonance_f_hz: histogram of 30 PASS units");
-  EXPECT_CONTAINS(s.words, "resonance_q: individuals (I chart), 30 PASS units");
+  EXPECT_CONTAINS(s.words,
+                  "resonance_f_hz rule 1: a point at 425 beyond the UCL 396.2 at unit 31 "
+                  "(serial C-031)");
+  EXPECT_CONTAINS(s.words, "resonance_f_hz: histogram of 31 PASS and FAIL units");
+  EXPECT_CONTAINS(s.words, "FAIL units (1)");
+  EXPECT_CONTAINS(s.words, "resonance_q: individuals (I chart), 31 PASS and FAIL units");
   EXPECT_CONTAINS(s.words, "UCL 51.32");
   EXPECT_CONTAINS(s.words, "Cp ");
   EXPECT_CONTAINS(s.words, "Pp ");
   EXPECT_CONTAINS(s.words, "unit (test order)");
+  EXPECT_EQ(s.words.find("396.228"), std::string::npos) << "six digits where four say it";
 
-  // Every unit measured: the FAIL unit enters and the chart says so.
-  const std::string all = dir_ / "all.svg";
-  ASSERT_EQ(Eol({"stats", "--db", db_, "--population", "all", "--plot", all}).code, 0);
-  const Svg a = ParseSvg(all);
+  // PASS units only, on request: the FAIL unit is left out and the chart says so.
+  const std::string pass = dir_ / "pass.svg";
+  ASSERT_EQ(Eol({"stats", "--db", db_, "--population", "pass", "--plot", pass}).code, 0);
+  const Svg a = ParseSvg(pass);
   ExpectSvg(a);
-  EXPECT_CONTAINS(a.words, "resonance_f_hz: individuals (I chart), 31 PASS and FAIL units");
-  EXPECT_EQ(a.words.find("30 PASS units"), std::string::npos);
+  EXPECT_CONTAINS(a.words, "resonance_f_hz: individuals (I chart), 30 PASS units");
+  EXPECT_EQ(a.words.find("31 PASS and FAIL units"), std::string::npos);
+  EXPECT_EQ(a.words.find("FAIL unit ("), std::string::npos);
 
   // PNG by extension.
   ASSERT_EQ(Eol({"stats", "--db", db_, "--plot", dir_ / "stats.png"}).code, 0);
@@ -186,14 +198,16 @@ TEST_F(ChartsTest, StatsPlotDrawsControlChartsAndHistogramsWithLimits) {
   EXPECT_EQ(magic, "\x89PNG\r\n\x1a\n");
 }
 
-TEST_F(ChartsTest, StatsNamesCpAndPpAndCountsPassUnitsByDefault) {
-  const CliRun r = Eol({"stats", "--db", db_, "--json"});
+TEST_F(ChartsTest, StatsNamesCpAndPpAndCountsPassUnitsOnRequest) {
+  const CliRun r = Eol({"stats", "--db", db_, "--population", "pass", "--json"});
   ASSERT_EQ(r.code, 0) << r.out;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["window"]["population"], "PASS units");
   const nlohmann::json& f0 = j["recipes"][0]["measurements"][0];
   ASSERT_EQ(f0["name"], "resonance_f_hz");
   EXPECT_EQ(f0["n"], 30);
+  EXPECT_EQ(f0["fail"], 0);
+  EXPECT_EQ(f0["caveat"], "");  // 30 units: enough for a capability index
   // sigma within = MRbar / 1.128 = (57 / 29) / 1.128 = 1.74248; Cp = 50 / (6 * 1.74248).
   EXPECT_NEAR(f0["sigma_within"].get<double>(), 57.0 / 29.0 / 1.128, 1e-9);
   EXPECT_NEAR(f0["cp"].get<double>(), 50.0 / (6.0 * 57.0 / 29.0 / 1.128), 1e-9);
@@ -215,21 +229,68 @@ TEST_F(ChartsTest, StatsNamesCpAndPpAndCountsPassUnitsByDefault) {
   EXPECT_EQ(f0["control"]["alarms"][0]["serial"], "C-029");
   ASSERT_EQ(j["spc_alarms"].size(), 1u) << j["spc_alarms"].dump();
 
-  const CliRun all = Eol({"stats", "--db", db_, "--population", "all", "--json"});
+  // By default every measured unit: the FAIL unit enters the figures and the chart, not its
+  // limits (they come from the PASS units), so it raises rule 1.
+  const CliRun all = Eol({"stats", "--db", db_, "--json"});
   ASSERT_EQ(all.code, 0) << all.out;
   const nlohmann::json ja = nlohmann::json::parse(all.out);
   EXPECT_EQ(ja["window"]["population"], "PASS and FAIL units");
-  EXPECT_EQ(ja["recipes"][0]["measurements"][0]["n"], 31);
+  const nlohmann::json& fa = ja["recipes"][0]["measurements"][0];
+  EXPECT_EQ(fa["n"], 31);
+  EXPECT_EQ(fa["fail"], 1);
+  EXPECT_EQ(fa["control"]["baseline_units"], 30);
+  EXPECT_NEAR(fa["control"]["ucl"].get<double>(), 391.0 + 2.66 * 57.0 / 29.0, 1e-9);
+  ASSERT_EQ(fa["control"]["alarms"].size(), 2u) << fa["control"].dump();
+  EXPECT_EQ(fa["control"]["alarms"][1]["rule"], 1);
+  EXPECT_EQ(fa["control"]["alarms"][1]["serial"], "C-031");
 
   const CliRun text = Eol({"stats", "--db", db_});
-  EXPECT_CONTAINS(text.out, "capability over PASS units; Cp/Cpk from the within-subgroup sigma");
+  EXPECT_CONTAINS(text.out,
+                  "capability over PASS and FAIL units; Cp/Cpk from the within-subgroup sigma");
   EXPECT_CONTAINS(text.out, "Ppk");
   const CliRun bad = Eol({"stats", "--db", db_, "--population", "some"}, true);
   EXPECT_EQ(bad.code, 2);
-  EXPECT_CONTAINS(bad.out, "--population must be pass or all");
+  EXPECT_CONTAINS(bad.out, "--population must be all or pass");
+  const CliRun base = Eol({"stats", "--db", db_, "--baseline", "1"}, true);
+  EXPECT_EQ(base.code, 2);
+  EXPECT_CONTAINS(base.out, "--baseline");
   const CliRun sub = Eol({"stats", "--db", db_, "--subgroup", "11"}, true);
   EXPECT_EQ(sub.code, 2);
   EXPECT_CONTAINS(sub.out, "subgroup must be 1 (I-MR) or 2..10 (X-bar/R)");
+}
+
+// Eight units below the lower spec after 30 good ones: charted against the limits of the PASS
+// units, every one of them alarms (rule 1), and the overall capability (Ppk) of all 38 units
+// says what the process did. A PASS-only chart shows none of them.
+TEST(HonestSpc, EightUnitsBelowTheLowerSpecAlarmAgainstTheBaselineLimits) {
+  eol::testing::TempDir dir;
+  const std::string db = dir / "drop.sqlite";
+  {
+    auto store = db::Store::Open(db);
+    for (int i = 0; i < 38; ++i) {
+      const bool bad = i >= 30;
+      const double f0 = bad ? 365.0 + (i % 2) : 390.0 + (i % 2 == 0 ? -1.0 : 1.0);
+      auto unit = Unit(i, bad ? Outcome::kFail : Outcome::kPass, f0, 46.0 + (i % 2));
+      store->Insert(unit);
+    }
+  }
+  const CliRun r = Eol({"stats", "--db", db, "--json"});
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json f0 = nlohmann::json::parse(r.out)["recipes"][0]["measurements"][0];
+  EXPECT_EQ(f0["n"], 38);
+  EXPECT_EQ(f0["fail"], 8);
+  EXPECT_EQ(f0["control"]["baseline_units"], 30);
+  EXPECT_NEAR(f0["control"]["lcl"].get<double>(), 390.0 - 2.66 * 2.0, 1e-9);
+  int beyond = 0;
+  for (const auto& a : f0["control"]["alarms"]) beyond += a["rule"] == 1 ? 1 : 0;
+  EXPECT_EQ(beyond, 8) << f0["control"].dump();
+  EXPECT_LT(f0["ppk"].get<double>(), 1.0) << "the eight spread the units over the LSL";
+
+  const CliRun pass = Eol({"stats", "--db", db, "--population", "pass", "--json"});
+  ASSERT_EQ(pass.code, 0) << pass.out;
+  const nlohmann::json p0 = nlohmann::json::parse(pass.out)["recipes"][0]["measurements"][0];
+  EXPECT_EQ(p0["n"], 30);
+  EXPECT_TRUE(p0["control"]["alarms"].empty()) << p0["control"].dump();
 }
 
 TEST_F(ChartsTest, ApiServesChartsAndRefusesBadRequestsWithJson) {
@@ -254,20 +315,34 @@ TEST_F(ChartsTest, ApiServesChartsAndRefusesBadRequestsWithJson) {
   ExpectSvg(imr);
   EXPECT_CONTAINS(imr.title,
                   "resonance_f_hz individuals / moving range (I-MR) - recipe pmsm-10pole");
-  EXPECT_CONTAINS(imr.words, "UCL 396.228");
+  EXPECT_CONTAINS(imr.words, "UCL 396.2\n");
   EXPECT_CONTAINS(imr.words, "(serials C-021..C-029)");
 
-  // The newest 10 units: units 21-30 alternate 392, 394: mean 393, MRbar 2, UCL 398.32.
-  const Svg last = get_svg("/api/charts/resonance_f_hz.svg?last=10&chart=imr");
+  // The newest 10 PASS units: units 21-30 alternate 392, 394: mean 393, MRbar 2, UCL 398.32;
+  // 10 baseline units are said to be too few for settled limits.
+  const Svg last = get_svg("/api/charts/resonance_f_hz.svg?last=10&chart=imr&population=pass");
   ExpectSvg(last);
   EXPECT_CONTAINS(last.words, "individuals (I chart), 10 PASS units");
-  EXPECT_CONTAINS(last.words, "UCL 398.32");
+  EXPECT_CONTAINS(last.words, "UCL 398.3\n");
+  EXPECT_CONTAINS(last.words,
+                  "control limits from only 10 baseline units (20 or more for settled limits)");
+
+  // A baseline of the first 20 PASS units: units 1-20 alternate 389, 391: centre 390, MRbar 2,
+  // UCL 395.32; every later unit is charted against those limits.
+  const Svg base = get_svg("/api/charts/resonance_f_hz.svg?baseline=20");
+  ExpectSvg(base);
+  EXPECT_CONTAINS(base.words, "control limits from the first 20 PASS units, C-001..C-020");
+  EXPECT_CONTAINS(base.words, "UCL 395.3\n");
+  EXPECT_CONTAINS(base.words, "centre 390\n");
 
   // X-bar/R of Q with subgroups of 5 consecutive units: 30 units make 6 subgroups.
   const Svg xr = get_svg("/api/charts/resonance_q.svg?chart=xbar_r&subgroup=5");
   ExpectSvg(xr);
   EXPECT_CONTAINS(xr.words, "resonance_q: subgroup means (X-bar chart), 6 subgroups of 5");
   EXPECT_CONTAINS(xr.words, "subgroup ranges (R chart)");
+  EXPECT_CONTAINS(xr.words, "the last 1 units make no whole subgroup");
+  EXPECT_EQ(xr.words.find("USL"), std::string::npos) << "spec limits bound units, not means";
+  EXPECT_EQ(xr.words.find("LSL"), std::string::npos) << "spec limits bound units, not means";
 
   const Svg h = get_svg("/api/charts/resonance_f_hz.svg?chart=histogram&population=all");
   ExpectSvg(h);
@@ -285,6 +360,7 @@ TEST_F(ChartsTest, ApiServesChartsAndRefusesBadRequestsWithJson) {
            {"/api/charts/resonance_f_hz.svg?last=5x", 400, "bad_last"},
            {"/api/charts/resonance_f_hz.svg?subgrup=3", 400, "unknown_parameter"},
            {"/api/charts/resonance_f_hz.svg?population=good", 400, "bad_population"},
+           {"/api/charts/resonance_f_hz.svg?baseline=1", 400, "bad_baseline"},
            {"/api/charts/resonance_f_hz.svg?from=2027-01-01T00:00:00Z", 404, "no_units"},
            {"/api/charts/winding_r_ohm.svg", 404, "no_units"}}) {
     auto res = http.Get(query);

@@ -115,7 +115,12 @@ class StatsKnownAnswer : public ::testing::Test {
     EXPECT_NEAR(f0.at("ppk").get<double>(), 4.21637021, 1e-7);
     EXPECT_NEAR(f0.at("cp").get<double>(), 9.4, 1e-9);
     EXPECT_NEAR(f0.at("cpk").get<double>(), 7.52, 1e-9);
-    EXPECT_EQ(f0.at("population"), "PASS units");
+    EXPECT_EQ(f0.at("population"), "PASS and FAIL units");  // every measured unit by default
+    // 5 units: the index comes with its caveat and the interval of Cpk (1.96 sqrt(1/45 +
+    // 7.52^2/8) = 5.219 either side).
+    EXPECT_EQ(f0.at("caveat"),
+              "only 5 units (30 or more for a capability index): Cpk 7.52 lies in about [2.301, "
+              "12.74] (95 %)");
     EXPECT_EQ(f0.at("sigma_within_method"), "MRbar/d2 (d2 = 1.128)");
     EXPECT_FALSE(f0.at("drift").at("usable").get<bool>());  // 5 < 10 tests
   }
