@@ -264,29 +264,17 @@ double Bic(double chi2_raw, int params, std::size_t k_lines, bool sigma_known) {
   return fit_term + params * std::log(n);
 }
 
-// Fits M + 1 modes starting from the M-mode model; fills *candidate and returns the summary.
-FitSummary AddMode(const Data& d, const MultiModeImpedance& fitted, const ModesFitOptions& o,
-                   double f0_lo, double f0_hi, bool sigma_known, ModeOrderCandidate* candidate) {
-  const int m = static_cast<int>(fitted.modes.size()) + 1;
-  const std::size_t k_lines = d.f.size();
-  FitSummary s;
-  s.model = "R+sL+" + std::to_string(m) + "x parallel-RLC";
-  s.sigma_estimated = !sigma_known;
-  s.dof = static_cast<int>(2 * k_lines) - ParamCount(m);
-  candidate->modes = m;
-  std::ostringstream os = MessageStream();
-
+// The start for the new mode: the best (f, Q) of a grid over the search range, then of local
+// refinements around the best cell, with the linear parameters solved. Not ok when no (f, Q)
+// gives positive linear parameters.
+SearchPoint StartForNewMode(const Data& d, const MultiModeImpedance& fitted,
+                            const ModesFitOptions& o, double f0_lo, double f0_hi) {
   const ModeSearch search(d, fitted);
   std::vector<double> fs = LogSpace(f0_lo, f0_hi, o.single.grid_f0);
   std::vector<double> qs = LogSpace(o.single.q_min, o.single.q_max, o.single.grid_q);
   int bi = -1, bj = -1;
   SearchPoint start = search.Grid(fs, qs, &bi, &bj);
-  if (!start.ok) {
-    s.termination = Termination::kFailed;
-    os << "no start for mode " << m << ": no (f, Q) gives positive linear parameters";
-    s.message = candidate->message = os.str();
-    return s;
-  }
+  if (!start.ok) return start;
   for (int pass = 0; pass < kRefinePasses; ++pass) {
     const auto at = [](const std::vector<double>& v, int i) {
       return v[static_cast<std::size_t>(std::clamp(i, 0, static_cast<int>(v.size()) - 1))];
@@ -300,20 +288,114 @@ FitSummary AddMode(const Data& d, const MultiModeImpedance& fitted, const ModesF
     bi = ri;
     bj = rj;
   }
+  return start;
+}
 
+// Levenberg-Marquardt in theta = ln p over `modes` modes; *theta ends at the fit.
+LeastSquaresOutcome Minimise(const Data& d, int modes, int max_iterations, Eigen::VectorXd* theta) {
   LeastSquaresProblem problem;
-  problem.parameters = ParamCount(m);
-  problem.residuals = static_cast<int>(2 * k_lines);
+  problem.parameters = ParamCount(modes);
+  problem.residuals = static_cast<int>(2 * d.f.size());
   problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
     Residual(d, FromTheta(t), r);
   };
   problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* j) {
     Jacobian(d, FromTheta(t), j);
   };
-  Eigen::VectorXd theta = ToTheta(start.model);
   LeastSquaresSettings settings;
-  settings.max_iterations = o.single.max_iterations;
-  const LeastSquaresOutcome lm = MinimizeLeastSquares(problem, &theta, settings);
+  settings.max_iterations = max_iterations;
+  return MinimizeLeastSquares(problem, theta, settings);
+}
+
+// chi2 (the noise estimated from the residual without sigma), the candidate's chi2 and BIC,
+// the covariance and the parameters of `fit` (theta = its ln p). Returns whether the
+// covariance is finite.
+bool FillStatistics(const Data& d, const MultiModeImpedance& fit, const Eigen::VectorXd& theta,
+                    bool sigma_known, FitSummary* s, ModeOrderCandidate* candidate) {
+  const int m = static_cast<int>(fit.modes.size());
+  Eigen::VectorXd r;
+  Eigen::MatrixXd jac;
+  Residual(d, fit, &r);
+  Jacobian(d, fit, &jac);
+  const double chi2_raw = r.squaredNorm();
+  const double noise_var = sigma_known ? 1.0 : chi2_raw / s->dof;
+  if (!sigma_known) s->estimated_sigma = std::sqrt(noise_var);
+  s->chi2 = chi2_raw / noise_var;
+  s->chi2_per_dof = s->chi2 / s->dof;
+  candidate->chi2 = chi2_raw;
+  candidate->bic = Bic(chi2_raw, ParamCount(m), d.f.size(), sigma_known);
+
+  Eigen::MatrixXd c_log;
+  const bool covariance_ok =
+      r.allFinite() && jac.allFinite() && InvertInformation(jac.transpose() * jac, &c_log);
+  const Eigen::VectorXd natural = theta.array().exp().matrix();
+  if (covariance_ok)
+    s->covariance = natural.asDiagonal() * (c_log * noise_var) * natural.asDiagonal();
+  auto sigma = [&](int i) { return covariance_ok ? std::sqrt(s->covariance(i, i)) : std::nan(""); };
+  s->params.push_back({"R_ohm", "ohm", fit.r_ohm, sigma(0)});
+  s->params.push_back({"L_h", "H", fit.l_h, sigma(1)});
+  for (int n = 0; n < m; ++n) {
+    const std::string k = std::to_string(n + 1);
+    const MotionalMode& mode = fit.modes[static_cast<std::size_t>(n)];
+    s->params.push_back({"Rp" + k + "_ohm", "ohm", mode.rp_ohm, sigma(2 + 3 * n)});
+    s->params.push_back({"f" + k + "_hz", "Hz", mode.f0_hz, sigma(3 + 3 * n)});
+    s->params.push_back({"Q" + k, "1", mode.q, sigma(4 + 3 * n)});
+  }
+  return covariance_ok;
+}
+
+// Whether every mode of the fit (finite covariance) is a resonance: inside the search range,
+// with a significant peak, distinct from the mode below it. Writes the first failure to os.
+bool ModesAreResolved(const FitSummary& s, const MultiModeImpedance& fit, const ModesFitOptions& o,
+                      double f0_lo, double f0_hi, std::ostream& os) {
+  const auto sigma = [&](int i) { return std::sqrt(s.covariance(i, i)); };
+  const double step = std::log(f0_hi / f0_lo) / (o.single.grid_f0 - 1);
+  const int m = static_cast<int>(fit.modes.size());
+  for (int n = 0; n < m; ++n) {
+    const MotionalMode& mode = fit.modes[static_cast<std::size_t>(n)];
+    const double rp_sigma = sigma(2 + 3 * n);
+    if (!(mode.f0_hz >= f0_lo * std::exp(step) && mode.f0_hz <= f0_hi * std::exp(-step))) {
+      os << "mode at " << mode.f0_hz << " Hz is at or beyond the edge of the search range";
+      return false;
+    }
+    if (!(mode.rp_ohm >= o.single.min_rp_significance * rp_sigma)) {
+      os << "mode at " << mode.f0_hz << " Hz: Rp = " << mode.rp_ohm << " +- " << rp_sigma
+         << " ohm is below " << o.single.min_rp_significance << " standard deviations";
+      return false;
+    }
+    if (n > 0) {
+      const MotionalMode& prev = fit.modes[static_cast<std::size_t>(n - 1)];
+      const double sep_sigma = std::hypot(sigma(3 + 3 * n), sigma(3 * n));
+      if (!(mode.f0_hz - prev.f0_hz > kDistinctSigmas * sep_sigma)) {
+        os << "modes at " << prev.f0_hz << " and " << mode.f0_hz
+           << " Hz are not distinct within their uncertainty";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// Fits M + 1 modes starting from the M-mode model; fills *candidate and returns the summary.
+FitSummary AddMode(const Data& d, const MultiModeImpedance& fitted, const ModesFitOptions& o,
+                   double f0_lo, double f0_hi, bool sigma_known, ModeOrderCandidate* candidate) {
+  const int m = static_cast<int>(fitted.modes.size()) + 1;
+  FitSummary s;
+  s.model = "R+sL+" + std::to_string(m) + "x parallel-RLC";
+  s.sigma_estimated = !sigma_known;
+  s.dof = static_cast<int>(2 * d.f.size()) - ParamCount(m);
+  candidate->modes = m;
+  std::ostringstream os = MessageStream();
+
+  const SearchPoint start = StartForNewMode(d, fitted, o, f0_lo, f0_hi);
+  if (!start.ok) {
+    s.termination = Termination::kFailed;
+    os << "no start for mode " << m << ": no (f, Q) gives positive linear parameters";
+    s.message = candidate->message = os.str();
+    return s;
+  }
+  Eigen::VectorXd theta = ToTheta(start.model);
+  const LeastSquaresOutcome lm = Minimise(d, m, o.single.max_iterations, &theta);
   s.iterations = lm.iterations;
   s.termination = lm.termination;
 
@@ -322,73 +404,22 @@ FitSummary AddMode(const Data& d, const MultiModeImpedance& fitted, const ModesF
   std::sort(fit.modes.begin(), fit.modes.end(),
             [](const MotionalMode& a, const MotionalMode& b) { return a.f0_hz < b.f0_hz; });
   theta = ToTheta(fit);
-  Eigen::VectorXd r;
-  Eigen::MatrixXd jac;
-  Residual(d, fit, &r);
-  Jacobian(d, fit, &jac);
-  const double chi2_raw = r.squaredNorm();
-  const double noise_var = sigma_known ? 1.0 : chi2_raw / s.dof;
-  if (!sigma_known) s.estimated_sigma = std::sqrt(noise_var);
-  s.chi2 = chi2_raw / noise_var;
-  s.chi2_per_dof = s.chi2 / s.dof;
-  candidate->chi2 = chi2_raw;
-  candidate->bic = Bic(chi2_raw, ParamCount(m), k_lines, sigma_known);
+  const bool covariance_ok = FillStatistics(d, fit, theta, sigma_known, &s, candidate);
 
-  Eigen::MatrixXd c_log;
-  const bool covariance_ok =
-      r.allFinite() && jac.allFinite() && InvertInformation(jac.transpose() * jac, &c_log);
-  const Eigen::VectorXd natural = theta.array().exp().matrix();
-  if (covariance_ok)
-    s.covariance = natural.asDiagonal() * (c_log * noise_var) * natural.asDiagonal();
-  auto sigma = [&](int i) { return covariance_ok ? std::sqrt(s.covariance(i, i)) : std::nan(""); };
-  s.params.push_back({"R_ohm", "ohm", fit.r_ohm, sigma(0)});
-  s.params.push_back({"L_h", "H", fit.l_h, sigma(1)});
-  for (int n = 0; n < m; ++n) {
-    const std::string k = std::to_string(n + 1);
-    const MotionalMode& mode = fit.modes[static_cast<std::size_t>(n)];
-    s.params.push_back({"Rp" + k + "_ohm", "ohm", mode.rp_ohm, sigma(2 + 3 * n)});
-    s.params.push_back({"f" + k + "_hz", "Hz", mode.f0_hz, sigma(3 + 3 * n)});
-    s.params.push_back({"Q" + k, "1", mode.q, sigma(4 + 3 * n)});
-  }
-
-  const double step = std::log(f0_hi / f0_lo) / (o.single.grid_f0 - 1);
   if (!lm.converged) {
     os << "Levenberg-Marquardt did not converge for " << m << " modes (" << ToString(lm.termination)
        << ", MINPACK status " << lm.minpack_status << ")";
   } else if (!covariance_ok) {
     os << m << " modes are not determined by the data (singular Jacobian)";
-  } else {
-    bool ok = true;
-    for (int n = 0; n < m && ok; ++n) {
+  } else if (ModesAreResolved(s, fit, o, f0_lo, f0_hi, os)) {
+    s.usable = true;
+    os << m << " modes:";
+    for (int n = 0; n < m; ++n) {
       const MotionalMode& mode = fit.modes[static_cast<std::size_t>(n)];
-      const double rp_sigma = sigma(2 + 3 * n);
-      if (!(mode.f0_hz >= f0_lo * std::exp(step) && mode.f0_hz <= f0_hi * std::exp(-step))) {
-        os << "mode at " << mode.f0_hz << " Hz is at or beyond the edge of the search range";
-        ok = false;
-      } else if (!(mode.rp_ohm >= o.single.min_rp_significance * rp_sigma)) {
-        os << "mode at " << mode.f0_hz << " Hz: Rp = " << mode.rp_ohm << " +- " << rp_sigma
-           << " ohm is below " << o.single.min_rp_significance << " standard deviations";
-        ok = false;
-      } else if (n > 0) {
-        const MotionalMode& prev = fit.modes[static_cast<std::size_t>(n - 1)];
-        const double sep_sigma = std::hypot(sigma(3 + 3 * n), sigma(3 * n));
-        if (!(mode.f0_hz - prev.f0_hz > kDistinctSigmas * sep_sigma)) {
-          os << "modes at " << prev.f0_hz << " and " << mode.f0_hz
-             << " Hz are not distinct within their uncertainty";
-          ok = false;
-        }
-      }
+      os << (n ? "," : "") << " f = " << mode.f0_hz << " +- " << s.params[3 + 3 * n].sigma
+         << " Hz (Q " << mode.q << ", Rp " << mode.rp_ohm << " ohm)";
     }
-    if (ok) {
-      s.usable = true;
-      os << m << " modes:";
-      for (int n = 0; n < m; ++n) {
-        const MotionalMode& mode = fit.modes[static_cast<std::size_t>(n)];
-        os << (n ? "," : "") << " f = " << mode.f0_hz << " +- " << sigma(3 + 3 * n) << " Hz (Q "
-           << mode.q << ", Rp " << mode.rp_ohm << " ohm)";
-      }
-      os << "; chi2/dof = " << s.chi2_per_dof << " (dof " << s.dof << ")";
-    }
+    os << "; chi2/dof = " << s.chi2_per_dof << " (dof " << s.dof << ")";
   }
   s.message = os.str();
   candidate->usable = s.usable;

@@ -151,6 +151,188 @@ FitSummary Invalid(const std::string& why) {
   return s;
 }
 
+// The f0 search range: the options' or, when both are 0, the data's band.
+struct F0Range {
+  double lo = 0.0, hi = 0.0;
+};
+
+F0Range SearchRange(const Frf& z, const ResonanceFitOptions& options) {
+  const bool auto_range = options.f0_min_hz == 0.0 && options.f0_max_hz == 0.0;
+  return {auto_range ? z.freq_hz.front() : options.f0_min_hz,
+          auto_range ? z.freq_hz.back() : options.f0_max_hz};
+}
+
+// Why the options or the data cannot be fitted; empty when they can.
+std::string InputProblem(const Frf& z, const ResonanceFitOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) return "options: " + why;
+  if (!z.Validate(&why)) return why;
+  if (z.quantity != Quantity::kImpedanceOhm)
+    return std::string("quantity is ") + ToString(z.quantity) + ", the fit needs " +
+           ToString(Quantity::kImpedanceOhm);
+  const std::size_t k_lines = z.size();
+  const std::size_t min_lines = kMinLinesPerParam * kMotionalParamCount;
+  if (k_lines < min_lines)
+    return std::to_string(k_lines) + " lines, the fit needs at least " + std::to_string(min_lines) +
+           " (2 per parameter)";
+  const F0Range range = SearchRange(z, options);
+  if (!(range.lo < z.freq_hz.back() && range.hi > z.freq_hz.front())) {
+    std::ostringstream os = MessageStream();
+    os << "f0 search range [" << range.lo << ", " << range.hi
+       << "] Hz does not overlap the data band [" << z.freq_hz.front() << ", " << z.freq_hz.back()
+       << "] Hz";
+    return os.str();
+  }
+  if (!(range.hi > range.lo)) return "the data band is a single frequency";
+  return "";
+}
+
+std::string NoResonance(const F0Range& range) {
+  std::ostringstream os = MessageStream();
+  os << "no resonance found between " << range.lo << " and " << range.hi << " Hz";
+  return os.str();
+}
+
+// The start of the fit: the best point of a coarse (f0, Q) grid, then of local refinements
+// around the best cell. Not ok when no grid point gives positive R, L and Rp.
+GridPoint GridStart(const Frf& z, const std::vector<double>& scale,
+                    const ResonanceFitOptions& options, const F0Range& range) {
+  VarProGrid grid(z.freq_hz, z.value, scale);
+  std::vector<double> f0s = LogSpace(range.lo, range.hi, options.grid_f0);
+  std::vector<double> qs = LogSpace(options.q_min, options.q_max, options.grid_q);
+  int bi = -1, bj = -1;
+  GridPoint start = grid.Search(f0s, qs, &bi, &bj);
+  if (!start.ok) return start;
+  for (int pass = 0; pass < kRefinePasses; ++pass) {
+    const double f_a = f0s[static_cast<std::size_t>(std::max(bi - 1, 0))];
+    const double f_b =
+        f0s[static_cast<std::size_t>(std::min(bi + 1, static_cast<int>(f0s.size()) - 1))];
+    const double q_a = qs[static_cast<std::size_t>(std::max(bj - 1, 0))];
+    const double q_b =
+        qs[static_cast<std::size_t>(std::min(bj + 1, static_cast<int>(qs.size()) - 1))];
+    f0s = LogSpace(f_a, f_b, kRefineSteps);
+    qs = LogSpace(q_a, q_b, kRefineSteps);
+    int ri = -1, rj = -1;
+    const GridPoint refined = grid.Search(f0s, qs, &ri, &rj);
+    if (!refined.ok || !(refined.chi2 < start.chi2)) break;
+    start = refined;
+    bi = ri;
+    bj = rj;
+  }
+  return start;
+}
+
+// Levenberg-Marquardt in theta = ln p from the grid's start; *theta ends at the fit.
+LeastSquaresOutcome MinimiseFromStart(const Frf& z, const std::vector<double>& scale,
+                                      const GridPoint& start, int max_iterations,
+                                      Eigen::VectorXd* theta) {
+  MotionalImpedance p0;
+  p0.r_ohm = start.r_ohm;
+  p0.l_h = start.l_h;
+  p0.rp_ohm = start.rp_ohm;
+  p0.f0_hz = start.f0_hz;
+  p0.q = start.q;
+  *theta = ToLogParams(p0);
+  LeastSquaresProblem problem;
+  problem.parameters = kMotionalParamCount;
+  problem.residuals = static_cast<int>(2 * z.freq_hz.size());
+  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
+    MotionalResidual(FromLogParams(t), z.freq_hz, z.value, scale, r);
+  };
+  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jacobian) {
+    MotionalJacobian(FromLogParams(t), z.freq_hz, scale, jacobian);
+  };
+  LeastSquaresSettings settings;
+  settings.max_iterations = max_iterations;
+  settings.ftol = kLmFtol;
+  settings.xtol = kLmXtol;
+  return MinimizeLeastSquares(problem, theta, settings);
+}
+
+// chi2 (noise scale 1 with known sigma, estimated from the residual otherwise), the
+// covariance and the parameters at `fit`; returns whether the covariance is finite.
+bool FillStatistics(const Frf& z, const std::vector<double>& scale, const MotionalImpedance& fit,
+                    FitSummary* s) {
+  Eigen::VectorXd r;
+  Eigen::MatrixXd jacobian;
+  MotionalResidual(fit, z.freq_hz, z.value, scale, &r);
+  MotionalJacobian(fit, z.freq_hz, scale, &jacobian);
+  const double chi2_raw = r.squaredNorm();
+  double noise_var = 1.0;
+  if (s->sigma_estimated) {
+    noise_var = chi2_raw / s->dof;
+    s->estimated_sigma = std::sqrt(noise_var);
+  }
+  s->chi2 = noise_var > 0.0 ? chi2_raw / noise_var : chi2_raw;
+  s->chi2_per_dof = s->chi2 / s->dof;
+
+  MotionalMatrix c_log = MotionalMatrix::Constant(std::numeric_limits<double>::quiet_NaN());
+  bool covariance_ok = false;
+  if (r.allFinite() && jacobian.allFinite()) {
+    const MotionalMatrix jtj = jacobian.transpose() * jacobian;
+    MotionalMatrix inverse;
+    if (InvertInformation(jtj, &inverse)) {
+      c_log = inverse * noise_var;
+      covariance_ok = c_log.allFinite();
+    }
+  }
+  const MotionalMatrix c_nat = LogToNaturalCovariance(fit, c_log);
+  const MotionalVector values = ToNaturalVector(fit);
+  s->params.resize(kMotionalParamCount);
+  for (int i = 0; i < kMotionalParamCount; ++i) {
+    FittedParameter& p = s->params[static_cast<std::size_t>(i)];
+    p.name = kMotionalParamNames[static_cast<std::size_t>(i)];
+    p.unit = kMotionalParamUnits[static_cast<std::size_t>(i)];
+    p.value = values[i];
+    p.sigma = covariance_ok ? std::sqrt(c_nat(i, i)) : std::numeric_limits<double>::quiet_NaN();
+  }
+  if (covariance_ok) s->covariance = c_nat;
+  return covariance_ok;
+}
+
+// Why the converged fit is not a resonance (not determined, at the search range's edge, no
+// significant peak); empty when it is one.
+std::string RejectFit(const FitSummary& s, const MotionalImpedance& fit, bool covariance_ok,
+                      const ResonanceFitOptions& options, const F0Range& range) {
+  std::ostringstream os = MessageStream();
+  if (!covariance_ok || !ToNaturalVector(fit).allFinite()) {
+    os << "covariance is not finite at f0 = " << fit.f0_hz
+       << " Hz: the Jacobian is singular there, the parameters are not determined by the data";
+    return os.str();
+  }
+  const double coarse_log_step = std::log(range.hi / range.lo) / (options.grid_f0 - 1);
+  const double edge_lo = range.lo * std::exp(coarse_log_step);
+  const double edge_hi = range.hi * std::exp(-coarse_log_step);
+  if (!(fit.f0_hz >= edge_lo && fit.f0_hz <= edge_hi)) {
+    os << NoResonance(range) << ": the fit ended at f0 = " << fit.f0_hz
+       << " Hz, at or beyond the edge of the search range";
+    return os.str();
+  }
+  const double rp_sigma = s.params[kParamRp].sigma;
+  if (!(fit.rp_ohm >= options.min_rp_significance * rp_sigma)) {
+    os << NoResonance(range) << ": the motional peak Rp = " << fit.rp_ohm << " +- " << rp_sigma
+       << " ohm is below " << options.min_rp_significance << " standard deviations";
+    return os.str();
+  }
+  return "";
+}
+
+// The message of a usable fit, with a warning when chi2/dof is well above 1.
+std::string UsableMessage(const FitSummary& s, const MotionalImpedance& fit) {
+  std::ostringstream os = MessageStream();
+  os << "converged in " << s.iterations << " iterations: f0 = " << fit.f0_hz << " +- "
+     << s.params[kParamF0].sigma << " Hz, Q = " << fit.q << " +- " << s.params[kParamQ].sigma
+     << ", chi2/dof = " << s.chi2_per_dof << " (dof " << s.dof << ")";
+  if (s.sigma_estimated) {
+    os << ". The frequency response carried no sigma: noise estimated from the residual as "
+       << s.estimated_sigma << " ohm per line (complex std), covariance scaled by it";
+  } else if (s.chi2_per_dof > 1.0 + 5.0 * std::sqrt(2.0 / s.dof)) {
+    os << ". chi2/dof is well above 1: the model does not explain the data within sigma "
+          "(an unmodelled effect, analysis/README.md 5, or sigma underestimated)";
+  }
+  return os.str();
+}
+
 }  // namespace
 
 bool ResonanceFitOptions::IsValid(std::string* why) const {
@@ -194,28 +376,9 @@ MotionalImpedance FitSummary::Model() const {
 }
 
 FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options) {
-  std::string why;
-  if (!options.IsValid(&why)) return Invalid("options: " + why);
-  if (!z.Validate(&why)) return Invalid(why);
-  if (z.quantity != Quantity::kImpedanceOhm)
-    return Invalid(std::string("quantity is ") + ToString(z.quantity) + ", the fit needs " +
-                   ToString(Quantity::kImpedanceOhm));
+  if (const std::string why = InputProblem(z, options); !why.empty()) return Invalid(why);
   const std::size_t k_lines = z.size();
-  const std::size_t min_lines = kMinLinesPerParam * kMotionalParamCount;
-  if (k_lines < min_lines)
-    return Invalid(std::to_string(k_lines) + " lines, the fit needs at least " +
-                   std::to_string(min_lines) + " (2 per parameter)");
-
-  const bool auto_range = options.f0_min_hz == 0.0 && options.f0_max_hz == 0.0;
-  const double f0_lo = auto_range ? z.freq_hz.front() : options.f0_min_hz;
-  const double f0_hi = auto_range ? z.freq_hz.back() : options.f0_max_hz;
-  if (!(f0_lo < z.freq_hz.back() && f0_hi > z.freq_hz.front())) {
-    std::ostringstream os = MessageStream();
-    os << "f0 search range [" << f0_lo << ", " << f0_hi << "] Hz does not overlap the data band ["
-       << z.freq_hz.front() << ", " << z.freq_hz.back() << "] Hz";
-    return Invalid(os.str());
-  }
-  if (!(f0_hi > f0_lo)) return Invalid("the data band is a single frequency");
+  const F0Range range = SearchRange(z, options);
 
   FitSummary s;
   s.sigma_estimated = !z.has_sigma();
@@ -224,107 +387,21 @@ FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options
     for (std::size_t k = 0; k < k_lines; ++k) scale[k] = std::numbers::sqrt2 / z.sigma[k];
   s.dof = static_cast<int>(2 * k_lines) - kMotionalParamCount;
 
-  auto no_resonance = [&]() {
-    std::ostringstream os = MessageStream();
-    os << "no resonance found between " << f0_lo << " and " << f0_hi << " Hz";
-    return os.str();
-  };
-
-  // Start: coarse grid, then local refinements around the best cell.
-  VarProGrid grid(z.freq_hz, z.value, scale);
-  std::vector<double> f0s = LogSpace(f0_lo, f0_hi, options.grid_f0);
-  std::vector<double> qs = LogSpace(options.q_min, options.q_max, options.grid_q);
-  const double coarse_log_step = std::log(f0_hi / f0_lo) / (options.grid_f0 - 1);
-  int bi = -1, bj = -1;
-  GridPoint start = grid.Search(f0s, qs, &bi, &bj);
+  const GridPoint start = GridStart(z, scale, options, range);
   if (!start.ok) {
     s.termination = Termination::kFailed;
-    s.message = no_resonance() + ": no (f0, Q) grid point gives positive R, L and Rp";
+    s.message = NoResonance(range) + ": no (f0, Q) grid point gives positive R, L and Rp";
     return s;
   }
-  for (int pass = 0; pass < kRefinePasses; ++pass) {
-    const double f_a = f0s[static_cast<std::size_t>(std::max(bi - 1, 0))];
-    const double f_b =
-        f0s[static_cast<std::size_t>(std::min(bi + 1, static_cast<int>(f0s.size()) - 1))];
-    const double q_a = qs[static_cast<std::size_t>(std::max(bj - 1, 0))];
-    const double q_b =
-        qs[static_cast<std::size_t>(std::min(bj + 1, static_cast<int>(qs.size()) - 1))];
-    f0s = LogSpace(f_a, f_b, kRefineSteps);
-    qs = LogSpace(q_a, q_b, kRefineSteps);
-    int ri = -1, rj = -1;
-    const GridPoint refined = grid.Search(f0s, qs, &ri, &rj);
-    if (!refined.ok || !(refined.chi2 < start.chi2)) break;
-    start = refined;
-    bi = ri;
-    bj = rj;
-  }
-
-  // Finish: Levenberg-Marquardt in theta = ln p.
-  MotionalImpedance p0;
-  p0.r_ohm = start.r_ohm;
-  p0.l_h = start.l_h;
-  p0.rp_ohm = start.rp_ohm;
-  p0.f0_hz = start.f0_hz;
-  p0.q = start.q;
-  Eigen::VectorXd theta = ToLogParams(p0);
-  LeastSquaresProblem problem;
-  problem.parameters = kMotionalParamCount;
-  problem.residuals = static_cast<int>(2 * z.freq_hz.size());
-  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
-    MotionalResidual(FromLogParams(t), z.freq_hz, z.value, scale, r);
-  };
-  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jacobian) {
-    MotionalJacobian(FromLogParams(t), z.freq_hz, scale, jacobian);
-  };
-  LeastSquaresSettings settings;
-  settings.max_iterations = options.max_iterations;
-  settings.ftol = kLmFtol;
-  settings.xtol = kLmXtol;
-  const LeastSquaresOutcome lm = MinimizeLeastSquares(problem, &theta, settings);
+  Eigen::VectorXd theta;
+  const LeastSquaresOutcome lm = MinimiseFromStart(z, scale, start, options.max_iterations, &theta);
   s.iterations = lm.iterations;
   s.termination = lm.termination;
-  const bool converged = lm.converged;
-
   const MotionalImpedance fit = FromLogParams(theta);
-  Eigen::VectorXd r;
-  Eigen::MatrixXd jacobian;
-  MotionalResidual(fit, z.freq_hz, z.value, scale, &r);
-  MotionalJacobian(fit, z.freq_hz, scale, &jacobian);
-  const double chi2_raw = r.squaredNorm();
+  const bool covariance_ok = FillStatistics(z, scale, fit, &s);
 
-  // Noise scale: 1 with known sigma; estimated from the residual otherwise.
-  double noise_var = 1.0;
-  if (s.sigma_estimated) {
-    noise_var = chi2_raw / s.dof;
-    s.estimated_sigma = std::sqrt(noise_var);
-  }
-  s.chi2 = noise_var > 0.0 ? chi2_raw / noise_var : chi2_raw;
-  s.chi2_per_dof = s.chi2 / s.dof;
-
-  MotionalMatrix c_log = MotionalMatrix::Constant(std::numeric_limits<double>::quiet_NaN());
-  bool covariance_ok = false;
-  if (r.allFinite() && jacobian.allFinite()) {
-    const MotionalMatrix jtj = jacobian.transpose() * jacobian;
-    MotionalMatrix inverse;
-    if (InvertInformation(jtj, &inverse)) {
-      c_log = inverse * noise_var;
-      covariance_ok = c_log.allFinite();
-    }
-  }
-  const MotionalMatrix c_nat = LogToNaturalCovariance(fit, c_log);
-  const MotionalVector values = ToNaturalVector(fit);
-  s.params.resize(kMotionalParamCount);
-  for (int i = 0; i < kMotionalParamCount; ++i) {
-    FittedParameter& p = s.params[static_cast<std::size_t>(i)];
-    p.name = kMotionalParamNames[static_cast<std::size_t>(i)];
-    p.unit = kMotionalParamUnits[static_cast<std::size_t>(i)];
-    p.value = values[i];
-    p.sigma = covariance_ok ? std::sqrt(c_nat(i, i)) : std::numeric_limits<double>::quiet_NaN();
-  }
-  if (covariance_ok) s.covariance = c_nat;
-
-  std::ostringstream os = MessageStream();
-  if (!converged) {
+  if (!lm.converged) {
+    std::ostringstream os = MessageStream();
     os << (s.termination == Termination::kMaxIterations ? "Levenberg-Marquardt did not converge in "
                                                         : "Levenberg-Marquardt failed after ")
        << s.iterations << " iterations (MINPACK status " << lm.minpack_status
@@ -332,40 +409,10 @@ FitSummary FitMotionalResonance(const Frf& z, const ResonanceFitOptions& options
     s.message = os.str();
     return s;
   }
-  if (!covariance_ok || !values.allFinite()) {
-    os << "covariance is not finite at f0 = " << fit.f0_hz
-       << " Hz: the Jacobian is singular there, the parameters are not determined by the data";
-    s.message = os.str();
-    return s;
-  }
-  const double edge_lo = f0_lo * std::exp(coarse_log_step);
-  const double edge_hi = f0_hi * std::exp(-coarse_log_step);
-  if (!(fit.f0_hz >= edge_lo && fit.f0_hz <= edge_hi)) {
-    os << no_resonance() << ": the fit ended at f0 = " << fit.f0_hz
-       << " Hz, at or beyond the edge of the search range";
-    s.message = os.str();
-    return s;
-  }
-  const double rp_sigma = s.params[kParamRp].sigma;
-  if (!(fit.rp_ohm >= options.min_rp_significance * rp_sigma)) {
-    os << no_resonance() << ": the motional peak Rp = " << fit.rp_ohm << " +- " << rp_sigma
-       << " ohm is below " << options.min_rp_significance << " standard deviations";
-    s.message = os.str();
-    return s;
-  }
-
+  s.message = RejectFit(s, fit, covariance_ok, options, range);
+  if (!s.message.empty()) return s;
   s.usable = true;
-  os << "converged in " << s.iterations << " iterations: f0 = " << fit.f0_hz << " +- "
-     << s.params[kParamF0].sigma << " Hz, Q = " << fit.q << " +- " << s.params[kParamQ].sigma
-     << ", chi2/dof = " << s.chi2_per_dof << " (dof " << s.dof << ")";
-  if (s.sigma_estimated) {
-    os << ". The frequency response carried no sigma: noise estimated from the residual as "
-       << s.estimated_sigma << " ohm per line (complex std), covariance scaled by it";
-  } else if (s.chi2_per_dof > 1.0 + 5.0 * std::sqrt(2.0 / s.dof)) {
-    os << ". chi2/dof is well above 1: the model does not explain the data within sigma "
-          "(an unmodelled effect, analysis/README.md 5, or sigma underestimated)";
-  }
-  s.message = os.str();
+  s.message = UsableMessage(s, fit);
   return s;
 }
 

@@ -94,6 +94,182 @@ void CentralDifferenceJacobian(const Eigen::VectorXd& theta, const Data& data, c
   }
 }
 
+// Why the options or the FRF cannot be fitted; empty when they can.
+std::string InputProblem(const Frf& frf, const TwoMassFitOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) return "options: " + why;
+  if (!frf.Validate(&why)) return why;
+  if (frf.quantity != Quantity::kMobility)
+    return std::string("quantity is ") + ToString(frf.quantity) + ", the two-mass fit needs " +
+           ToString(Quantity::kMobility);
+  return "";
+}
+
+// The lines in the options' band (every line when both ends are 0), with their weights.
+Data LinesInBand(const Frf& frf, const TwoMassFitOptions& o) {
+  Data d;
+  const bool all = o.f_lo_hz == 0.0 && o.f_hi_hz == 0.0;
+  for (std::size_t k = 0; k < frf.size(); ++k) {
+    if (!all && (frf.freq_hz[k] < o.f_lo_hz || frf.freq_hz[k] > o.f_hi_hz)) continue;
+    d.f.push_back(frf.freq_hz[k]);
+    d.h.push_back(frf.value[k]);
+    d.scale.push_back(frf.has_sigma() ? std::numbers::sqrt2 / frf.sigma[k] : std::numbers::sqrt2);
+  }
+  return d;
+}
+
+// Start: the |H| maximum is the resonance, the |H| minimum below it the anti-resonance, the
+// gain from the rigid body on the lowest lines, zeta_ar the best of a few. Returns false with
+// *why when |H| shows no resonance or anti-resonance.
+bool StartFromPeaks(const Data& d, const Layout& layout, TwoMassResponse* start, std::string* why) {
+  const std::size_t n = d.f.size();
+  std::size_t i_max = 0;
+  for (std::size_t k = 1; k < n; ++k)
+    if (std::abs(d.h[k]) > std::abs(d.h[i_max])) i_max = k;
+  if (i_max == 0) {
+    *why = "no resonance: |H| has its maximum at the lowest line";
+    return false;
+  }
+  std::size_t i_min = 0;
+  for (std::size_t k = 1; k < i_max; ++k)
+    if (std::abs(d.h[k]) < std::abs(d.h[i_min])) i_min = k;
+  if (i_min == 0) {
+    *why = "no anti-resonance: |H| has no minimum below its maximum at " +
+           std::to_string(d.f[i_max]) + " Hz";
+    return false;
+  }
+  start->f_ar_hz = d.f[i_min];
+  start->f_r_hz = d.f[i_max];
+  {
+    // Rigid body on the lowest lines: |H| ~ g / w.
+    std::vector<double> g;
+    for (std::size_t k = 0; k < std::min<std::size_t>(5, i_min); ++k)
+      g.push_back(std::abs(d.h[k]) * kTwoPi * d.f[k]);
+    std::sort(g.begin(), g.end());
+    start->gain_rad_per_s2_per_a = g[g.size() / 2];
+  }
+  double best = std::numeric_limits<double>::infinity();
+  TwoMassResponse trial = *start;
+  Eigen::VectorXd r;
+  for (double zeta : {0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2}) {
+    trial.zeta_ar = zeta;
+    Residual(trial, d, &r);
+    if (r.allFinite() && r.squaredNorm() < best) {
+      best = r.squaredNorm();
+      start->zeta_ar = zeta;
+    }
+  }
+  if (layout.friction) start->friction_per_s = 0.1 * kTwoPi * d.f.front();
+  return true;
+}
+
+LeastSquaresOutcome Minimise(const Data& d, const Layout& layout, int max_iterations,
+                             Eigen::VectorXd* theta) {
+  LeastSquaresProblem problem;
+  problem.parameters = layout.size();
+  problem.residuals = static_cast<int>(2 * d.f.size());
+  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* res) {
+    GuardedResidual(t, d, layout, res);
+  };
+  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jac) {
+    CentralDifferenceJacobian(t, d, layout, jac);
+  };
+  LeastSquaresSettings settings;
+  settings.max_iterations = max_iterations;
+  return MinimizeLeastSquares(problem, theta, settings);
+}
+
+// chi2 (the noise estimated from the residual without sigma) and the normalised rms error of
+// out->response; returns the noise variance the covariance is scaled by.
+double FillChi2(const Data& d, const Layout& layout, bool has_sigma, TwoMassFit* out) {
+  const std::size_t n = d.f.size();
+  Eigen::VectorXd r;
+  Residual(out->response, d, &r);
+  out->dof = static_cast<int>(2 * n) - layout.size();
+  const double chi2_raw = r.squaredNorm();
+  out->sigma_estimated = !has_sigma;
+  const double noise_var = out->sigma_estimated ? chi2_raw / out->dof : 1.0;
+  out->chi2 = chi2_raw / noise_var;
+  out->chi2_per_dof = out->chi2 / out->dof;
+  double err2 = 0.0, h2 = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    err2 += std::norm(out->response.At(d.f[k]) - d.h[k]);
+    h2 += std::norm(d.h[k]);
+  }
+  out->rms_relative_error = std::sqrt(err2 / h2);
+  return noise_var;
+}
+
+// The parameters with their sigmas from the covariance in theta, scaled by the noise estimate
+// and, when the model error dominates, by chi2/dof (Birge ratio). Returns whether the
+// covariance is finite and positive (the sigmas are NaN otherwise).
+bool FillParams(const Data& d, const Layout& layout, const Eigen::VectorXd& theta, double noise_var,
+                TwoMassFit* out) {
+  Eigen::MatrixXd jac;
+  CentralDifferenceJacobian(theta, d, layout, &jac);
+  const double inflate = std::max(1.0, out->chi2_per_dof);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(layout.size(), layout.size(),
+                                                  std::numeric_limits<double>::quiet_NaN());
+  const Eigen::MatrixXd jtj = jac.transpose() * jac;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
+  bool cov_ok = false;
+  if (jac.allFinite() && ldlt.info() == Eigen::Success && ldlt.isPositive()) {
+    cov = ldlt.solve(Eigen::MatrixXd::Identity(layout.size(), layout.size())) * noise_var * inflate;
+    cov_ok = cov.allFinite() && cov.diagonal().minCoeff() > 0.0;
+  }
+  const TwoMassResponse& m = out->response;
+  auto add = [&](const char* name, const char* unit, double value, double sigma) {
+    out->params.push_back(FittedParameter{name, unit, value, cov_ok ? sigma : std::nan("")});
+  };
+  auto sd = [&](int i) { return std::sqrt(cov(i, i)); };
+  add("g_rad_per_s2_per_a", "rad/s^2/A", m.gain_rad_per_s2_per_a, m.gain_rad_per_s2_per_a * sd(0));
+  add("f_ar_hz", "Hz", m.f_ar_hz, m.f_ar_hz * sd(1));
+  add("f_r_hz", "Hz", m.f_r_hz, m.f_r_hz * sd(2));
+  add("zeta_ar", "1", m.zeta_ar, kZetaScale * sd(3));
+  int i = 4;
+  if (layout.friction) {
+    add("friction_per_s", "1/s", m.friction_per_s, sd(i));
+    ++i;
+  }
+  if (layout.delay) add("delay_s", "s", m.delay_s, kDelayScale * sd(i));
+  return cov_ok;
+}
+
+// Why the fit is not a usable two-mass response; empty when it is one.
+std::string RejectFit(const TwoMassFit& out, bool cov_ok) {
+  const TwoMassResponse& m = out.response;
+  std::ostringstream os = MessageStream();
+  if (!(m.f_r_hz > m.f_ar_hz)) {
+    os << "not a two-mass response: the fit put the resonance (" << m.f_r_hz
+       << " Hz) at or below the anti-resonance (" << m.f_ar_hz << " Hz)";
+    return os.str();
+  }
+  if (!cov_ok) return "covariance is not finite: the data do not determine every parameter";
+  if (m.zeta_ar < -2.0 * out.params[3].sigma) {
+    os << "not a passive two-mass response: zeta_ar = " << m.zeta_ar << " +- "
+       << out.params[3].sigma << " is significantly negative";
+    return os.str();
+  }
+  return "";
+}
+
+std::string UsableMessage(const TwoMassFit& out, std::size_t n) {
+  const TwoMassResponse& m = out.response;
+  std::ostringstream os = MessageStream();
+  os << "two-mass fit over " << n << " lines: anti-resonance " << m.f_ar_hz << " +- "
+     << out.params[1].sigma << " Hz, resonance " << m.f_r_hz << " +- " << out.params[2].sigma
+     << " Hz, chi2/dof " << out.chi2_per_dof << " (dof " << out.dof << "), normalised rms error "
+     << out.rms_relative_error;
+  if (m.zeta_ar < 0.0)
+    os << "; zeta_ar is negative but within 2 sigma of 0: the coupling damping is not resolved"
+          " (the friction to ground carries the damping)";
+  if (out.sigma_estimated)
+    os << "; no sigma given: noise estimated from the residual";
+  else if (out.chi2_per_dof > 1.0 + 5.0 * std::sqrt(2.0 / out.dof))
+    os << "; chi2/dof above 1: the model error exceeds the noise, sigmas scaled by sqrt(chi2/dof)";
+  return os.str();
+}
+
 }  // namespace
 
 Cplx TwoMassResponse::At(double f_hz) const {
@@ -169,175 +345,43 @@ const FittedParameter* TwoMassFit::Find(const std::string& name) const {
 TwoMassFit FitTwoMass(const Frf& frf, const TwoMassFitOptions& o) {
   TwoMassFit out;
   out.termination = Termination::kInvalidInput;
-  std::string why;
-  if (!o.IsValid(&why)) {
-    out.message = "invalid input: options: " + why;
-    return out;
-  }
-  if (!frf.Validate(&why)) {
+  if (const std::string why = InputProblem(frf, o); !why.empty()) {
     out.message = "invalid input: " + why;
     return out;
   }
-  if (frf.quantity != Quantity::kMobility) {
-    out.message = std::string("invalid input: quantity is ") + ToString(frf.quantity) +
-                  ", the two-mass fit needs " + ToString(Quantity::kMobility);
-    return out;
-  }
   const Layout layout{o.fit_friction, o.fit_delay};
-  Data d;
-  const bool all = o.f_lo_hz == 0.0 && o.f_hi_hz == 0.0;
-  for (std::size_t k = 0; k < frf.size(); ++k) {
-    if (!all && (frf.freq_hz[k] < o.f_lo_hz || frf.freq_hz[k] > o.f_hi_hz)) continue;
-    d.f.push_back(frf.freq_hz[k]);
-    d.h.push_back(frf.value[k]);
-    d.scale.push_back(frf.has_sigma() ? std::numbers::sqrt2 / frf.sigma[k] : std::numbers::sqrt2);
-  }
+  const Data d = LinesInBand(frf, o);
   const std::size_t n = d.f.size();
   if (n < static_cast<std::size_t>(2 * layout.size())) {
     out.message = "invalid input: " + std::to_string(n) + " lines in the band, need at least " +
                   std::to_string(2 * layout.size());
     return out;
   }
-
-  // Start: the |H| maximum is the resonance, the |H| minimum below it the anti-resonance.
-  std::size_t i_max = 0;
-  for (std::size_t k = 1; k < n; ++k)
-    if (std::abs(d.h[k]) > std::abs(d.h[i_max])) i_max = k;
-  if (i_max == 0) {
-    out.termination = Termination::kFailed;
-    out.message = "no resonance: |H| has its maximum at the lowest line";
-    return out;
-  }
-  std::size_t i_min = 0;
-  for (std::size_t k = 1; k < i_max; ++k)
-    if (std::abs(d.h[k]) < std::abs(d.h[i_min])) i_min = k;
-  if (i_min == 0) {
-    out.termination = Termination::kFailed;
-    out.message = "no anti-resonance: |H| has no minimum below its maximum at " +
-                  std::to_string(d.f[i_max]) + " Hz";
-    return out;
-  }
   TwoMassResponse start;
-  start.f_ar_hz = d.f[i_min];
-  start.f_r_hz = d.f[i_max];
-  {
-    // Rigid body on the lowest lines: |H| ~ g / w.
-    std::vector<double> g;
-    for (std::size_t k = 0; k < std::min<std::size_t>(5, i_min); ++k)
-      g.push_back(std::abs(d.h[k]) * kTwoPi * d.f[k]);
-    std::sort(g.begin(), g.end());
-    start.gain_rad_per_s2_per_a = g[g.size() / 2];
+  if (!StartFromPeaks(d, layout, &start, &out.message)) {
+    out.termination = Termination::kFailed;
+    return out;
   }
-  double best = std::numeric_limits<double>::infinity();
-  TwoMassResponse trial = start;
-  Eigen::VectorXd r;
-  for (double zeta : {0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2}) {
-    trial.zeta_ar = zeta;
-    Residual(trial, d, &r);
-    if (r.allFinite() && r.squaredNorm() < best) {
-      best = r.squaredNorm();
-      start.zeta_ar = zeta;
-    }
-  }
-  if (layout.friction) start.friction_per_s = 0.1 * kTwoPi * d.f.front();
 
   Eigen::VectorXd theta = ToTheta(start, layout);
-  LeastSquaresProblem problem;
-  problem.parameters = layout.size();
-  problem.residuals = static_cast<int>(2 * n);
-  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* res) {
-    GuardedResidual(t, d, layout, res);
-  };
-  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jac) {
-    CentralDifferenceJacobian(t, d, layout, jac);
-  };
-  LeastSquaresSettings settings;
-  settings.max_iterations = o.max_iterations;
-  const LeastSquaresOutcome lm = MinimizeLeastSquares(problem, &theta, settings);
+  const LeastSquaresOutcome lm = Minimise(d, layout, o.max_iterations, &theta);
   out.termination = lm.termination;
-  const bool converged = lm.converged;
   out.response = FromTheta(theta, layout);
-  Residual(out.response, d, &r);
-  out.dof = static_cast<int>(2 * n) - layout.size();
-  const double chi2_raw = r.squaredNorm();
-  out.sigma_estimated = !frf.has_sigma();
-  const double noise_var = out.sigma_estimated ? chi2_raw / out.dof : 1.0;
-  out.chi2 = chi2_raw / noise_var;
-  out.chi2_per_dof = out.chi2 / out.dof;
-  double err2 = 0.0, h2 = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    err2 += std::norm(out.response.At(d.f[k]) - d.h[k]);
-    h2 += std::norm(d.h[k]);
-  }
-  out.rms_relative_error = std::sqrt(err2 / h2);
+  const double noise_var = FillChi2(d, layout, frf.has_sigma(), &out);
+  const bool cov_ok = FillParams(d, layout, theta, noise_var, &out);
 
-  // Covariance in theta, scaled by the noise estimate and, when the model error dominates,
-  // by chi2/dof (Birge ratio).
-  Eigen::MatrixXd jac;
-  CentralDifferenceJacobian(theta, d, layout, &jac);
-  const double inflate = std::max(1.0, out.chi2_per_dof);
-  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(layout.size(), layout.size(),
-                                                  std::numeric_limits<double>::quiet_NaN());
-  const Eigen::MatrixXd jtj = jac.transpose() * jac;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
-  bool cov_ok = false;
-  if (jac.allFinite() && ldlt.info() == Eigen::Success && ldlt.isPositive()) {
-    cov = ldlt.solve(Eigen::MatrixXd::Identity(layout.size(), layout.size())) * noise_var * inflate;
-    cov_ok = cov.allFinite() && cov.diagonal().minCoeff() > 0.0;
-  }
-  const TwoMassResponse& m = out.response;
-  auto add = [&](const char* name, const char* unit, double value, double sigma) {
-    out.params.push_back(FittedParameter{name, unit, value, cov_ok ? sigma : std::nan("")});
-  };
-  auto sd = [&](int i) { return std::sqrt(cov(i, i)); };
-  add("g_rad_per_s2_per_a", "rad/s^2/A", m.gain_rad_per_s2_per_a, m.gain_rad_per_s2_per_a * sd(0));
-  add("f_ar_hz", "Hz", m.f_ar_hz, m.f_ar_hz * sd(1));
-  add("f_r_hz", "Hz", m.f_r_hz, m.f_r_hz * sd(2));
-  add("zeta_ar", "1", m.zeta_ar, kZetaScale * sd(3));
-  int i = 4;
-  if (layout.friction) {
-    add("friction_per_s", "1/s", m.friction_per_s, sd(i));
-    ++i;
-  }
-  if (layout.delay) add("delay_s", "s", m.delay_s, kDelayScale * sd(i));
-
-  std::ostringstream os = MessageStream();
-  if (!converged) {
+  if (!lm.converged) {
+    std::ostringstream os = MessageStream();
     os << "Levenberg-Marquardt " << ToString(out.termination) << " (MINPACK status "
        << lm.minpack_status << ") from f_ar = " << start.f_ar_hz << " Hz, f_r = " << start.f_r_hz
        << " Hz";
     out.message = os.str();
     return out;
   }
-  if (!(m.f_r_hz > m.f_ar_hz)) {
-    os << "not a two-mass response: the fit put the resonance (" << m.f_r_hz
-       << " Hz) at or below the anti-resonance (" << m.f_ar_hz << " Hz)";
-    out.message = os.str();
-    return out;
-  }
-  if (!cov_ok) {
-    out.message = "covariance is not finite: the data do not determine every parameter";
-    return out;
-  }
-  if (m.zeta_ar < -2.0 * out.params[3].sigma) {
-    os << "not a passive two-mass response: zeta_ar = " << m.zeta_ar << " +- "
-       << out.params[3].sigma << " is significantly negative";
-    out.message = os.str();
-    return out;
-  }
+  out.message = RejectFit(out, cov_ok);
+  if (!out.message.empty()) return out;
   out.usable = true;
-  os << "two-mass fit over " << n << " lines: anti-resonance " << m.f_ar_hz << " +- "
-     << out.params[1].sigma << " Hz, resonance " << m.f_r_hz << " +- " << out.params[2].sigma
-     << " Hz, chi2/dof " << out.chi2_per_dof << " (dof " << out.dof << "), normalised rms error "
-     << out.rms_relative_error;
-  if (m.zeta_ar < 0.0)
-    os << "; zeta_ar is negative but within 2 sigma of 0: the coupling damping is not resolved"
-          " (the friction to ground carries the damping)";
-  if (out.sigma_estimated)
-    os << "; no sigma given: noise estimated from the residual";
-  else if (out.chi2_per_dof > 1.0 + 5.0 * std::sqrt(2.0 / out.dof))
-    os << "; chi2/dof above 1: the model error exceeds the noise, sigmas scaled by sqrt(chi2/dof)";
-  out.message = os.str();
+  out.message = UsableMessage(out, n);
   return out;
 }
 

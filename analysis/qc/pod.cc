@@ -134,6 +134,152 @@ std::vector<Obs> ToObs(const std::vector<HitMiss>& data, PodScale scale) {
   return d;
 }
 
+// Scans the sizes into s (range, hits); returns false with s->message when a size is not
+// finite and positive or the data cannot be fitted (no hits, no misses, no overlap).
+bool ScanSizes(const std::vector<HitMiss>& data, PodSummary* s) {
+  double miss_max = -kInf, hit_min = kInf, miss_min = kInf, hit_max = -kInf;
+  s->size_min = kInf;
+  s->size_max = -kInf;
+  for (const HitMiss& h : data) {
+    if (!std::isfinite(h.size) || h.size <= 0.0) {
+      std::ostringstream m;
+      m << "defect size " << h.size << ": must be finite and > 0";
+      s->message = m.str();
+      return false;
+    }
+    s->size_min = std::min(s->size_min, h.size);
+    s->size_max = std::max(s->size_max, h.size);
+    if (h.hit) {
+      ++s->hits;
+      hit_min = std::min(hit_min, h.size);
+      hit_max = std::max(hit_max, h.size);
+    } else {
+      miss_max = std::max(miss_max, h.size);
+      miss_min = std::min(miss_min, h.size);
+    }
+  }
+  std::ostringstream m;
+  if (s->hits == 0 || s->hits == s->units) {
+    m << (s->hits == 0 ? "no hits" : "no misses") << " among " << s->units << " units (sizes "
+      << s->size_min << "-" << s->size_max << "): POD(a) cannot be fitted";
+    s->message = m.str();
+    return false;
+  }
+  if (miss_max <= hit_min || hit_max <= miss_min) {
+    m << "hits and misses do not overlap (misses at " << miss_min << "-" << miss_max << ", hits at "
+      << hit_min << "-" << hit_max
+      << "): the maximum likelihood estimate does not exist (MIL-HDBK-1823A: test units with "
+         "sizes in between)";
+    s->message = m.str();
+    return false;
+  }
+  return true;
+}
+
+// The maximum likelihood estimate (b0, b1), its log-likelihood and the Fisher information
+// of the last iteration's start.
+struct MlEstimate {
+  double b0 = 0.0, b1 = 0.0, l = 0.0;
+  double i00 = 0.0, i01 = 0.0, i11 = 0.0;
+  bool converged = false;
+};
+
+// Fisher scoring from (b0, 0), each step halved until the likelihood does not fall;
+// *iterations counts the steps (max_iterations + 1 when it did not converge).
+MlEstimate MaximiseLikelihood(PodLink link, const std::vector<Obs>& d, double b0,
+                              int max_iterations, int* iterations) {
+  MlEstimate e;
+  e.b0 = b0;
+  e.l = LogLik(link, d, e.b0, e.b1);
+  for (*iterations = 1; *iterations <= max_iterations; ++*iterations) {
+    double g0 = 0.0, g1 = 0.0;
+    e.i00 = e.i01 = e.i11 = 0.0;
+    for (const Obs& o : d) {
+      double sc = 0.0, w = 0.0;
+      ScoreWeight(link, e.b0 + e.b1 * o.x, o.h, &sc, &w);
+      g0 += sc;
+      g1 += sc * o.x;
+      e.i00 += w;
+      e.i01 += w * o.x;
+      e.i11 += w * o.x * o.x;
+    }
+    const double det = e.i00 * e.i11 - e.i01 * e.i01;
+    if (!(det > 0.0)) break;
+    double d0 = (e.i11 * g0 - e.i01 * g1) / det, d1 = (e.i00 * g1 - e.i01 * g0) / det;
+    double l_next = LogLik(link, d, e.b0 + d0, e.b1 + d1);
+    for (int half = 0; half < 60 && !(l_next >= e.l); ++half) {
+      d0 *= 0.5;
+      d1 *= 0.5;
+      l_next = LogLik(link, d, e.b0 + d0, e.b1 + d1);
+    }
+    if (!(l_next >= e.l)) break;
+    e.b0 += d0;
+    e.b1 += d1;
+    const double gain = l_next - e.l;
+    e.l = l_next;
+    if (gain < 1e-12 &&
+        std::abs(d0) + std::abs(d1) < 1e-9 * (1.0 + std::abs(e.b0) + std::abs(e.b1))) {
+      e.converged = true;
+      break;
+    }
+  }
+  return e;
+}
+
+// a50, a90 and the a90/95 bounds (Wald and likelihood ratio) of the fitted s.
+void FillSizes(PodLink link, const std::vector<Obs>& d, PodSummary* s) {
+  const double b0 = s->b0, b1 = s->b1, l = s->log_likelihood;
+  const PodScale scale = s->options.scale;
+  const double q = Quantile(link, s->options.pod_level);
+  const double x90 = (q - b0) / b1;
+  s->a50 = ToA(scale, -b0 / b1);
+  s->a90 = ToA(scale, x90);
+  const double span = std::max(ToX(scale, s->size_max) - ToX(scale, s->size_min), 1e-9);
+  const double z = NormalQuantile(s->options.confidence);
+  // Wald: the lower band crosses pod_level.
+  const double x_w = FirstCrossing(
+      [&](double x) {
+        const double var = s->cov00 + 2.0 * x * s->cov01 + x * x * s->cov11;
+        return b0 + b1 * x - z * std::sqrt(std::max(var, 0.0)) - q;
+      },
+      x90, span);
+  s->a90_95_wald = std::isfinite(x_w) ? ToA(scale, x_w) : kInf;
+  // Likelihood ratio: the profile deviance reaches z^2 (chi2_1 at 2 gamma - 1). As a90' -> inf
+  // the best curve through (a90', pod_level) flattens (b1 -> 0) and its likelihood tends to
+  // that of one POD for every size, l_0; when 2 (l - l_0) stays within z^2 no a90' is excluded
+  // (the data do not show at this confidence that POD rises with a) and the bound is +inf.
+  const double share = static_cast<double>(s->hits) / s->units;
+  const double l0 = s->hits * std::log(share) + (s->units - s->hits) * std::log1p(-share);
+  double x_lr = kInf;
+  if (2.0 * (l - l0) > z * z)
+    x_lr = FirstCrossing(
+        [&](double x) { return 2.0 * (l - ProfileLogLik(link, d, q, x, b1)) - z * z; }, x90, span);
+  s->a90_95_lr = std::isfinite(x_lr) ? ToA(scale, x_lr) : kInf;
+}
+
+std::string UsableMessage(const PodSummary& s) {
+  const PodOptions& options = s.options;
+  std::ostringstream m;
+  m << ToString(options.link) << " POD on " << (options.scale == PodScale::kLog ? "ln a" : "a")
+    << " from " << s.units << " units (" << s.hits << " hits, sizes " << s.size_min << "-"
+    << s.size_max << "): a50 " << s.a50 << ", a" << std::lround(100 * options.pod_level) << " "
+    << s.a90 << ", a" << std::lround(100 * options.pod_level) << "/"
+    << std::lround(100 * options.confidence) << " " << s.a90_95_lr << " (likelihood ratio), "
+    << s.a90_95_wald << " (Wald)";
+  if (!std::isfinite(s.a90_95_lr) || !std::isfinite(s.a90_95_wald))
+    m << "; inf: the data do not bound a" << std::lround(100 * options.pod_level)
+      << " from above at this confidence";
+  else if (s.a90_95_lr > s.size_max)
+    m << "; a" << std::lround(100 * options.pod_level) << "/"
+      << std::lround(100 * options.confidence)
+      << " lies beyond the largest size tested (extrapolated)";
+  if (s.misses_beyond_a90_95 > 0)
+    m << "; " << s.misses_beyond_a90_95 << " miss(es) at or beyond a"
+      << std::lround(100 * options.pod_level) << "/" << std::lround(100 * options.confidence)
+      << " (up to " << s.largest_miss_beyond << "): POD may not rise monotonically there";
+  return m.str();
+}
+
 }  // namespace
 
 bool PodOptions::IsValid(std::string* why) const {
@@ -168,149 +314,43 @@ PodSummary FitPod(const std::vector<HitMiss>& data, const PodOptions& options) {
     s.message = "no hit/miss data";
     return s;
   }
-  double miss_max = -kInf, hit_min = kInf, miss_min = kInf, hit_max = -kInf;
-  s.size_min = kInf;
-  s.size_max = -kInf;
-  for (const HitMiss& h : data) {
-    if (!std::isfinite(h.size) || h.size <= 0.0) {
-      std::ostringstream m;
-      m << "defect size " << h.size << ": must be finite and > 0";
-      s.message = m.str();
-      return s;
-    }
-    s.size_min = std::min(s.size_min, h.size);
-    s.size_max = std::max(s.size_max, h.size);
-    if (h.hit) {
-      ++s.hits;
-      hit_min = std::min(hit_min, h.size);
-      hit_max = std::max(hit_max, h.size);
-    } else {
-      miss_max = std::max(miss_max, h.size);
-      miss_min = std::min(miss_min, h.size);
-    }
-  }
-  std::ostringstream m;
-  if (s.hits == 0 || s.hits == s.units) {
-    m << (s.hits == 0 ? "no hits" : "no misses") << " among " << s.units << " units (sizes "
-      << s.size_min << "-" << s.size_max << "): POD(a) cannot be fitted";
-    s.message = m.str();
-    return s;
-  }
-  if (miss_max <= hit_min || hit_max <= miss_min) {
-    m << "hits and misses do not overlap (misses at " << miss_min << "-" << miss_max << ", hits at "
-      << hit_min << "-" << hit_max
-      << "): the maximum likelihood estimate does not exist (MIL-HDBK-1823A: test units with "
-         "sizes in between)";
-    s.message = m.str();
-    return s;
-  }
+  if (!ScanSizes(data, &s)) return s;
 
   const PodLink link = options.link;
   const std::vector<Obs> d = ToObs(data, options.scale);
-  double b0 = Quantile(link, static_cast<double>(s.hits) / s.units), b1 = 0.0;
-  double l = LogLik(link, d, b0, b1);
-  double i00 = 0.0, i01 = 0.0, i11 = 0.0;
-  bool converged = false;
-  for (s.iterations = 1; s.iterations <= options.max_iterations; ++s.iterations) {
-    double g0 = 0.0, g1 = 0.0;
-    i00 = i01 = i11 = 0.0;
-    for (const Obs& o : d) {
-      double sc = 0.0, w = 0.0;
-      ScoreWeight(link, b0 + b1 * o.x, o.h, &sc, &w);
-      g0 += sc;
-      g1 += sc * o.x;
-      i00 += w;
-      i01 += w * o.x;
-      i11 += w * o.x * o.x;
-    }
-    const double det = i00 * i11 - i01 * i01;
-    if (!(det > 0.0)) break;
-    double d0 = (i11 * g0 - i01 * g1) / det, d1 = (i00 * g1 - i01 * g0) / det;
-    double l_next = LogLik(link, d, b0 + d0, b1 + d1);
-    for (int half = 0; half < 60 && !(l_next >= l); ++half) {
-      d0 *= 0.5;
-      d1 *= 0.5;
-      l_next = LogLik(link, d, b0 + d0, b1 + d1);
-    }
-    if (!(l_next >= l)) break;
-    b0 += d0;
-    b1 += d1;
-    const double gain = l_next - l;
-    l = l_next;
-    if (gain < 1e-12 && std::abs(d0) + std::abs(d1) < 1e-9 * (1.0 + std::abs(b0) + std::abs(b1))) {
-      converged = true;
-      break;
-    }
-  }
-  if (!converged) {
+  const MlEstimate e =
+      MaximiseLikelihood(link, d, Quantile(link, static_cast<double>(s.hits) / s.units),
+                         options.max_iterations, &s.iterations);
+  if (!e.converged) {
+    std::ostringstream m;
     m << "the maximum likelihood fit did not converge in " << options.max_iterations
-      << " iterations (b0 " << b0 << ", b1 " << b1 << ")";
+      << " iterations (b0 " << e.b0 << ", b1 " << e.b1 << ")";
     s.message = m.str();
     return s;
   }
   // Covariance at the estimate (the information of the last iteration's start is that of the
   // converged point up to the last, vanishing step).
-  const double det = i00 * i11 - i01 * i01;
-  s.b0 = b0;
-  s.b1 = b1;
-  s.cov00 = i11 / det;
-  s.cov01 = -i01 / det;
-  s.cov11 = i00 / det;
-  s.log_likelihood = l;
-  if (!(b1 > 0.0)) {
-    m << "POD does not rise with the defect size (b1 = " << b1 << ")";
+  const double det = e.i00 * e.i11 - e.i01 * e.i01;
+  s.b0 = e.b0;
+  s.b1 = e.b1;
+  s.cov00 = e.i11 / det;
+  s.cov01 = -e.i01 / det;
+  s.cov11 = e.i00 / det;
+  s.log_likelihood = e.l;
+  if (!(e.b1 > 0.0)) {
+    std::ostringstream m;
+    m << "POD does not rise with the defect size (b1 = " << e.b1 << ")";
     s.message = m.str();
     return s;
   }
-  const PodScale scale = options.scale;
-  const double q = Quantile(link, options.pod_level);
-  const double x90 = (q - b0) / b1;
-  s.a50 = ToA(scale, -b0 / b1);
-  s.a90 = ToA(scale, x90);
-  const double span = std::max(ToX(scale, s.size_max) - ToX(scale, s.size_min), 1e-9);
-  const double z = NormalQuantile(options.confidence);
-  // Wald: the lower band crosses pod_level.
-  const double x_w = FirstCrossing(
-      [&](double x) {
-        const double var = s.cov00 + 2.0 * x * s.cov01 + x * x * s.cov11;
-        return b0 + b1 * x - z * std::sqrt(std::max(var, 0.0)) - q;
-      },
-      x90, span);
-  s.a90_95_wald = std::isfinite(x_w) ? ToA(scale, x_w) : kInf;
-  // Likelihood ratio: the profile deviance reaches z^2 (chi2_1 at 2 gamma - 1). As a90' -> inf
-  // the best curve through (a90', pod_level) flattens (b1 -> 0) and its likelihood tends to
-  // that of one POD for every size, l_0; when 2 (l - l_0) stays within z^2 no a90' is excluded
-  // (the data do not show at this confidence that POD rises with a) and the bound is +inf.
-  const double share = static_cast<double>(s.hits) / s.units;
-  const double l0 = s.hits * std::log(share) + (s.units - s.hits) * std::log1p(-share);
-  double x_lr = kInf;
-  if (2.0 * (l - l0) > z * z)
-    x_lr = FirstCrossing(
-        [&](double x) { return 2.0 * (l - ProfileLogLik(link, d, q, x, b1)) - z * z; }, x90, span);
-  s.a90_95_lr = std::isfinite(x_lr) ? ToA(scale, x_lr) : kInf;
+  FillSizes(link, d, &s);
   for (const HitMiss& h : data)
     if (!h.hit && h.size >= s.a90_95_lr) {
       ++s.misses_beyond_a90_95;
       s.largest_miss_beyond = std::max(s.largest_miss_beyond, h.size);
     }
   s.usable = true;
-  m << ToString(link) << " POD on " << (scale == PodScale::kLog ? "ln a" : "a") << " from "
-    << s.units << " units (" << s.hits << " hits, sizes " << s.size_min << "-" << s.size_max
-    << "): a50 " << s.a50 << ", a" << std::lround(100 * options.pod_level) << " " << s.a90 << ", a"
-    << std::lround(100 * options.pod_level) << "/" << std::lround(100 * options.confidence) << " "
-    << s.a90_95_lr << " (likelihood ratio), " << s.a90_95_wald << " (Wald)";
-  if (!std::isfinite(s.a90_95_lr) || !std::isfinite(s.a90_95_wald))
-    m << "; inf: the data do not bound a" << std::lround(100 * options.pod_level)
-      << " from above at this confidence";
-  else if (s.a90_95_lr > s.size_max)
-    m << "; a" << std::lround(100 * options.pod_level) << "/"
-      << std::lround(100 * options.confidence)
-      << " lies beyond the largest size tested (extrapolated)";
-  if (s.misses_beyond_a90_95 > 0)
-    m << "; " << s.misses_beyond_a90_95 << " miss(es) at or beyond a"
-      << std::lround(100 * options.pod_level) << "/" << std::lround(100 * options.confidence)
-      << " (up to " << s.largest_miss_beyond << "): POD may not rise monotonically there";
-  s.message = m.str();
+  s.message = UsableMessage(s);
   return s;
 }
 

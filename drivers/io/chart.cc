@@ -190,102 +190,120 @@ void LegendEntry(Painter& p, double x, double* y, const std::string& label, Colo
   *y += 16.0;
 }
 
-void DrawPanel(Painter& p, const ChartPanel& panel, double top, double width, double height) {
-  cairo_t* cr = p.cr();
-  const double plot_top = top + kPanelTitleH, plot_bottom = top + height - kBelow;
-  const double plot_left = kLeft, plot_right = width - kRight;
+// Pixels of a panel's plot area (inside the frame).
+struct PlotArea {
+  double left = 0.0, right = 0.0, top = 0.0, bottom = 0.0;
+  double Width() const { return right - left; }
+  double Height() const { return bottom - top; }
+};
 
-  Extent ex, ey;
+// Height of the notes box in the top-left corner (0 without notes).
+double NotesHeight(const ChartPanel& panel) {
+  return panel.notes.empty() ? 0.0 : 14.0 * static_cast<double>(panel.notes.size()) + 6.0;
+}
+
+// The extents of everything drawn: series, bars, lines and band ends.
+void DataExtents(const ChartPanel& panel, Extent* ex, Extent* ey) {
   for (const ChartSeries& s : panel.series) {
-    for (double v : s.x) ex.Add(v, panel.log_x);
-    for (double v : s.y) ey.Add(v, panel.log_y);
+    for (double v : s.x) ex->Add(v, panel.log_x);
+    for (double v : s.y) ey->Add(v, panel.log_y);
   }
   for (const ChartBars& b : panel.bars)
     for (const ChartBar& bar : b.bars) {
-      ex.Add(bar.x_lo, panel.log_x);
-      ex.Add(bar.x_hi, panel.log_x);
-      ey.Add(bar.height, panel.log_y);
-      ey.Add(0.0, panel.log_y);
+      ex->Add(bar.x_lo, panel.log_x);
+      ex->Add(bar.x_hi, panel.log_x);
+      ey->Add(bar.height, panel.log_y);
+      ey->Add(0.0, panel.log_y);
     }
-  for (const ChartLine& l : panel.hlines) ey.Add(l.value, panel.log_y);
-  for (const ChartLine& l : panel.vlines) ex.Add(l.value, panel.log_x);
-  for (const ChartBand& b : panel.hbands) ey.Add(b.lo, panel.log_y), ey.Add(b.hi, panel.log_y);
-  for (const ChartBand& b : panel.vbands) ex.Add(b.lo, panel.log_x), ex.Add(b.hi, panel.log_x);
+  for (const ChartLine& l : panel.hlines) ey->Add(l.value, panel.log_y);
+  for (const ChartLine& l : panel.vlines) ex->Add(l.value, panel.log_x);
+  for (const ChartBand& b : panel.hbands) ey->Add(b.lo, panel.log_y), ey->Add(b.hi, panel.log_y);
+  for (const ChartBand& b : panel.vbands) ex->Add(b.lo, panel.log_x), ex->Add(b.hi, panel.log_x);
+}
 
-  Axis x, y;
-  x.log = panel.log_x;
-  y.log = panel.log_y;
-  std::tie(x.lo, x.hi) = panel.x_range ? *panel.x_range : ex.Range(x.log, 0.02);
-  std::tie(y.lo, y.hi) = panel.y_range ? *panel.y_range : ey.Range(y.log, 0.06);
-  if (!panel.bars.empty() && !y.log && !panel.y_range) y.lo = std::max(y.lo, 0.0);
+// The panel's axes: fixed ranges or the padded extents, mapped onto the plot area.
+void SetUpAxes(const ChartPanel& panel, const PlotArea& area, Axis* x, Axis* y) {
+  Extent ex, ey;
+  DataExtents(panel, &ex, &ey);
+  x->log = panel.log_x;
+  y->log = panel.log_y;
+  std::tie(x->lo, x->hi) = panel.x_range ? *panel.x_range : ex.Range(x->log, 0.02);
+  std::tie(y->lo, y->hi) = panel.y_range ? *panel.y_range : ey.Range(y->log, 0.06);
+  if (!panel.bars.empty() && !y->log && !panel.y_range) y->lo = std::max(y->lo, 0.0);
   // Head room above the data for the notes box and the vertical lines' labels, so that
   // neither hides a point or a bar (linear axes whose range is not fixed).
-  const double notes_h =
-      panel.notes.empty() ? 0.0 : 14.0 * static_cast<double>(panel.notes.size()) + 6.0;
-  const double head_px =
-      notes_h + 13.0 * static_cast<double>(panel.vlines.size()) + (panel.vlines.empty() ? 0 : 4);
-  if (!y.log && !panel.y_range && head_px > 0.0) {
-    const double room = plot_bottom - plot_top;
-    if (head_px < 0.6 * room) y.hi += (y.hi - y.lo) * head_px / (room - head_px);
+  const double head_px = NotesHeight(panel) + 13.0 * static_cast<double>(panel.vlines.size()) +
+                         (panel.vlines.empty() ? 0 : 4);
+  if (!y->log && !panel.y_range && head_px > 0.0) {
+    const double room = area.bottom - area.top;
+    if (head_px < 0.6 * room) y->hi += (y->hi - y->lo) * head_px / (room - head_px);
   }
-  x.px_lo = plot_left;
-  x.px_hi = plot_right;
-  y.px_lo = plot_bottom;
-  y.px_hi = plot_top;
+  x->px_lo = area.left;
+  x->px_hi = area.right;
+  y->px_lo = area.bottom;
+  y->px_hi = area.top;
+}
 
-  // Title.
-  p.Text(panel.title, plot_left, top + 15.0, kPanelTitleFont, 0.0, kChartBlack, 0.0, true);
-
-  // Bands behind everything.
+void ClipToPlot(cairo_t* cr, const PlotArea& area) {
   cairo_save(cr);
-  cairo_rectangle(cr, plot_left, plot_top, plot_right - plot_left, plot_bottom - plot_top);
+  cairo_rectangle(cr, area.left, area.top, area.Width(), area.Height());
   cairo_clip(cr);
+}
+
+// Shaded bands, behind everything.
+void DrawBands(Painter& p, const ChartPanel& panel, const PlotArea& area, const Axis& x,
+               const Axis& y) {
+  cairo_t* cr = p.cr();
+  ClipToPlot(cr, area);
   for (const ChartBand& b : panel.hbands) {
     const double a = y.MapEdge(b.lo, true), c = y.MapEdge(b.hi, false);
     p.SetColour(b.colour, b.alpha);
-    cairo_rectangle(cr, plot_left, std::min(a, c), plot_right - plot_left, std::abs(a - c));
+    cairo_rectangle(cr, area.left, std::min(a, c), area.Width(), std::abs(a - c));
     cairo_fill(cr);
   }
   for (const ChartBand& b : panel.vbands) {
     const double a = x.MapEdge(b.lo, true), c = x.MapEdge(b.hi, false);
     p.SetColour(b.colour, b.alpha);
-    cairo_rectangle(cr, std::min(a, c), plot_top, std::max(std::abs(a - c), 1.0),
-                    plot_bottom - plot_top);
+    cairo_rectangle(cr, std::min(a, c), area.top, std::max(std::abs(a - c), 1.0), area.Height());
     cairo_fill(cr);
   }
   cairo_restore(cr);
+}
 
-  // Grid and ticks.
+// Grid lines, ticks with their numbers, and the axis labels.
+void DrawGrid(Painter& p, const ChartPanel& panel, const PlotArea& area, const Axis& x,
+              const Axis& y) {
   const std::vector<double> xt = x.log ? LogTicks(x.lo, x.hi) : LinearTicks(x.lo, x.hi, 8);
   const std::vector<double> yt = y.log ? LogTicks(y.lo, y.hi) : LinearTicks(y.lo, y.hi, 5);
   p.SetStroke(1.0, LineStyle::kSolid);
   for (double t : yt) {
     const double py = y.Map(t);
     p.SetColour({0.88, 0.88, 0.88});
-    p.Line(plot_left, py, plot_right, py);
+    p.Line(area.left, py, area.right, py);
     p.SetColour(kChartBlack);
-    p.Line(plot_left - 4.0, py, plot_left, py);
-    p.Text(Num(t), plot_left - 7.0, py + 4.0, kFont, 1.0);
+    p.Line(area.left - 4.0, py, area.left, py);
+    p.Text(Num(t), area.left - 7.0, py + 4.0, kFont, 1.0);
   }
   for (double t : xt) {
     const double px = x.Map(t);
     p.SetColour({0.92, 0.92, 0.92});
-    p.Line(px, plot_top, px, plot_bottom);
+    p.Line(px, area.top, px, area.bottom);
     p.SetColour(kChartBlack);
-    p.Line(px, plot_bottom, px, plot_bottom + 4.0);
-    p.Text(Num(t), px, plot_bottom + 17.0, kFont, 0.5);
+    p.Line(px, area.bottom, px, area.bottom + 4.0);
+    p.Text(Num(t), px, area.bottom + 17.0, kFont, 0.5);
   }
-  p.Text(panel.x_label, (plot_left + plot_right) / 2.0, plot_bottom + 35.0, kFont, 0.5);
-  p.Text(panel.y_label, 20.0, (plot_top + plot_bottom) / 2.0, kFont, 0.5, kChartBlack, -M_PI / 2.0);
+  p.Text(panel.x_label, (area.left + area.right) / 2.0, area.bottom + 35.0, kFont, 0.5);
+  p.Text(panel.y_label, 20.0, (area.top + area.bottom) / 2.0, kFont, 0.5, kChartBlack, -M_PI / 2.0);
+}
 
-  cairo_save(cr);
-  cairo_rectangle(cr, plot_left, plot_top, plot_right - plot_left, plot_bottom - plot_top);
-  cairo_clip(cr);
+void DrawBars(Painter& p, const ChartPanel& panel, const PlotArea& area, const Axis& x,
+              const Axis& y) {
+  cairo_t* cr = p.cr();
   for (const ChartBars& b : panel.bars)
     for (const ChartBar& bar : b.bars) {
       if (!x.Valid(bar.x_lo) || !x.Valid(bar.x_hi) || !(bar.height > 0.0)) continue;
       const double a = x.Map(bar.x_lo), c = x.Map(bar.x_hi);
-      const double base = y.log ? plot_bottom : y.Map(std::max(0.0, y.lo));
+      const double base = y.log ? area.bottom : y.Map(std::max(0.0, y.lo));
       const double h = y.Valid(bar.height) ? y.Map(bar.height) : base;
       p.SetColour(b.colour, 0.55);
       cairo_rectangle(cr, a, h, c - a, base - h);
@@ -294,85 +312,109 @@ void DrawPanel(Painter& p, const ChartPanel& panel, double top, double width, do
       p.SetStroke(0.8, LineStyle::kSolid);
       cairo_stroke(cr);
     }
-  for (const ChartSeries& s : panel.series) {
-    p.SetColour(s.colour);
-    p.SetStroke(s.width, s.style);
-    if (s.line) {
-      bool open = false;
-      for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-        if (!x.Valid(s.x[i]) || !y.Valid(s.y[i])) {
-          open = false;
-          continue;
-        }
-        if (open)
-          cairo_line_to(cr, x.Map(s.x[i]), y.Map(s.y[i]));
-        else
-          cairo_move_to(cr, x.Map(s.x[i]), y.Map(s.y[i]));
-        open = true;
+}
+
+// One series: its line (broken at invalid points) and its markers.
+void DrawSeries(Painter& p, const ChartSeries& s, const Axis& x, const Axis& y) {
+  cairo_t* cr = p.cr();
+  p.SetColour(s.colour);
+  p.SetStroke(s.width, s.style);
+  if (s.line) {
+    bool open = false;
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if (!x.Valid(s.x[i]) || !y.Valid(s.y[i])) {
+        open = false;
+        continue;
       }
-      cairo_stroke(cr);
+      if (open)
+        cairo_line_to(cr, x.Map(s.x[i]), y.Map(s.y[i]));
+      else
+        cairo_move_to(cr, x.Map(s.x[i]), y.Map(s.y[i]));
+      open = true;
     }
-    if (s.markers)
-      for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-        if (!x.Valid(s.x[i]) || !y.Valid(s.y[i])) continue;
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, x.Map(s.x[i]), y.Map(s.y[i]), s.marker_radius, 0.0, 2.0 * M_PI);
-        cairo_fill(cr);
-      }
+    cairo_stroke(cr);
   }
+  if (s.markers)
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if (!x.Valid(s.x[i]) || !y.Valid(s.y[i])) continue;
+      cairo_new_sub_path(cr);
+      cairo_arc(cr, x.Map(s.x[i]), y.Map(s.y[i]), s.marker_radius, 0.0, 2.0 * M_PI);
+      cairo_fill(cr);
+    }
+}
+
+void DrawLimitLines(Painter& p, const ChartPanel& panel, const PlotArea& area, const Axis& x,
+                    const Axis& y) {
   for (const ChartLine& l : panel.hlines) {
     if (!y.Valid(l.value)) continue;
     const double py = y.Map(l.value);
     p.SetColour(l.colour);
     p.SetStroke(l.width, l.style);
-    p.Line(plot_left, py, plot_right, py);
+    p.Line(area.left, py, area.right, py);
   }
   for (const ChartLine& l : panel.vlines) {
     if (!x.Valid(l.value)) continue;
     const double px = x.Map(l.value);
     p.SetColour(l.colour);
     p.SetStroke(l.width, l.style);
-    p.Line(px, plot_top, px, plot_bottom);
+    p.Line(px, area.top, px, area.bottom);
   }
-  cairo_restore(cr);
-  // Line labels beside their lines, inside the frame.
+}
+
+// Bars, series and limit lines, clipped to the plot area.
+void DrawData(Painter& p, const ChartPanel& panel, const PlotArea& area, const Axis& x,
+              const Axis& y) {
+  ClipToPlot(p.cr(), area);
+  DrawBars(p, panel, area, x, y);
+  for (const ChartSeries& s : panel.series) DrawSeries(p, s, x, y);
+  DrawLimitLines(p, panel, area, x, y);
+  cairo_restore(p.cr());
+}
+
+// Line labels beside their lines, inside the frame.
+void DrawLineLabels(Painter& p, const ChartPanel& panel, const PlotArea& area, const Axis& x,
+                    const Axis& y) {
   for (const ChartLine& l : panel.hlines)
     if (y.Valid(l.value) && l.value >= y.lo && l.value <= y.hi)
-      p.Text(l.label, plot_right - 4.0, y.Map(l.value) - 3.0, kSmallFont, 1.0, l.colour);
-  double label_y = plot_top + notes_h + 15.0;  // one row per vertical line, below the notes
+      p.Text(l.label, area.right - 4.0, y.Map(l.value) - 3.0, kSmallFont, 1.0, l.colour);
+  double label_y = area.top + NotesHeight(panel) + 15.0;  // one row per vertical line
   for (const ChartLine& l : panel.vlines)
     if (x.Valid(l.value) && l.value >= x.lo && l.value <= x.hi) {
       // Right of the line, or left of it when it would leave the frame.
       const double px = x.Map(l.value);
-      const bool left = px + 3.0 + p.TextWidth(l.label, kSmallFont) > plot_right;
+      const bool left = px + 3.0 + p.TextWidth(l.label, kSmallFont) > area.right;
       p.Text(l.label, left ? px - 3.0 : px + 3.0, label_y, kSmallFont, left ? 1.0 : 0.0, l.colour);
       label_y += 13.0;
     }
+}
 
-  // Frame.
+void DrawFrame(Painter& p, const PlotArea& area) {
   p.SetColour({0.2, 0.2, 0.2});
   p.SetStroke(1.0, LineStyle::kSolid);
-  cairo_rectangle(cr, plot_left, plot_top, plot_right - plot_left, plot_bottom - plot_top);
-  cairo_stroke(cr);
+  cairo_rectangle(p.cr(), area.left, area.top, area.Width(), area.Height());
+  cairo_stroke(p.cr());
+}
 
-  // Notes on a white box in the top-left corner.
-  if (!panel.notes.empty()) {
-    double w = 0.0;
-    for (const std::string& n : panel.notes) w = std::max(w, p.TextWidth(n, kSmallFont));
-    const double h = 14.0 * static_cast<double>(panel.notes.size()) + 6.0;
-    cairo_set_source_rgba(cr, 1.0, 1.0, 1.0, 0.85);
-    cairo_rectangle(cr, plot_left + 6.0, plot_top + 6.0, w + 10.0, h);
-    cairo_fill(cr);
-    double ny = plot_top + 19.0;
-    for (const std::string& n : panel.notes) {
-      p.Text(n, plot_left + 11.0, ny, kSmallFont);
-      ny += 14.0;
-    }
+// Notes on a white box in the top-left corner.
+void DrawNotes(Painter& p, const ChartPanel& panel, const PlotArea& area) {
+  if (panel.notes.empty()) return;
+  cairo_t* cr = p.cr();
+  double w = 0.0;
+  for (const std::string& n : panel.notes) w = std::max(w, p.TextWidth(n, kSmallFont));
+  const double h = 14.0 * static_cast<double>(panel.notes.size()) + 6.0;
+  cairo_set_source_rgba(cr, 1.0, 1.0, 1.0, 0.85);
+  cairo_rectangle(cr, area.left + 6.0, area.top + 6.0, w + 10.0, h);
+  cairo_fill(cr);
+  double ny = area.top + 19.0;
+  for (const std::string& n : panel.notes) {
+    p.Text(n, area.left + 11.0, ny, kSmallFont);
+    ny += 14.0;
   }
+}
 
-  // Legend.
-  double ly = plot_top + 10.0;
-  const double lx = plot_right + 12.0;
+void DrawLegend(Painter& p, const ChartPanel& panel, const PlotArea& area) {
+  double ly = area.top + 10.0;
+  const double lx = area.right + 12.0;
   for (const ChartBand& b : panel.hbands)
     LegendEntry(p, lx, &ly, b.label, b.colour, LineStyle::kSolid, 0, false, false, true, b.alpha);
   for (const ChartBand& b : panel.vbands)
@@ -385,6 +427,20 @@ void DrawPanel(Painter& p, const ChartPanel& panel, double top, double width, do
     LegendEntry(p, lx, &ly, l.label, l.colour, l.style, l.width, true, false, false, 1.0);
   for (const ChartLine& l : panel.vlines)
     LegendEntry(p, lx, &ly, l.label, l.colour, l.style, l.width, true, false, false, 1.0);
+}
+
+void DrawPanel(Painter& p, const ChartPanel& panel, double top, double width, double height) {
+  const PlotArea area{kLeft, width - kRight, top + kPanelTitleH, top + height - kBelow};
+  Axis x, y;
+  SetUpAxes(panel, area, &x, &y);
+  p.Text(panel.title, area.left, top + 15.0, kPanelTitleFont, 0.0, kChartBlack, 0.0, true);
+  DrawBands(p, panel, area, x, y);
+  DrawGrid(p, panel, area, x, y);
+  DrawData(p, panel, area, x, y);
+  DrawLineLabels(p, panel, area, x, y);
+  DrawFrame(p, area);
+  DrawNotes(p, panel, area);
+  DrawLegend(p, panel, area);
 }
 
 // Draws the whole chart on `cr`; returns the strings drawn.

@@ -20,6 +20,7 @@
 #include <locale>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "analysis/fit/fit_json.h"
@@ -249,51 +250,51 @@ int AnalyzeMobility(const AnalyzeArgs& a, const analysis::Frf& h, json out) {
   return 0;
 }
 
-int RunAnalyze(const AnalyzeArgs& a) {
-  json out = {{"file", a.measured}};
-  if (a.clamp_pressure_bar > 0.0)
-    out["conditions"] = {{std::string(analysis::names::kClampPressureBar), a.clamp_pressure_bar}};
+// What the command reads: the recipe (optional), the measured file and, for a raw
+// recording, its excited lines (periodic) or its Welch options.
+struct Inputs {
   std::unique_ptr<Recipe> recipe;
-  io::MeasuredInput in;
+  io::MeasuredInput file;
   std::vector<std::size_t> lines;
   analysis::WelchOptions welch;
-  try {
-    if (a.measured.empty()) throw UsageError("--measured FILE is required");
-    if (!a.recipe.empty()) recipe = std::make_unique<Recipe>(LoadRecipe(a.recipe));
-    in = io::ReadMeasured(a.measured, {a.voltage_gain, a.current_gain});
-    const bool recording = in.kind == io::MeasuredKind::kRecording;
-    if (!recording && (a.voltage_full_scale > 0.0 || a.current_full_scale > 0.0))
-      throw UsageError("--voltage-full-scale and --current-full-scale apply to raw recordings");
-    if (a.voltage_full_scale > 0.0) in.recording.voltage_full_scale_v = a.voltage_full_scale;
-    if (a.current_full_scale > 0.0) in.recording.current_full_scale_a = a.current_full_scale;
-    if (recording && a.welch_segment > 0)
-      welch = SetUpWelch(a, recipe.get());
-    else if (recording)
-      lines = SetUpPeriodic(a, recipe.get(), &in.recording);
-    else if (a.period_samples != 0 || !a.lines.empty() || !a.excitation_band.empty() ||
-             a.welch_segment > 0)
-      throw UsageError(
-          "--period-samples, --lines, --excitation-band and --welch-segment apply to raw "
-          "recordings only");
-  } catch (const UsageError& e) {
-    return Fail(a, out, 2, std::string("usage: ") + e.what());
-  } catch (const std::exception& e) {  // io::FileError, io::ConfigError
-    return Fail(a, out, 2, e.what());
-  }
-  out["format"] = in.format;
-  if (recipe)
-    out["recipe"] = {{"id", recipe->id}, {"version", recipe->version}, {"hash", recipe->hash}};
-  if (in.kind == io::MeasuredKind::kFrf && in.frf.quantity == analysis::Quantity::kMobility)
-    return AnalyzeMobility(a, in.frf, out);
+};
 
+// Reads the recipe and the file and checks the options against the file's kind. Throws
+// UsageError for bad options, io::FileError or io::ConfigError for unreadable files.
+void ReadInputs(const AnalyzeArgs& a, Inputs* inputs) {
+  if (a.measured.empty()) throw UsageError("--measured FILE is required");
+  if (!a.recipe.empty()) inputs->recipe = std::make_unique<Recipe>(LoadRecipe(a.recipe));
+  io::MeasuredInput& in = inputs->file;
+  in = io::ReadMeasured(a.measured, {a.voltage_gain, a.current_gain});
+  const bool recording = in.kind == io::MeasuredKind::kRecording;
+  if (!recording && (a.voltage_full_scale > 0.0 || a.current_full_scale > 0.0))
+    throw UsageError("--voltage-full-scale and --current-full-scale apply to raw recordings");
+  if (a.voltage_full_scale > 0.0) in.recording.voltage_full_scale_v = a.voltage_full_scale;
+  if (a.current_full_scale > 0.0) in.recording.current_full_scale_a = a.current_full_scale;
+  if (recording && a.welch_segment > 0)
+    inputs->welch = SetUpWelch(a, inputs->recipe.get());
+  else if (recording)
+    inputs->lines = SetUpPeriodic(a, inputs->recipe.get(), &in.recording);
+  else if (a.period_samples != 0 || !a.lines.empty() || !a.excitation_band.empty() ||
+           a.welch_segment > 0)
+    throw UsageError(
+        "--period-samples, --lines, --excitation-band and --welch-segment apply to raw "
+        "recordings only");
+}
+
+// Estimates Z(f) (a recording) and fits it into *result, with the estimate's summary in out.
+// Returns the exit code when a Welch estimate is not usable, nothing otherwise.
+std::optional<int> EstimateAndFit(const AnalyzeArgs& a, const Inputs& inputs, json& out,
+                                  analysis::ImpedanceAnalysis* result) {
+  const io::MeasuredInput& in = inputs.file;
+  const Recipe* recipe = inputs.recipe.get();
   const analysis::ImpedanceAnalysisOptions options =
       recipe ? recipe->analysis : analysis::ImpedanceAnalysisOptions{};
-  analysis::ImpedanceAnalysis result;
   if (in.kind == io::MeasuredKind::kFrf) {
-    result = analysis::AnalyzeImpedance(in.frf, options.fit);
+    *result = analysis::AnalyzeImpedance(in.frf, options.fit);
   } else if (a.welch_segment > 0) {
     const analysis::WelchSummary w =
-        analysis::EstimateWelchFrf(analysis::ChannelPair::Impedance(in.recording), welch);
+        analysis::EstimateWelchFrf(analysis::ChannelPair::Impedance(in.recording), inputs.welch);
     out["frf"] = {{"method", w.frf.method},
                   {"segments", w.segments},
                   {"effective_averages", w.effective_averages},
@@ -307,77 +308,65 @@ int RunAnalyze(const AnalyzeArgs& a) {
       }
       return Fail(a, out, 1, "invalid measurement: " + w.message);
     }
-    result = analysis::AnalyzeImpedance(w.frf, options.fit);
-    result.frf.message = w.message;
+    *result = analysis::AnalyzeImpedance(w.frf, options.fit);
+    result->frf.message = w.message;
   } else {
-    result = analysis::AnalyzeRecording(in.recording, lines, options);
+    *result = analysis::AnalyzeRecording(in.recording, inputs.lines, options);
   }
-  const analysis::Frf& z = result.frf.frf;
+  const analysis::Frf& z = result->frf.frf;
   if (in.kind == io::MeasuredKind::kRecording && a.welch_segment == 0)
     out["frf"] = {{"method", z.method},
-                  {"periods_used", result.frf.periods_used},
-                  {"periods_dropped", result.frf.periods_dropped},
-                  {"message", result.frf.message},
+                  {"periods_used", result->frf.periods_used},
+                  {"periods_dropped", result->frf.periods_dropped},
+                  {"message", result->frf.message},
                   {"sample_rate_hz", in.recording.sample_rate_hz},
                   {"period_samples", in.recording.period_samples}};
   out["lines"] = z.size();
-  const bool noise_estimated = !z.has_sigma();
-  out["noise_estimated"] = noise_estimated;
-  const analysis::FitSummary& fit = result.fit;
-  out["fit"] = fit;  // analysis/fit/fit_json.h
-  if (noise_estimated) out["estimated_sigma_ohm"] = fit.estimated_sigma;
-  // A noise recording (Welch) was not excited with the recipe's multisine: the recipe's
-  // excitation-level windows do not apply to it, so it is judged like an FRF file.
-  const analysis::Recording* recording =
-      in.kind == io::MeasuredKind::kRecording && a.welch_segment == 0 ? &in.recording : nullptr;
-  if (!result.usable) {
-    if (recipe) out["verdict"] = JudgeJson(*recipe, result, recording, out);
-    return Fail(a, out, 1, result.message);
+  out["noise_estimated"] = !z.has_sigma();
+  out["fit"] = result->fit;  // analysis/fit/fit_json.h
+  if (!z.has_sigma()) out["estimated_sigma_ohm"] = result->fit.estimated_sigma;
+  return std::nullopt;
+}
+
+// --plot: the curve against the model, with the recipe's window, masks and the verdict's
+// reasons. Throws what io::WriteChart throws.
+void WritePlot(const AnalyzeArgs& a, const Recipe* recipe,
+               const analysis::ImpedanceAnalysis& result, const Judgement& verdict) {
+  const analysis::Frf& z = result.frf.frf;
+  CurvePlot p;
+  p.title = "eol analyze " + a.measured;
+  p.freq_hz = z.freq_hz;
+  p.measured = z.value;
+  p.model_freq_hz = z.freq_hz;
+  p.model = result.fit.Model().Evaluate(z.freq_hz).value;
+  p.f0_hz = result.fit.Find("f0_hz")->value;
+  if (recipe) {
+    p.title += " - recipe " + recipe->id + " v" + std::to_string(recipe->version) + ": " +
+               analysis::ToString(verdict.outcome);
+    for (const analysis::MeasurementSpec& spec : recipe->limits)
+      if (spec.name == "resonance_f_hz") p.resonance_window = spec.limit;
+    p.masks = recipe->masks;
+    for (const analysis::Reason& r : verdict.reasons) p.notes.push_back(r.text);
+  } else {
+    p.notes.push_back("no --recipe: no limits or masks drawn");
   }
-  json params = json::object();
-  for (const auto& p : fit.params) params[p.name] = Param(p);
-  out["params"] = params;
+  io::WriteChart(a.plot, CurveChart(p));
+}
+
+// The analysis as text on stdout.
+void PrintSummary(const AnalyzeArgs& a, const Inputs& inputs,
+                  const analysis::ImpedanceAnalysis& result, const Judgement& verdict) {
+  const io::MeasuredInput& in = inputs.file;
+  const Recipe* recipe = inputs.recipe.get();
+  const analysis::Frf& z = result.frf.frf;
+  const analysis::FitSummary& fit = result.fit;
   const analysis::FittedParameter& f0 = *fit.Find("f0_hz");
   const analysis::FittedParameter& q = *fit.Find("Q");
-  out["resonance"] = {
-      {"f_hz", f0.value}, {"f_sigma_hz", f0.sigma}, {"q", q.value}, {"q_sigma", q.sigma}};
-  Judgement verdict;
-  if (recipe) out["verdict"] = JudgeJson(*recipe, result, recording, out, &verdict);
-  out["usable"] = true;
-  if (!a.plot.empty()) {
-    CurvePlot p;
-    p.title = "eol analyze " + a.measured;
-    p.freq_hz = z.freq_hz;
-    p.measured = z.value;
-    p.model_freq_hz = z.freq_hz;
-    p.model = fit.Model().Evaluate(z.freq_hz).value;
-    p.f0_hz = f0.value;
-    if (recipe) {
-      p.title += " - recipe " + recipe->id + " v" + std::to_string(recipe->version) + ": " +
-                 analysis::ToString(verdict.outcome);
-      for (const analysis::MeasurementSpec& spec : recipe->limits)
-        if (spec.name == "resonance_f_hz") p.resonance_window = spec.limit;
-      p.masks = recipe->masks;
-      for (const analysis::Reason& r : verdict.reasons) p.notes.push_back(r.text);
-    } else {
-      p.notes.push_back("no --recipe: no limits or masks drawn");
-    }
-    try {
-      io::WriteChart(a.plot, CurveChart(p));
-    } catch (const std::exception& e) {
-      return Fail(a, out, 2, std::string("--plot: ") + e.what());
-    }
-    out["plot"] = a.plot;
-  }
-  if (a.json) {
-    std::cout << out.dump() << std::endl;
-    return 0;
-  }
   std::cout << a.measured << ": " << in.format << ", " << z.size() << " lines "
             << Fixed(z.freq_hz.front(), 1) << "-" << Fixed(z.freq_hz.back(), 1) << " Hz";
   if (in.kind == io::MeasuredKind::kRecording) std::cout << " (" << result.frf.message << ")";
   std::cout << "\n";
-  if (noise_estimated)
+  if (!z.has_sigma())
     std::cout << "noise: the file has no sigma; estimated from the fit residual as "
               << Sci(fit.estimated_sigma) << " ohm per line (complex std): uncertainties below "
               << "assume the model is right\n";
@@ -398,6 +387,62 @@ int RunAnalyze(const AnalyzeArgs& a) {
       std::cout << "  condition " << c
                 << " not evaluated: no recording of the recipe's excitation\n";
   }
+}
+
+int RunAnalyze(const AnalyzeArgs& a) {
+  json out = {{"file", a.measured}};
+  if (a.clamp_pressure_bar > 0.0)
+    out["conditions"] = {{std::string(analysis::names::kClampPressureBar), a.clamp_pressure_bar}};
+  Inputs inputs;
+  try {
+    ReadInputs(a, &inputs);
+  } catch (const UsageError& e) {
+    return Fail(a, out, 2, std::string("usage: ") + e.what());
+  } catch (const std::exception& e) {  // io::FileError, io::ConfigError
+    return Fail(a, out, 2, e.what());
+  }
+  const io::MeasuredInput& in = inputs.file;
+  const Recipe* recipe = inputs.recipe.get();
+  out["format"] = in.format;
+  if (recipe)
+    out["recipe"] = {{"id", recipe->id}, {"version", recipe->version}, {"hash", recipe->hash}};
+  if (in.kind == io::MeasuredKind::kFrf && in.frf.quantity == analysis::Quantity::kMobility)
+    return AnalyzeMobility(a, in.frf, out);
+
+  analysis::ImpedanceAnalysis result;
+  if (const std::optional<int> code = EstimateAndFit(a, inputs, out, &result)) return *code;
+  const analysis::FitSummary& fit = result.fit;
+  // A noise recording (Welch) was not excited with the recipe's multisine: the recipe's
+  // excitation-level windows do not apply to it, so it is judged like an FRF file.
+  const analysis::Recording* recording =
+      in.kind == io::MeasuredKind::kRecording && a.welch_segment == 0 ? &in.recording : nullptr;
+  if (!result.usable) {
+    if (recipe) out["verdict"] = JudgeJson(*recipe, result, recording, out);
+    return Fail(a, out, 1, result.message);
+  }
+  json params = json::object();
+  for (const auto& p : fit.params) params[p.name] = Param(p);
+  out["params"] = params;
+  const analysis::FittedParameter& f0 = *fit.Find("f0_hz");
+  const analysis::FittedParameter& q = *fit.Find("Q");
+  out["resonance"] = {
+      {"f_hz", f0.value}, {"f_sigma_hz", f0.sigma}, {"q", q.value}, {"q_sigma", q.sigma}};
+  Judgement verdict;
+  if (recipe) out["verdict"] = JudgeJson(*recipe, result, recording, out, &verdict);
+  out["usable"] = true;
+  if (!a.plot.empty()) {
+    try {
+      WritePlot(a, recipe, result, verdict);
+    } catch (const std::exception& e) {
+      return Fail(a, out, 2, std::string("--plot: ") + e.what());
+    }
+    out["plot"] = a.plot;
+  }
+  if (a.json) {
+    std::cout << out.dump() << std::endl;
+    return 0;
+  }
+  PrintSummary(a, inputs, result, verdict);
   return 0;
 }
 

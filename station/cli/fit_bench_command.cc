@@ -51,8 +51,10 @@ std::string G(double v, int precision = 4) {
   return os.str();
 }
 
-int RunFitBench(const FitBenchArgs& a) {
-  const Recipe recipe = LoadRecipe(a.recipe);
+// The benchmark's options: the population's nominal good rotor measured with the recipe's
+// excitation and the simulated DAQ's noise, with the command's overrides. Prints the error
+// and returns false for a bad --frf-method or --sim.
+bool MakeOptions(const FitBenchArgs& a, const Recipe& recipe, analysis::FitBenchOptions* o) {
   const analysis::MotorPopulation population;
   analysis::ClampedRotor rotor;
   rotor.inertia_kg_m2 = population.inertia_kg_m2;
@@ -62,113 +64,121 @@ int RunFitBench(const FitBenchArgs& a) {
   rotor.transmission_nm_per_a = population.transmission_nm_per_a;
   const drivers::SimDaqSettings daq;
 
-  analysis::FitBenchOptions o;
-  o.truth = rotor.Electrical(population.r_ohm, population.l_h);
-  o.excitation = recipe.excitation;
-  o.periods = recipe.periods;
-  o.transient_periods = recipe.transient_periods;
-  o.voltage_noise_v = daq.voltage_noise_v;
-  o.current_noise_a = daq.current_noise_a;
-  o.analysis = recipe.analysis;
-  if (!a.frf_method.empty() && !analysis::ParseFrfMethod(a.frf_method, &o.analysis.frf_method)) {
+  o->truth = rotor.Electrical(population.r_ohm, population.l_h);
+  o->excitation = recipe.excitation;
+  o->periods = recipe.periods;
+  o->transient_periods = recipe.transient_periods;
+  o->voltage_noise_v = daq.voltage_noise_v;
+  o->current_noise_a = daq.current_noise_a;
+  o->analysis = recipe.analysis;
+  if (!a.frf_method.empty() && !analysis::ParseFrfMethod(a.frf_method, &o->analysis.frf_method)) {
     std::cerr << "eol fit-bench: --frf-method must be discard_transient or transient_lpm\n";
-    return 2;
+    return false;
   }
   if (a.sim == "time_domain") {
-    o.simulation = analysis::BenchSimulation::kTimeDomain;
+    o->simulation = analysis::BenchSimulation::kTimeDomain;
   } else if (a.sim != "steady_state") {
     std::cerr << "eol fit-bench: --sim must be steady_state or time_domain\n";
-    return 2;
+    return false;
   }
-  o.series_ohm = a.series_ohm;
-  if (a.line_spacing_hz > 0.0) o.excitation.line_spacing_hz = a.line_spacing_hz;
-  if (a.periods > 0) o.periods = static_cast<std::size_t>(a.periods);
+  o->series_ohm = a.series_ohm;
+  if (a.line_spacing_hz > 0.0) o->excitation.line_spacing_hz = a.line_spacing_hz;
+  if (a.periods > 0) o->periods = static_cast<std::size_t>(a.periods);
   if (a.transient_periods >= 0) {
-    o.transient_periods = static_cast<std::size_t>(a.transient_periods);
-    o.analysis.frf.transient_periods = o.transient_periods;
+    o->transient_periods = static_cast<std::size_t>(a.transient_periods);
+    o->analysis.frf.transient_periods = o->transient_periods;
   }
-  if (a.lpm_degree >= 0) o.analysis.lpm.degree = static_cast<std::size_t>(a.lpm_degree);
-  if (a.lpm_half_width >= 0) o.analysis.lpm.half_width = static_cast<std::size_t>(a.lpm_half_width);
-  o.runs = a.runs;
-  o.seed = a.seed;
-  o.check_runs = a.check_runs;
-  o.keep_recordings = static_cast<std::size_t>(std::max(0, std::min(a.peer_runs, a.runs)));
-  analysis::FitBenchResult r;
-  {
-    Progress progress("fit-bench");
-    o.progress = progress.Callback();
-    r = analysis::RunFitBench(o);
-  }
-  if (r.usable_runs < 2) {
-    std::cerr << "eol fit-bench: only " << r.usable_runs << " of " << r.runs
-              << " runs were usable; first failure: " << r.first_failure << std::endl;
-    return 1;
-  }
+  if (a.lpm_degree >= 0) o->analysis.lpm.degree = static_cast<std::size_t>(a.lpm_degree);
+  if (a.lpm_half_width >= 0)
+    o->analysis.lpm.half_width = static_cast<std::size_t>(a.lpm_half_width);
+  o->runs = a.runs;
+  o->seed = a.seed;
+  o->check_runs = a.check_runs;
+  o->keep_recordings = static_cast<std::size_t>(std::max(0, std::min(a.peer_runs, a.runs)));
+  return true;
+}
+
+// The SciPy pipeline on the kept recordings, compared with ours.
+struct PeerComparison {
   ScipyPeerResult peer;
+  double max_diff_sigma = 0.0;  // largest |f0 difference| in Cramer-Rao bounds
+  double ratio = 0.0;           // SciPy's time over ours; NaN when it did not run
+};
+
+PeerComparison ComparePeer(const FitBenchArgs& a, const analysis::FitBenchOptions& o,
+                           const analysis::FitBenchResult& r) {
+  PeerComparison c;
+  ScipyPeerResult& peer = c.peer;
   peer.message = "skipped (--peer-runs 0)";
   // The SciPy pipeline re-implements the discarding estimator only.
   if (a.peer_runs > 0 && o.analysis.frf_method != analysis::FrfMethod::kDiscardTransient)
     peer.message = "skipped: the SciPy pipeline implements discard_transient only";
   else if (a.peer_runs > 0)
     peer = RunScipyPipelinePeer(r, o, a.python, a.script);
-  double peer_max_diff_sigma = 0.0;
   for (std::size_t k = 0; peer.ran && k < peer.f0_hz.size() && k < r.kept_f0_hat_hz.size(); ++k)
-    peer_max_diff_sigma =
-        std::max(peer_max_diff_sigma, std::abs(peer.f0_hz[k] - r.kept_f0_hat_hz[k]) / r.crb_f0_hz);
-  const double ratio = peer.ran ? peer.ms_mean / r.analysis_ms_mean : std::nan("");
+    c.max_diff_sigma =
+        std::max(c.max_diff_sigma, std::abs(peer.f0_hz[k] - r.kept_f0_hat_hz[k]) / r.crb_f0_hz);
+  c.ratio = peer.ran ? peer.ms_mean / r.analysis_ms_mean : std::nan("");
+  return c;
+}
 
-  nlohmann::json j = {
-      {"recipe", {{"id", recipe.id}, {"version", recipe.version}}},
-      {"truth",
-       {{"R_ohm", o.truth.r_ohm},
-        {"L_h", o.truth.l_h},
-        {"Rp_ohm", o.truth.rp_ohm},
-        {"f0_hz", o.truth.f0_hz},
-        {"Q", o.truth.q}}},
-      {"noise", {{"voltage_v_rms", o.voltage_noise_v}, {"current_a_rms", o.current_noise_a}}},
-      {"runs", r.runs},
-      {"usable_runs", r.usable_runs},
-      {"seed", a.seed},
-      {"crest_factor", r.excitation.crest_factor},
-      {"f0",
-       {{"mean_hz", r.f0_mean_hz},
-        {"std_hz", r.f0_std_hz},
-        {"crb_hz", r.crb_f0_hz},
-        {"crb_closed_form_hz", r.crb_f0_closed_form_hz},
-        {"std_over_crb", r.std_over_crb},
-        {"crb_true_noise_hz", r.crb_true_noise_f0_hz},
-        {"std_over_crb_true_noise", r.std_over_crb_true_noise},
-        {"bias_over_std", r.bias_over_std}}},
-      {"frf_method", analysis::ToString(o.analysis.frf_method)},
-      {"simulation", a.sim},
-      {"noise_dof", r.noise_dof},
-      {"coverage_2sigma", r.coverage_2sigma},
-      {"mean_reported_f_sigma_hz", r.mean_reported_f_sigma_hz},
-      {"bias",
-       {{"ml_hz", r.ml_bias_hz},
-        {"peak_pick_hz", r.peak_pick_bias_hz},
-        {"peak_pick_std_hz", r.peak_pick_std_hz}}},
-      {"time",
-       {{"analysis_ms_mean", r.analysis_ms_mean},
-        {"analysis_ms_min", r.analysis_ms_min},
-        {"scipy_ran", peer.ran},
-        {"scipy_message", peer.message},
-        {"scipy_version", peer.scipy_version},
-        {"scipy_ms_mean", peer.ms_mean},
-        {"scipy_over_ours", ratio},
-        {"scipy_max_f0_diff_over_crb", peer_max_diff_sigma}}},
-      {"measurement_time",
-       {{"target_f0_sigma_hz", o.target_f0_sigma_hz},
-        {"averaged_s", r.averaged_time_s},
-        {"needed_s", r.time_for_target_s},
-        {"check_periods", r.check_periods},
-        {"check_predicted_f0_std_hz", r.check_predicted_f0_std_hz},
-        {"check_measured_f0_std_hz", r.check_measured_f0_std_hz}}},
-      {"chi2_per_dof_mean", r.chi2_per_dof_mean}};
-  if (a.json) {
-    std::cout << j.dump() << std::endl;
-    return 0;
-  }
+nlohmann::json ResultJson(const FitBenchArgs& a, const Recipe& recipe,
+                          const analysis::FitBenchOptions& o, const analysis::FitBenchResult& r,
+                          const PeerComparison& c) {
+  const ScipyPeerResult& peer = c.peer;
+  return {{"recipe", {{"id", recipe.id}, {"version", recipe.version}}},
+          {"truth",
+           {{"R_ohm", o.truth.r_ohm},
+            {"L_h", o.truth.l_h},
+            {"Rp_ohm", o.truth.rp_ohm},
+            {"f0_hz", o.truth.f0_hz},
+            {"Q", o.truth.q}}},
+          {"noise", {{"voltage_v_rms", o.voltage_noise_v}, {"current_a_rms", o.current_noise_a}}},
+          {"runs", r.runs},
+          {"usable_runs", r.usable_runs},
+          {"seed", a.seed},
+          {"crest_factor", r.excitation.crest_factor},
+          {"f0",
+           {{"mean_hz", r.f0_mean_hz},
+            {"std_hz", r.f0_std_hz},
+            {"crb_hz", r.crb_f0_hz},
+            {"crb_closed_form_hz", r.crb_f0_closed_form_hz},
+            {"std_over_crb", r.std_over_crb},
+            {"crb_true_noise_hz", r.crb_true_noise_f0_hz},
+            {"std_over_crb_true_noise", r.std_over_crb_true_noise},
+            {"bias_over_std", r.bias_over_std}}},
+          {"frf_method", analysis::ToString(o.analysis.frf_method)},
+          {"simulation", a.sim},
+          {"noise_dof", r.noise_dof},
+          {"coverage_2sigma", r.coverage_2sigma},
+          {"mean_reported_f_sigma_hz", r.mean_reported_f_sigma_hz},
+          {"bias",
+           {{"ml_hz", r.ml_bias_hz},
+            {"peak_pick_hz", r.peak_pick_bias_hz},
+            {"peak_pick_std_hz", r.peak_pick_std_hz}}},
+          {"time",
+           {{"analysis_ms_mean", r.analysis_ms_mean},
+            {"analysis_ms_min", r.analysis_ms_min},
+            {"scipy_ran", peer.ran},
+            {"scipy_message", peer.message},
+            {"scipy_version", peer.scipy_version},
+            {"scipy_ms_mean", peer.ms_mean},
+            {"scipy_over_ours", c.ratio},
+            {"scipy_max_f0_diff_over_crb", c.max_diff_sigma}}},
+          {"measurement_time",
+           {{"target_f0_sigma_hz", o.target_f0_sigma_hz},
+            {"averaged_s", r.averaged_time_s},
+            {"needed_s", r.time_for_target_s},
+            {"check_periods", r.check_periods},
+            {"check_predicted_f0_std_hz", r.check_predicted_f0_std_hz},
+            {"check_measured_f0_std_hz", r.check_measured_f0_std_hz}}},
+          {"chi2_per_dof_mean", r.chi2_per_dof_mean}};
+}
+
+// The five figures of analysis/README.md "Measured figures", as text.
+void PrintReport(const FitBenchArgs& a, const Recipe& recipe, const analysis::FitBenchOptions& o,
+                 const analysis::FitBenchResult& r, const PeerComparison& c) {
+  const ScipyPeerResult& peer = c.peer;
   const auto& e = o.excitation;
   std::cout << "eol fit-bench: recipe " << recipe.id << " v" << recipe.version << ": multisine "
             << G(e.f_lo_hz) << "-" << G(e.f_hi_hz) << " Hz at " << G(e.line_spacing_hz)
@@ -200,8 +210,8 @@ int RunFitBench(const FitBenchArgs& a) {
             << G(r.analysis_ms_min, 3) << " ms)";
   if (peer.ran)
     std::cout << "; SciPy " << peer.scipy_version << " pipeline " << G(peer.ms_mean, 3) << " ms on "
-              << peer.f0_hz.size() << " of the same recordings: ratio " << G(ratio, 3)
-              << " (largest f0 difference " << G(peer_max_diff_sigma, 2) << " bounds)\n";
+              << peer.f0_hz.size() << " of the same recordings: ratio " << G(c.ratio, 3)
+              << " (largest f0 difference " << G(c.max_diff_sigma, 2) << " bounds)\n";
   else
     std::cout << "; SciPy pipeline not run: " << peer.message << "\n";
   std::cout
@@ -215,6 +225,29 @@ int RunFitBench(const FitBenchArgs& a) {
       << G(r.check_predicted_f0_std_hz) << " Hz, Monte Carlo " << G(r.check_measured_f0_std_hz)
       << " Hz\n"
       << "    mean chi2/dof " << G(r.chi2_per_dof_mean, 3) << "\n";
+}
+
+int RunFitBench(const FitBenchArgs& a) {
+  const Recipe recipe = LoadRecipe(a.recipe);
+  analysis::FitBenchOptions o;
+  if (!MakeOptions(a, recipe, &o)) return 2;
+  analysis::FitBenchResult r;
+  {
+    Progress progress("fit-bench");
+    o.progress = progress.Callback();
+    r = analysis::RunFitBench(o);
+  }
+  if (r.usable_runs < 2) {
+    std::cerr << "eol fit-bench: only " << r.usable_runs << " of " << r.runs
+              << " runs were usable; first failure: " << r.first_failure << std::endl;
+    return 1;
+  }
+  const PeerComparison peer = ComparePeer(a, o, r);
+  if (a.json) {
+    std::cout << ResultJson(a, recipe, o, r, peer).dump() << std::endl;
+    return 0;
+  }
+  PrintReport(a, recipe, o, r, peer);
   return 0;
 }
 
