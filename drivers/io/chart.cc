@@ -371,12 +371,21 @@ void DrawData(Painter& p, const ChartPanel& panel, const PlotArea& area, const A
   cairo_restore(p.cr());
 }
 
-// Line labels beside their lines, inside the frame.
+// Line labels beside their lines, inside the frame; the horizontal lines' labels spread so
+// that none overwrites another.
 void DrawLineLabels(Painter& p, const ChartPanel& panel, const PlotArea& area, const Axis& x,
                     const Axis& y) {
+  std::vector<const ChartLine*> shown;
+  std::vector<double> want;
   for (const ChartLine& l : panel.hlines)
-    if (y.Valid(l.value) && l.value >= y.lo && l.value <= y.hi)
-      p.Text(l.label, area.right - 4.0, y.Map(l.value) - 3.0, kSmallFont, 1.0, l.colour);
+    if (y.Valid(l.value) && l.value >= y.lo && l.value <= y.hi && !l.label.empty()) {
+      shown.push_back(&l);
+      want.push_back(y.Map(l.value) - 3.0);
+    }
+  const std::vector<double> at =
+      SpreadLabels(want, kSmallFont + 2.0, area.top + kSmallFont, area.bottom - 3.0);
+  for (std::size_t i = 0; i < shown.size(); ++i)
+    p.Text(shown[i]->label, area.right - 4.0, at[i], kSmallFont, 1.0, shown[i]->colour);
   double label_y = area.top + NotesHeight(panel) + 15.0;  // one row per vertical line
   for (const ChartLine& l : panel.vlines)
     if (x.Valid(l.value) && l.value >= x.lo && l.value <= x.hi) {
@@ -482,6 +491,26 @@ void ThrowIf(cairo_status_t status, const char* what) {
 }
 
 }  // namespace
+
+std::vector<double> SpreadLabels(const std::vector<double>& desired, double gap, double top,
+                                 double bottom) {
+  std::vector<std::size_t> order(desired.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return desired[a] < desired[b]; });
+  std::vector<double> y(desired.size());
+  double prev = -INFINITY;
+  for (const std::size_t i : order) {  // top to bottom: push down what is too close
+    y[i] = std::max({desired[i], top, prev + gap});
+    prev = y[i];
+  }
+  double next = INFINITY;
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {  // then back up from the bottom
+    y[*it] = std::min({y[*it], bottom, next - gap});
+    next = y[*it];
+  }
+  return y;
+}
 
 ChartBars Histogram(const std::vector<double>& values, double lo, double hi, int bins) {
   if (bins < 1 || !(lo < hi)) throw std::invalid_argument("Histogram: needs bins >= 1 and lo < hi");

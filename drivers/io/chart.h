@@ -94,6 +94,14 @@ struct Chart {
   int panel_height_px = 280;
 };
 
+// Label rows that do not overlap: `desired` are the baselines (pixels, down is +) where labels
+// of one text height would go; returns the baselines moved apart by at least `gap`, in the
+// same order, as little as possible, all within [top, bottom] when they fit (pushed down from
+// the top, then back up from the bottom). The horizontal limit lines' labels are placed so
+// that "UCL 417.8" and "USL 420 Hz" two pixels apart do not overwrite each other.
+std::vector<double> SpreadLabels(const std::vector<double>& desired, double gap, double top,
+                                 double bottom);
+
 // The documents. Throw std::invalid_argument for a chart without panels and
 // std::runtime_error when cairo fails.
 std::string RenderChartSvg(const Chart& chart);

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -58,6 +59,28 @@ TEST(Chart, SvgCarriesTheWordsEscapedAndIsReproducible) {
     EXPECT_NE(svg.find(std::string("\n") + word + "\n"), std::string::npos) << word;
   EXPECT_NE(svg.find("<use"), std::string::npos);  // glyphs drawn
   EXPECT_EQ(svg, RenderChartSvg(Sample()));
+}
+
+// "UCL 417.8" and "USL 420 Hz" 5 px apart (the overlap a quality engineer saw), a third label
+// far away, and a crowd at the bottom edge: the rows keep their order, stay 12 px apart, move
+// as little as needed and stay inside the frame.
+TEST(Chart, LineLabelsNeverOverlap) {
+  const std::vector<double> two = SpreadLabels({100.0, 95.0, 200.0}, 12.0, 20.0, 280.0);
+  ASSERT_EQ(two.size(), 3u);
+  EXPECT_DOUBLE_EQ(two[1], 95.0);   // the upper one stays
+  EXPECT_DOUBLE_EQ(two[0], 107.0);  // the lower one moves down by 7 px
+  EXPECT_DOUBLE_EQ(two[2], 200.0);  // far from both: unmoved
+
+  const std::vector<double> crowd = SpreadLabels({279.0, 278.0, 277.0, 30.0}, 12.0, 20.0, 280.0);
+  EXPECT_DOUBLE_EQ(crowd[0], 280.0);
+  EXPECT_DOUBLE_EQ(crowd[1], 268.0);
+  EXPECT_DOUBLE_EQ(crowd[2], 256.0);
+  EXPECT_DOUBLE_EQ(crowd[3], 30.0);
+  std::vector<double> sorted = crowd;
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t i = 1; i < sorted.size(); ++i) EXPECT_GE(sorted[i] - sorted[i - 1], 12.0);
+  EXPECT_DOUBLE_EQ(SpreadLabels({5.0}, 12.0, 20.0, 280.0)[0], 20.0);  // kept inside the frame
+  EXPECT_TRUE(SpreadLabels({}, 12.0, 20.0, 280.0).empty());
 }
 
 TEST(Chart, PngAndErrors) {
