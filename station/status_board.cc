@@ -57,6 +57,10 @@ void StatusBoard::OnVerdict(const db::TestRecord& record) {
       break;
   }
   PushEventLocked({{"type", "verdict"}, {"record", last_}});
+  if (!message_.empty()) {
+    message_.clear();
+    PushEventLocked({{"type", "message"}, {"message", ""}});
+  }
 }
 
 void StatusBoard::SetRecipe(const std::string& recipe_id, const std::string& recipe_hash) {
@@ -78,13 +82,43 @@ void StatusBoard::SetSimulation(const std::string& why) {
   simulation_ = why;
 }
 
-void StatusBoard::SetReadiness(bool ready, const std::string& why) {
+void StatusBoard::SetCause(NotReadyCause cause, const std::string& detail) {
   std::lock_guard<std::mutex> lock(mu_);
-  if (ready == ready_ && why == not_ready_reason_) return;
-  ready_ = ready;
-  not_ready_reason_ = ready ? "" : why;
-  PushEventLocked(
-      {{"type", "readiness"}, {"ready", ready_}, {"not_ready_reason", not_ready_reason_}});
+  const auto it = causes_.find(cause);
+  if (it != causes_.end() && it->second == detail) return;
+  causes_[cause] = detail;
+  nlohmann::json event = ReadinessLocked();
+  event["type"] = "readiness";
+  PushEventLocked(std::move(event));
+}
+
+void StatusBoard::ClearCause(NotReadyCause cause) {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (causes_.erase(cause) == 0) return;
+  nlohmann::json event = ReadinessLocked();
+  event["type"] = "readiness";
+  PushEventLocked(std::move(event));
+}
+
+bool StatusBoard::HasCause(NotReadyCause cause) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return causes_.count(cause) > 0;
+}
+
+nlohmann::json StatusBoard::ReadinessLocked() const {
+  std::string reason;
+  nlohmann::json all = nlohmann::json::array();
+  for (const auto& [cause, detail] : causes_) {
+    reason += (reason.empty() ? "" : "; ") + detail;
+    all.push_back(
+        {{"code", Code(cause)}, {"reason", detail}, {"operator_text", OperatorText(cause)}});
+  }
+  const bool ready = causes_.empty();
+  return {{"ready", ready},
+          {"not_ready_reason", reason},
+          {"not_ready_code", ready ? "" : Code(causes_.begin()->first)},
+          {"not_ready_text", ready ? "" : OperatorText(causes_.begin()->first)},
+          {"not_ready", all}};
 }
 
 void StatusBoard::SetLockout(const nlohmann::json& lockout) {
@@ -96,19 +130,20 @@ void StatusBoard::SetLockout(const nlohmann::json& lockout) {
 
 nlohmann::json StatusBoard::Snapshot() const {
   std::lock_guard<std::mutex> lock(mu_);
-  return {{"station_id", station_id_},
-          {"state", state_ ? ToString(*state_) : "idle"},
-          {"serial", serial_},
-          {"detail", detail_},
-          {"message", message_},
-          {"ready", ready_},
-          {"not_ready_reason", not_ready_reason_},
-          {"simulation", simulation_},
-          {"recipe", {{"id", recipe_id_}, {"hash", recipe_hash_}}},
-          {"counts", {{"pass", pass_}, {"fail", fail_}, {"error", error_}, {"aborted", aborted_}}},
-          {"last", last_},
-          {"recent", recent_},
-          {"lockout", lockout_}};
+  nlohmann::json s = ReadinessLocked();
+  s.update(
+      {{"station_id", station_id_},
+       {"state", state_ ? ToString(*state_) : "idle"},
+       {"serial", serial_},
+       {"detail", detail_},
+       {"message", message_},
+       {"simulation", simulation_},
+       {"recipe", {{"id", recipe_id_}, {"hash", recipe_hash_}}},
+       {"counts", {{"pass", pass_}, {"fail", fail_}, {"error", error_}, {"aborted", aborted_}}},
+       {"last", last_},
+       {"recent", recent_},
+       {"lockout", lockout_}});
+  return s;
 }
 
 std::vector<std::pair<std::uint64_t, nlohmann::json>> StatusBoard::EventsAfter(

@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "db/test_record.h"
+#include "station/health.h"
 
 namespace eol::station {
 
@@ -32,20 +34,27 @@ class StatusBoard {
   void OnVerdict(const db::TestRecord& record);
   // The recipe changed (between tests).
   void SetRecipe(const std::string& recipe_id, const std::string& recipe_hash);
-  // Free text for the operator ("locked out: ...", "fixture not answering").
+  // Free text for the operator ("store write failed: ..."). The next verdict clears it:
+  // a message is about the station's last moments, not about the unit tested after.
   void SetMessage(const std::string& message);
   // Simulators or recorded data instead of the fixture and the DAQ: the page shows
   // SIMULATION and every record says so (conditions.simulation). Set once at start.
   void SetSimulation(const std::string& why);
-  // Ready: the fixture and the DAQ answered (at start or at the latest test). `why` names
-  // what did not answer.
-  void SetReadiness(bool ready, const std::string& why);
+  // Readiness (station/health.h): ready while no cause is raised. SetCause raises one (or
+  // updates its detail, the technical text); ClearCause lowers it. Each change is a
+  // "readiness" event.
+  void SetCause(NotReadyCause cause, const std::string& detail);
+  void ClearCause(NotReadyCause cause);
+  bool HasCause(NotReadyCause cause) const;
   // The self-check lockout (station/self_check.h LockoutState::ToJson): {"locked", "reason",
   // "good", "limit", "tests_since_check"}; null while self-checks are off.
   void SetLockout(const nlohmann::json& lockout);
 
-  // {"station_id", "state", "serial", "detail", "message", "ready", "not_ready_reason",
-  //  "simulation": "" | "<why>", "recipe": {...}, "counts": {...},
+  // {"station_id", "state", "serial", "detail", "message",
+  //  "ready", "not_ready_reason" (every raised cause's detail, "; "-joined, "" when ready),
+  //  "not_ready_code" (the first raised cause's code, "" when ready), "not_ready_text" (its
+  //  operator text), "not_ready": [{code, reason, operator_text}] (every raised cause, by
+  //  priority), "simulation": "" | "<why>", "recipe": {...}, "counts": {...},
   //  "last": {serial, outcome, reasons [{code, text}], measurements, finished_at, id,
   //           kind: "production" | "self_check"} | null,
   //  "recent": [...], "lockout": {...} | null}
@@ -59,6 +68,7 @@ class StatusBoard {
 
  private:
   void PushEventLocked(nlohmann::json event);
+  nlohmann::json ReadinessLocked() const;
 
   const std::string station_id_;
   std::string recipe_id_;
@@ -70,8 +80,9 @@ class StatusBoard {
   std::string detail_;
   std::string message_;
   std::string simulation_;  // empty: real fixture and DAQ
-  bool ready_ = false;
-  std::string not_ready_reason_ = "drivers not connected yet";
+  // The raised causes and their details, by priority; ready when empty.
+  std::map<NotReadyCause, std::string> causes_ = {
+      {NotReadyCause::kDriversNotConnected, "drivers not connected yet"}};
   nlohmann::json last_;     // null until the first verdict
   nlohmann::json lockout_;  // null while self-checks are off
   std::deque<nlohmann::json> recent_;

@@ -27,9 +27,11 @@ void GetEvents(ApiContext& c, const httplib::Request&, httplib::Response& res) {
   res.set_header("Cache-Control", "no-cache");
   res.set_chunked_content_provider(
       "text/event-stream", [&c, last](std::size_t, httplib::DataSink& sink) {
-        const auto events = c.board.EventsAfter(*last, std::chrono::milliseconds(1000));
+        // A quiet half second is a "ping" event: the page calls the station offline when
+        // nothing at all arrived for 1.5 s (station/web/app.js), and a proxy keeps the stream.
+        const auto events = c.board.EventsAfter(*last, std::chrono::milliseconds(500));
         if (events.empty()) {
-          const std::string ping = ": keep-alive\n\n";
+          const std::string ping = "event: ping\ndata: {}\n\n";
           return sink.write(ping.data(), ping.size());
         }
         for (const auto& [seq, e] : events) {

@@ -386,11 +386,46 @@ function renderSimulation(why) {
   b.textContent = why ? "SIMULATION: " + why + ", not production results" : "";
 }
 
-// Ready: the fixture and the DAQ answered.
-function renderReadiness(ready, why) {
+// Readiness (station/health.h): what the operator does in large type, the technical reason
+// under it, the cause's code in data-code. `r` is /api/status or a "readiness" event.
+function renderReadiness(r) {
   const b = $("not-ready");
-  b.hidden = ready !== false;
-  b.textContent = b.hidden ? "" : "NOT READY: " + why;
+  b.hidden = r.ready !== false;
+  b.dataset.code = b.hidden ? "" : r.not_ready_code || "";
+  if (b.hidden) {
+    b.replaceChildren();
+    return;
+  }
+  b.replaceChildren(el("span", {class: "what"}, "NOT READY: " + (r.not_ready_text || r.not_ready_reason)),
+                    el("span", {class: "why"}, r.not_ready_reason || ""));
+}
+
+// --- The link to the station: offline within 2 s of losing it. ---
+// The event stream sends something at least every 0.5 s (a "ping" when nothing happens);
+// nothing for OFFLINE_AFTER_MS, or the stream failing, is a lost station: the verdict is
+// greyed (it may be old) and Start is disabled until the stream is back.
+const OFFLINE_AFTER_MS = 1500;
+let lastHeard = 0, offline = true;
+
+function setOffline(now) {
+  if (now === offline) return;
+  offline = now;
+  const c = $("connection");
+  c.textContent = now ? "station offline" : "live";
+  c.className = now ? "offline" : "online";
+  document.body.classList.toggle("offline", now);
+  $("offline").hidden = !now;
+  $("start").disabled = now;
+  if (!now) refreshStatus().catch(() => {});  // what happened while the link was down
+}
+
+function heard() {
+  lastHeard = performance.now();
+  setOffline(false);
+}
+
+function watchLink() {
+  setInterval(() => { if (performance.now() - lastHeard > OFFLINE_AFTER_MS) setOffline(true); }, 250);
 }
 
 // Events of each kind received over the stream. A status fetched while an event of a kind
@@ -408,7 +443,7 @@ async function refreshStatus() {
   const fresh = (...kinds) => kinds.every(k => (eventsSeen[k] || 0) === (before[k] || 0));
   if (fresh("lockout")) renderLockout(s.lockout);
   renderSimulation(s.simulation);
-  if (fresh("readiness")) renderReadiness(s.ready, s.not_ready_reason);
+  if (fresh("readiness")) renderReadiness(s);
   $("station").textContent = "EOL station " + s.station_id;
   if (fresh("message")) $("message").textContent = s.message || "";
   renderHistory(s);
@@ -514,6 +549,10 @@ function setupStart() {
     $("scan").value = "";
     $("scan").focus();
     if (!serial) return;
+    if (offline) {
+      startStatus(serial + " not started: station offline", true);
+      return;
+    }
     saveWork();
     startStatus(serial + " sent…");
     startTest(serial);
@@ -528,30 +567,32 @@ async function main() {
   const source = new EventSource("/api/events");
   const events = {
     addEventListener(kind, handle) {
-      source.addEventListener(kind, ev => { eventsSeen[kind] = (eventsSeen[kind] || 0) + 1; handle(ev); });
+      source.addEventListener(kind, ev => {
+        heard();
+        eventsSeen[kind] = (eventsSeen[kind] || 0) + 1;
+        handle(ev);
+      });
     },
   };
-  source.onopen = () => {
-    $("connection").textContent = "live";
-    $("connection").className = "online";
-    refreshStatus().catch(() => {});  // what happened while the stream was down
-  };
-  source.onerror = () => { $("connection").textContent = "reconnecting…"; $("connection").className = "offline"; };
+  source.onopen = heard;
+  source.onerror = () => setOffline(true);
+  watchLink();
+  events.addEventListener("ping", () => {});
   events.addEventListener("state", ev => {
     const e = JSON.parse(ev.data);
     renderStates(e.state);
     if (e.state === "check_interlocks") showRunning(e.serial);
   });
   events.addEventListener("verdict", ev => {
+    // A new verdict: what was said about the station before it is old news.
+    $("message").textContent = "";
+    if ($("start-status").className === "problem") startStatus("");
     showResult(JSON.parse(ev.data).record);
     refreshStatus().catch(() => {});
   });
   events.addEventListener("recipe", () => { loadRecipe(); });
   events.addEventListener("lockout", ev => { renderLockout(JSON.parse(ev.data).lockout); });
-  events.addEventListener("readiness", ev => {
-    const e = JSON.parse(ev.data);
-    renderReadiness(e.ready, e.not_ready_reason);
-  });
+  events.addEventListener("readiness", ev => renderReadiness(JSON.parse(ev.data)));
   events.addEventListener("message", ev => { $("message").textContent = JSON.parse(ev.data).message; });
 }
 
