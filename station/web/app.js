@@ -541,18 +541,25 @@ async function startTest(serial) {
   }
 }
 
+// Offline, Start is disabled and the form cannot submit: a scanner's Enter is answered here,
+// and its serial does not stay in the field to be glued to the next scan.
+function refuseScanWhileOffline(e) {
+  if (e.key !== "Enter" || !offline) return;
+  e.preventDefault();
+  const serial = $("scan").value.trim();
+  $("scan").value = "";
+  if (serial) startStatus(serial + " not started: station offline", true);
+}
+
 function setupStart() {
   loadWork();
+  $("scan").addEventListener("keydown", refuseScanWhileOffline);
   $("start-form").addEventListener("submit", e => {
     e.preventDefault();
     const serial = $("scan").value.trim();
     $("scan").value = "";
     $("scan").focus();
     if (!serial) return;
-    if (offline) {
-      startStatus(serial + " not started: station offline", true);
-      return;
-    }
     saveWork();
     startStatus(serial + " sent…");
     startTest(serial);
@@ -560,40 +567,50 @@ function setupStart() {
   keepScanFocus();
 }
 
+// What each kind of event does, with its parsed data.
+const HANDLERS = {
+  ping: () => {},
+  state: e => {
+    renderStates(e.state);
+    if (e.state === "check_interlocks") showRunning(e.serial);
+  },
+  verdict: e => {
+    // A new verdict: what was said about the station before it is old news.
+    $("message").textContent = "";
+    if ($("start-status").className === "problem") startStatus("");
+    showResult(e.record);
+    refreshStatus().catch(() => {});
+  },
+  recipe: () => { loadRecipe(); },
+  lockout: e => renderLockout(e.lockout),
+  readiness: e => renderReadiness(e),
+  message: e => { $("message").textContent = e.message; },
+};
+
+// The event stream. The browser reconnects a lost one by itself (every second: the station
+// sends "retry: 1000"); one it gave up on (an HTTP error answered) is opened anew.
+function openStream() {
+  const source = new EventSource("/api/events");
+  for (const [kind, handle] of Object.entries(HANDLERS)) {
+    source.addEventListener(kind, ev => {
+      heard();
+      eventsSeen[kind] = (eventsSeen[kind] || 0) + 1;
+      handle(JSON.parse(ev.data));
+    });
+  }
+  source.onopen = heard;
+  source.onerror = () => {
+    setOffline(true);
+    if (source.readyState === EventSource.CLOSED) setTimeout(openStream, 1000);
+  };
+}
+
 async function main() {
   setupStart();
   await loadRecipe();
   await refreshStatus().catch(e => { $("message").textContent = e.message; });
-  const source = new EventSource("/api/events");
-  const events = {
-    addEventListener(kind, handle) {
-      source.addEventListener(kind, ev => {
-        heard();
-        eventsSeen[kind] = (eventsSeen[kind] || 0) + 1;
-        handle(ev);
-      });
-    },
-  };
-  source.onopen = heard;
-  source.onerror = () => setOffline(true);
+  openStream();
   watchLink();
-  events.addEventListener("ping", () => {});
-  events.addEventListener("state", ev => {
-    const e = JSON.parse(ev.data);
-    renderStates(e.state);
-    if (e.state === "check_interlocks") showRunning(e.serial);
-  });
-  events.addEventListener("verdict", ev => {
-    // A new verdict: what was said about the station before it is old news.
-    $("message").textContent = "";
-    if ($("start-status").className === "problem") startStatus("");
-    showResult(JSON.parse(ev.data).record);
-    refreshStatus().catch(() => {});
-  });
-  events.addEventListener("recipe", () => { loadRecipe(); });
-  events.addEventListener("lockout", ev => { renderLockout(JSON.parse(ev.data).lockout); });
-  events.addEventListener("readiness", ev => renderReadiness(JSON.parse(ev.data)));
-  events.addEventListener("message", ev => { $("message").textContent = JSON.parse(ev.data).message; });
 }
 
 main();
