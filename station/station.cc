@@ -82,6 +82,7 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
     board_->SetMessage(lost);
     board_->SetCause(NotReadyCause::kStoreLostVerdicts, lost);
   }
+  RestoreBoard();
   probe_ = std::make_unique<FixtureProbe>(
       *drivers_.fixture,
       std::chrono::milliseconds(std::lround(config_.safety.heartbeat_timeout_ms)));
@@ -118,6 +119,24 @@ void Station::ConnectDrivers() {
                      "acquisition unavailable: " + s.message());
   }
   board_->ClearCause(NotReadyCause::kDriversNotConnected);  // tried: their own causes stand
+}
+
+// Shift continuity (issue 36): "Last results" and the day's counts as the store holds them,
+// so that a restart shows what the shift did so far.
+void Station::RestoreBoard() {
+  const auto now = std::chrono::system_clock::now();
+  db::TestQuery day;
+  day.from = db::UtcIso8601(LocalMidnight(now));
+  day.limit = 1000;
+  VerdictCounts counts;
+  for (std::vector<db::TestRecord> page = store_->Tests(day); !page.empty();
+       page = store_->Tests(day)) {
+    for (const db::TestRecord& r : page) counts.Add(r.outcome);
+    day.after = {page.back().started_at, page.back().id};
+  }
+  db::TestQuery recent;
+  recent.limit = 20;
+  board_->Restore(store_->Tests(recent), counts, LocalDay(now));
 }
 
 Station::~Station() {

@@ -118,6 +118,7 @@ class Station {
 
   void ServeQueue();
   void ConnectDrivers();
+  void RestoreBoard();
   // The idle look (station/health.h); Serve calls it every health.period_ms.
   void LookAtDrivers();
   // Held by a test and by an idle look: never both at once.

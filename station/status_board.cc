@@ -1,5 +1,7 @@
 #include "station/status_board.h"
 
+#include <ctime>
+
 #include "station/sequencer.h"  // ToString(SeqState)
 
 namespace eol::station {
@@ -15,6 +17,41 @@ nlohmann::json RecordSummary(const db::TestRecord& r) {
       {"finished_at", r.finished_at},
       {"kind", r.kind},  // a master part's self-check is no production unit
       {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}}};
+}
+
+void VerdictCounts::Add(analysis::Outcome outcome) {
+  switch (outcome) {
+    case analysis::Outcome::kPass:
+      ++pass;
+      break;
+    case analysis::Outcome::kFail:
+      ++fail;
+      break;
+    case analysis::Outcome::kError:
+      ++error;
+      break;
+    case analysis::Outcome::kAborted:
+      ++aborted;
+      break;
+  }
+}
+
+std::string LocalDay(std::chrono::system_clock::time_point t) {
+  const std::time_t tt = std::chrono::system_clock::to_time_t(t);
+  std::tm local{};
+  localtime_r(&tt, &local);
+  char day[16];
+  std::strftime(day, sizeof day, "%Y-%m-%d", &local);
+  return day;
+}
+
+std::chrono::system_clock::time_point LocalMidnight(std::chrono::system_clock::time_point t) {
+  const std::time_t tt = std::chrono::system_clock::to_time_t(t);
+  std::tm local{};
+  localtime_r(&tt, &local);
+  local.tm_hour = local.tm_min = local.tm_sec = 0;
+  local.tm_isdst = -1;  // whatever holds at midnight
+  return std::chrono::system_clock::from_time_t(std::mktime(&local));
 }
 
 StatusBoard::StatusBoard(std::string station_id, std::string recipe_id, std::string recipe_hash)
@@ -42,25 +79,27 @@ void StatusBoard::OnVerdict(const db::TestRecord& record) {
   last_ = RecordSummary(record);
   recent_.push_front(last_);
   while (recent_.size() > 20) recent_.pop_back();
-  switch (record.outcome) {
-    case analysis::Outcome::kPass:
-      ++pass_;
-      break;
-    case analysis::Outcome::kFail:
-      ++fail_;
-      break;
-    case analysis::Outcome::kError:
-      ++error_;
-      break;
-    case analysis::Outcome::kAborted:
-      ++aborted_;
-      break;
-  }
+  const std::string today = LocalDay(std::chrono::system_clock::now());
+  if (today != day_) counts_ = VerdictCounts{};
+  day_ = today;
+  counts_.Add(record.outcome);
   PushEventLocked({{"type", "verdict"}, {"record", last_}});
   if (!message_.empty()) {
     message_.clear();
     PushEventLocked({{"type", "message"}, {"message", ""}});
   }
+}
+
+void StatusBoard::Restore(const std::vector<db::TestRecord>& newest_first, VerdictCounts counts,
+                          std::string day) {
+  std::lock_guard<std::mutex> lock(mu_);
+  recent_.clear();
+  for (const db::TestRecord& r : newest_first) {
+    if (recent_.size() == 20) break;
+    recent_.push_back(RecordSummary(r));
+  }
+  counts_ = counts;
+  day_ = std::move(day);
 }
 
 void StatusBoard::SetRecipe(const std::string& recipe_id, const std::string& recipe_hash) {
@@ -131,18 +170,22 @@ void StatusBoard::SetLockout(const nlohmann::json& lockout) {
 nlohmann::json StatusBoard::Snapshot() const {
   std::lock_guard<std::mutex> lock(mu_);
   nlohmann::json s = ReadinessLocked();
-  s.update(
-      {{"station_id", station_id_},
-       {"state", state_ ? ToString(*state_) : "idle"},
-       {"serial", serial_},
-       {"detail", detail_},
-       {"message", message_},
-       {"simulation", simulation_},
-       {"recipe", {{"id", recipe_id_}, {"hash", recipe_hash_}}},
-       {"counts", {{"pass", pass_}, {"fail", fail_}, {"error", error_}, {"aborted", aborted_}}},
-       {"last", last_},
-       {"recent", recent_},
-       {"lockout", lockout_}});
+  s.update({{"station_id", station_id_},
+            {"state", state_ ? ToString(*state_) : "idle"},
+            {"serial", serial_},
+            {"detail", detail_},
+            {"message", message_},
+            {"simulation", simulation_},
+            {"recipe", {{"id", recipe_id_}, {"hash", recipe_hash_}}},
+            {"counts",
+             {{"pass", counts_.pass},
+              {"fail", counts_.fail},
+              {"error", counts_.error},
+              {"aborted", counts_.aborted},
+              {"day", day_}}},
+            {"last", last_},
+            {"recent", recent_},
+            {"lockout", lockout_}});
   return s;
 }
 

@@ -23,6 +23,16 @@ namespace eol::station {
 // and /metrics read those strings), or "idle" before the first test.
 enum class SeqState;
 
+// The board's counts of verdicts: of one day, station local time.
+struct VerdictCounts {
+  std::uint64_t pass = 0, fail = 0, error = 0, aborted = 0;
+  void Add(analysis::Outcome outcome);
+};
+
+// "YYYY-MM-DD" of `t` in the station's local time, and that day's first instant.
+std::string LocalDay(std::chrono::system_clock::time_point t);
+std::chrono::system_clock::time_point LocalMidnight(std::chrono::system_clock::time_point t);
+
 class StatusBoard {
  public:
   explicit StatusBoard(std::string station_id, std::string recipe_id = "",
@@ -30,8 +40,14 @@ class StatusBoard {
 
   // A sequencer state was entered.
   void OnState(const std::string& serial, SeqState state, const std::string& detail);
-  // A finished, stored record.
+  // A finished, stored record. The counts start again on a new local day.
   void OnVerdict(const db::TestRecord& record);
+  // Shift continuity (issue 36), at start before any verdict: the newest stored tests
+  // (newest first; the last 20 are kept, as OnVerdict keeps them) and the counts of `day`
+  // (LocalDay) so far, as the store holds them. The lamp ("last") stays empty: no unit was
+  // tested since the start.
+  void Restore(const std::vector<db::TestRecord>& newest_first, VerdictCounts counts,
+               std::string day);
   // The recipe changed (between tests).
   void SetRecipe(const std::string& recipe_id, const std::string& recipe_hash);
   // Free text for the operator ("store write failed: ..."). The next verdict clears it:
@@ -54,7 +70,9 @@ class StatusBoard {
   //  "ready", "not_ready_reason" (every raised cause's detail, "; "-joined, "" when ready),
   //  "not_ready_code" (the first raised cause's code, "" when ready), "not_ready_text" (its
   //  operator text), "not_ready": [{code, reason, operator_text}] (every raised cause, by
-  //  priority), "simulation": "" | "<why>", "recipe": {...}, "counts": {...},
+  //  priority), "simulation": "" | "<why>", "recipe": {...},
+  //  "counts": {"pass", "fail", "error", "aborted", "day"} (the local day's verdicts, stored
+  //  ones rebuilt from the store at start),
   //  "last": {serial, outcome, reasons [{code, text}], measurements, finished_at, id,
   //           kind: "production" | "self_check"} | null,
   //  "recent": [...], "lockout": {...} | null}
@@ -86,7 +104,8 @@ class StatusBoard {
   nlohmann::json last_;     // null until the first verdict
   nlohmann::json lockout_;  // null while self-checks are off
   std::deque<nlohmann::json> recent_;
-  std::uint64_t pass_ = 0, fail_ = 0, error_ = 0, aborted_ = 0;
+  VerdictCounts counts_;
+  std::string day_;  // LocalDay of the counts; "" until the first verdict or Restore
   std::deque<std::pair<std::uint64_t, nlohmann::json>> events_;
   std::uint64_t next_event_ = 1;
 };

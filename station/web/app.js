@@ -137,7 +137,7 @@ function renderHistory(status) {
     t.appendChild(row);
   }
   const c = status.counts || {};
-  $("counts").textContent = `PASS ${c.pass || 0} · FAIL ${c.fail || 0} · ERROR ${c.error || 0}` +
+  $("counts").textContent = (c.day ? "Today: " : "") + `PASS ${c.pass || 0} · FAIL ${c.fail || 0} · ERROR ${c.error || 0}` +
       ` · ABORTED ${c.aborted || 0}`;
 }
 
@@ -504,10 +504,36 @@ function loadWork() {
   $("token-row").hidden = !$("token").value;
 }
 
+// When the shown refusal was made, and when the latest test began (page time, ms): a verdict
+// clears only a refusal made before its test began (a serial refused while that test ran must
+// still be scanned again).
+let problemAt = -1, testBeganAt = -1;
+
 function startStatus(text, problem) {
   const s = $("start-status");
   s.textContent = text;
   s.className = problem ? "problem" : "";
+  if (problem) {
+    problemAt = performance.now();
+    refusalCue();
+  }
+}
+
+// A short low tone for a scan that did not start a test (made in the page: no sound file,
+// nothing loaded). Counted in body[data-cues] for the tests.
+function refusalCue() {
+  document.body.dataset.cues = Number(document.body.dataset.cues || 0) + 1;
+  try {
+    const ctx = refusalCue.ctx || (refusalCue.ctx = new AudioContext());
+    const tone = ctx.createOscillator(), gain = ctx.createGain();
+    tone.frequency.value = 330;
+    gain.gain.value = 0.25;
+    tone.connect(gain).connect(ctx.destination);
+    tone.start();
+    tone.stop(ctx.currentTime + 0.35);
+  } catch (e) {
+    // no audio device: the red text stands alone
+  }
 }
 
 // POST /api/tests as any client does: no token while the station has none configured (the
@@ -572,12 +598,15 @@ const HANDLERS = {
   ping: () => {},
   state: e => {
     renderStates(e.state);
-    if (e.state === "check_interlocks") showRunning(e.serial);
+    if (e.state === "check_interlocks" && e.detail === "") {
+      testBeganAt = performance.now();
+      showRunning(e.serial);
+    }
   },
   verdict: e => {
-    // A new verdict: what was said about the station before it is old news.
+    // A new verdict: what was said about the station before its test began is old news.
     $("message").textContent = "";
-    if ($("start-status").className === "problem") startStatus("");
+    if ($("start-status").className === "problem" && problemAt < testBeganAt) startStatus("");
     showResult(e.record);
     refreshStatus().catch(() => {});
   },

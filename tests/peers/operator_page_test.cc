@@ -570,6 +570,12 @@ TEST(OperatorPage, FollowsTheFixtureControllerAndShowsALostStationWithin2s) {
   EXPECT_EQ(lost["connection"], "live");
   EXPECT_LE(j["fixture_back"]["ms"].get<int>(), 1500) << j["fixture_back"];
   EXPECT_TRUE(j["fixture_back"]["not_ready"].is_null()) << j["fixture_back"];
+  // A scan while HEALTH-2 ran: refused with the reason and a cue, still shown after HEALTH-2's
+  // verdict (that serial was not tested).
+  EXPECT_EQ(j["busy"]["start_status"],
+            "HEALTH-2-B not started: busy: a test is running or waiting");
+  EXPECT_EQ(j["busy"]["cues"], 1);
+  EXPECT_TRUE(j["after_second"]["start_status_problem"].get<bool>()) << j["after_second"];
   // No stale driver text under the next verdict.
   const std::string text = j["after_second"]["page_text"];
   for (const char* stale : {"Connection refused", "fixture unavailable", "NOT READY"})
@@ -589,6 +595,14 @@ TEST(OperatorPage, FollowsTheFixtureControllerAndShowsALostStationWithin2s) {
   EXPECT_EQ(j["back"]["connection"], "live");
   EXPECT_FALSE(j["back"]["start_disabled"].get<bool>());
   EXPECT_TRUE(j["back"]["start_status_problem"].get<bool>()) << j["back"];
+  // Shift continuity: the restarted daemon's "Last results" and counts come from the store.
+  EXPECT_EQ(j["back"]["history"], (nlohmann::json{"HEALTH-2", "HEALTH-1"})) << j["back"];
+  std::smatch counts;
+  const std::string counts_text = j["back"]["counts"];
+  ASSERT_TRUE(std::regex_search(counts_text, counts,
+                                std::regex("^Today: PASS ([0-9]+) · FAIL ([0-9]+) · ERROR 0")))
+      << counts_text;
+  EXPECT_EQ(std::stoi(counts[1]) + std::stoi(counts[2]), 2) << counts_text;
   EXPECT_EQ(j["after_third"]["start_status"], "");
   EXPECT_FALSE(j["after_third"]["start_status_problem"].get<bool>());
   EXPECT_EQ(j["after_third"]["message"], "");

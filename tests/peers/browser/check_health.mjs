@@ -74,7 +74,24 @@ await runCheck(out, async browser => {
   acted = await step("start_fixture");
   await page.waitForFunction(() => document.getElementById("not-ready").hidden, null, POLL);
   out.fixture_back = { ms: Date.now() - acted, ...(await page.evaluate(linkState)) };
-  out.second = await scan(page, serial2);
+  // A scan while a test runs is refused (the station tests one unit at a time), visibly and
+  // audibly, and that refusal outlives the running test's verdict: the unit was not tested.
+  const cues = () => page.evaluate(() => Number(document.body.dataset.cues || 0));
+  const cuesBefore = await cues();
+  await page.keyboard.type(serial2);
+  await page.keyboard.press("Enter");
+  await page.waitForFunction(s => document.getElementById("serial").textContent === s &&
+      document.getElementById("verdict").classList.contains("RUNNING"), serial2, POLL);
+  await page.keyboard.type(serial2 + "-B");
+  await page.keyboard.press("Enter");
+  await page.waitForFunction(() => document.getElementById("start-status").className === "problem", null, POLL);
+  out.busy = { cues: (await cues()) - cuesBefore, ...(await page.evaluate(linkState)) };
+  await page.waitForFunction(s => document.getElementById("serial").textContent === s &&
+      /PASS|FAIL|ERROR|ABORTED/.test(document.getElementById("verdict").className), serial2,
+      { polling: 50, timeout: 60000 });
+  await page.waitForFunction(s => document.getElementById("plot").dataset.serial === s, serial2,
+                             { polling: 50, timeout: 20000 });
+  out.second = await page.textContent("#verdict");
   out.after_second = { page_text: await page.evaluate(() => document.body.innerText),
                        ...(await page.evaluate(linkState)) };
 
