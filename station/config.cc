@@ -137,6 +137,12 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
                  "safe_state_retry_s", "must be in [0, 60] s");
       s->RejectUnknown();
     }
+    if (auto h = root.OptionalObject("health")) {
+      c.health.period_ms = h->Number("period_ms", c.health.period_ms);
+      h->Require(c.health.period_ms >= 50 && c.health.period_ms <= 10000, "period_ms",
+                 "must be in [50, 10000] ms");
+      h->RejectUnknown();
+    }
     c.serial_from_stdin = root.Bool("serial_from_stdin", false);
     c.publish_before_release = root.Bool("publish_before_release", false);
     if (auto sc = root.OptionalObject("self_check")) {

@@ -18,6 +18,10 @@
 //   "sim": {...},                                    the simulated bench, when a driver is sim
 //   "safety": {"watchdog_period_ms": 5, "heartbeat_timeout_ms": 1500, "poll_period_ms": 10,
 //              "safe_state_retry_s": 3, "watchdog_reaction_ms": 0, "alive_period_ms": 50},
+//   "health": {"period_ms": 500},                  the idle look at the fixture controller and
+//                                                    the DAQ while no test runs (station/health.h):
+//                                                    "ready" follows a loss or a return within
+//                                                    one period (plus one failed read)
 //   "serial_from_stdin": false,                      a scanner typing serials into stdin
 //                                                    (its line format: station/test_request.h)
 //   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
@@ -69,6 +73,11 @@ struct SafetyOptions {
   double alive_period_ms = 50.0;
 };
 
+// The station's live health (station/health.h).
+struct HealthOptions {
+  double period_ms = 500.0;  // idle look at the fixture controller and the DAQ; 50..10000
+};
+
 // What a token may do. Operators start tests; engineers also change and teach recipes.
 // Ordered: a higher role may do everything a lower one may.
 enum class Role { kOperator, kEngineer };
@@ -108,6 +117,7 @@ struct StationConfig {
   // Host header values the API answers besides the listen address and loopback names.
   std::vector<std::string> http_hosts;
   SafetyOptions safety;
+  HealthOptions health;
   bool serial_from_stdin = false;
   // Store and publish the verdict while the clamp opens (SequencerOptions, station/sequencer.h).
   bool publish_before_release = false;

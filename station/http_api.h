@@ -1,7 +1,10 @@
 // The station's HTTP/JSON API (cpp-httplib), default 127.0.0.1:8080.
 //
-//   GET  /api/status            live state, current serial, last result, counts
-//   GET  /api/events            server-sent events: state changes and verdicts
+//   GET  /api/status            live state, current serial, last result, counts, readiness
+//                               (ready, not_ready_code, not_ready_text, not_ready_reason,
+//                               not_ready: station/status_board.h, station/health.h)
+//   GET  /api/events            server-sent events: state changes, verdicts, readiness,
+//                               messages; a "ping" after 0.5 s without one
 //   GET  /api/units/{serial}    every test of that serial, newest first (no curves)
 //   GET  /api/tests/{id}        one test with its curves
 //   GET  /api/tests?from=&to=&outcome=&serial=&limit=   tests in a time range ("verdict=",

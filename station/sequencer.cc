@@ -154,13 +154,14 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
   if (fixture_.lifecycle() != drivers::Lifecycle::kInactive &&
       fixture_.lifecycle() != drivers::Lifecycle::kActive) {
     if (const drivers::Status s = fixture_.Connect(); !s.ok()) {
-      board_.SetReadiness(false, "fixture unavailable: " + s.message());
+      board_.SetCause(NotReadyCause::kFixtureUnreachable, "fixture unavailable: " + s.message());
       throw Fault{Outcome::kError, {ReasonCode::kFixture, "fixture unavailable: " + s.message()}};
     }
   }
   if (daq_.lifecycle() != drivers::Lifecycle::kInactive) {
     if (const drivers::Status s = daq_.Connect(); !s.ok()) {
-      board_.SetReadiness(false, "acquisition unavailable: " + s.message());
+      board_.SetCause(NotReadyCause::kAcquisitionUnavailable,
+                      "acquisition unavailable: " + s.message());
       throw Fault{Outcome::kError,
                   {ReasonCode::kAcquisition, "acquisition unavailable: " + s.message()}};
     }
@@ -170,7 +171,11 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
   // counts.
   (void)ReadInputs("check interlocks");
   const drivers::FixtureInputs in = ReadInputs("check interlocks");
-  board_.SetReadiness(true, "");
+  // Both drivers answered: their causes are gone (the idle look watches the rest).
+  for (NotReadyCause c :
+       {NotReadyCause::kFixtureUnreachable, NotReadyCause::kAcquisitionUnavailable,
+        NotReadyCause::kDriversNotConnected})
+    board_.ClearCause(c);
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
     throw Fault{Outcome::kError,
                 {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, Clock::now())}};
@@ -477,7 +482,7 @@ void Sequencer::ConfirmRelease(db::TestRecord& record) {
                    " stands): free the part and check the clamp; tests resume when the clamp "
                    "reads released";
   spdlog::error("[{}] {}", record.serial, release_fault_);
-  board_.SetReadiness(false, release_fault_);
+  board_.SetCause(NotReadyCause::kClampNotReleased, release_fault_);
 }
 
 void Sequencer::PublishRefusal(db::TestRecord& record) {
@@ -492,11 +497,12 @@ bool Sequencer::RefusedForReleaseFault(db::TestRecord& record) {
   if (auto in = fixture_.ReadInputs(); in.ok() && in.value().released) {
     spdlog::warn("clamp reads released again: {} cleared", release_fault_);
     release_fault_.clear();
+    board_.ClearCause(NotReadyCause::kClampNotReleased);
     return false;
   }
   // Refused before anything moves; not a test of the motor, so nothing is stored.
   record.reasons = {{ReasonCode::kFixture, "station stopped: " + release_fault_}};
-  board_.SetReadiness(false, release_fault_);
+  board_.SetCause(NotReadyCause::kClampNotReleased, release_fault_);
   PublishRefusal(record);
   return true;
 }

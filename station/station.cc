@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <thread>
 
@@ -68,29 +70,22 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
     spdlog::error("store {}: VERDICTS LOST: {}", config_.db_path, store_->loss_on_open());
   drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench));
   board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_->id, recipe_->hash);
-  std::string not_ready;
-  if (const drivers::Status s = drivers_.fixture->Connect(); !s.ok()) {
-    spdlog::error("{} (will retry at the next test)", s.message());
-    board_->SetMessage(s.message());
-    not_ready = s.message();
-  }
-  if (const drivers::Status s = drivers_.daq->Connect(); !s.ok()) {
-    spdlog::error("{} (will retry at the next test)", s.message());
-    board_->SetMessage(s.message());
-    not_ready += (not_ready.empty() ? "" : "; ") + s.message();
-  }
+  ConnectDrivers();
   if (!recipe_problem_.empty()) {
     board_->SetMessage(recipe_problem_);
-    not_ready += (not_ready.empty() ? "" : "; ") + std::string("recipe does not load");
+    board_->SetCause(NotReadyCause::kRecipeInvalid, recipe_problem_);
   }
   if (!store_->loss_on_open().empty()) {
     // Named until the first test; the journal keeps it. Tests go on: refusing them would not
     // bring the lost records back, and new tests get ids of their own.
     const std::string lost = "store lost acknowledged verdicts: " + store_->loss_on_open();
     board_->SetMessage(lost);
-    not_ready += (not_ready.empty() ? "" : "; ") + lost;
+    board_->SetCause(NotReadyCause::kStoreLostVerdicts, lost);
   }
-  board_->SetReadiness(not_ready.empty(), not_ready);
+  RestoreBoard();
+  probe_ = std::make_unique<FixtureProbe>(
+      *drivers_.fixture,
+      std::chrono::milliseconds(std::lround(config_.safety.heartbeat_timeout_ms)));
   const std::string simulation = SimulationReason(config_);
   if (!simulation.empty()) {
     spdlog::warn("SIMULATION ({}): records are marked and are no production results", simulation);
@@ -109,6 +104,39 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
   sequencer_ = std::make_unique<Sequencer>(*drivers_.fixture, *drivers_.daq, *store_, recipe_,
                                            *board_, opts);
   sequencer_->PublishLockout();  // a lockout survives a restart: it is read from the store
+}
+
+// A fixture or DAQ that does not answer yet is not fatal: the idle look (LookAtDrivers)
+// and each test retry it.
+void Station::ConnectDrivers() {
+  if (const drivers::Status s = drivers_.fixture->Connect(); !s.ok()) {
+    spdlog::error("{} (retried while idle and at the next test)", s.message());
+    board_->SetCause(NotReadyCause::kFixtureUnreachable, "fixture unavailable: " + s.message());
+  }
+  if (const drivers::Status s = drivers_.daq->Connect(); !s.ok()) {
+    spdlog::error("{} (retried while idle and at the next test)", s.message());
+    board_->SetCause(NotReadyCause::kAcquisitionUnavailable,
+                     "acquisition unavailable: " + s.message());
+  }
+  board_->ClearCause(NotReadyCause::kDriversNotConnected);  // tried: their own causes stand
+}
+
+// Shift continuity (issue 36): "Last results" and the day's counts as the store holds them,
+// so that a restart shows what the shift did so far.
+void Station::RestoreBoard() {
+  const auto now = std::chrono::system_clock::now();
+  db::TestQuery day;
+  day.from = db::UtcIso8601(LocalMidnight(now));
+  day.limit = 1000;
+  VerdictCounts counts;
+  for (std::vector<db::TestRecord> page = store_->Tests(day); !page.empty();
+       page = store_->Tests(day)) {
+    for (const db::TestRecord& r : page) counts.Add(r.outcome);
+    day.after = {page.back().started_at, page.back().id};
+  }
+  db::TestQuery recent;
+  recent.limit = 20;
+  board_->Restore(store_->Tests(recent), counts, LocalDay(now));
 }
 
 Station::~Station() {
@@ -220,19 +248,8 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   if (!recipe_problem_.empty()) {  // under queue_mu_, as Enqueue reads it
     recipe_problem_.clear();
     board_->SetMessage("");
-    // The recipe was the only thing wrong only if both drivers answered; otherwise the board
-    // keeps saying so until the next test reconnects them.
-    const auto connected = [](drivers::Lifecycle l) {
-      return l == drivers::Lifecycle::kInactive || l == drivers::Lifecycle::kActive;
-    };
-    const bool fixture_up = connected(drivers_.fixture->lifecycle());
-    const bool daq_up = connected(drivers_.daq->lifecycle());
-    std::string not_ready;
-    if (!fixture_up) not_ready = "fixture not connected (retried at the next test)";
-    if (!daq_up)
-      not_ready += (not_ready.empty() ? "" : "; ") +
-                   std::string("acquisition not connected (retried at the next test)");
-    board_->SetReadiness(not_ready.empty(), not_ready);
+    // Only the recipe's cause: a fixture that never answered keeps its own.
+    board_->ClearCause(NotReadyCause::kRecipeInvalid);
   }
   sequencer_->SetRecipe(next, std::move(designed));
   board_->SetRecipe(next->id, next->hash);
@@ -256,25 +273,61 @@ bool Station::ready() const { return board_->Snapshot().value("ready", false); }
 int Station::http_port() const { return http_ ? http_->port() : 0; }
 
 db::TestRecord Station::RunTest(const std::string& serial) {
-  db::TestRecord r = sequencer_->RunTest(serial);
+  db::TestRecord r;
+  {
+    std::lock_guard<std::mutex> fixture_lock(fixture_use_mu_);
+    r = sequencer_->RunTest(serial);
+  }
   metrics_.OnTest(r);
   ShowStoreFailure();
   return r;
 }
 
 // A write that failed (a full disk): the station is not ready, and says why, until a write
-// succeeds (the next test's BeginTest first finishes the failed test as ERROR).
+// succeeds (the next test's BeginTest first finishes the failed test as ERROR). Lost verdicts
+// found at start are named until this first test after them.
 void Station::ShowStoreFailure() {
+  board_->ClearCause(NotReadyCause::kStoreLostVerdicts);
   const std::string& failure = store_->write_failure();
   if (failure.empty()) {
-    if (showing_store_failure_) board_->SetMessage("");  // the test's own readiness stands
+    if (showing_store_failure_) board_->SetMessage("");
     showing_store_failure_ = false;
+    board_->ClearCause(NotReadyCause::kStoreWriteFailed);
     return;
   }
   showing_store_failure_ = true;
   spdlog::error("store write failed, station not ready: {}", failure);
   board_->SetMessage("store write failed: " + failure);
-  board_->SetReadiness(false, "store write failed: " + failure);
+  board_->SetCause(NotReadyCause::kStoreWriteFailed, "store write failed: " + failure);
+}
+
+// One idle look at the drivers (station/health.h), every health.period_ms while Serve runs:
+// skipped while a test runs or waits, and a test waits for a look in flight.
+void Station::LookAtDrivers() {
+  {
+    std::lock_guard<std::mutex> lock(queue_mu_);
+    if (running_test_ || !queue_.empty() || stop_) return;
+  }
+  std::unique_lock<std::mutex> fixture_lock(fixture_use_mu_, std::try_to_lock);
+  if (!fixture_lock.owns_lock()) return;
+  const std::vector<FixtureProbe::Finding> found = probe_->Look(std::chrono::steady_clock::now());
+  for (NotReadyCause cause : kFixtureCauses) {
+    const auto it = std::find_if(found.begin(), found.end(),
+                                 [cause](const auto& f) { return f.first == cause; });
+    if (it == found.end()) {
+      if (board_->HasCause(cause)) spdlog::info("{} cleared while idle", Code(cause));
+      board_->ClearCause(cause);
+    } else {
+      if (!board_->HasCause(cause)) spdlog::error("not ready: {} while idle", it->second);
+      board_->SetCause(cause, it->second);
+    }
+  }
+  if (drivers_.daq->lifecycle() == drivers::Lifecycle::kInactive) return;
+  if (const drivers::Status s = drivers_.daq->Connect(); !s.ok())
+    board_->SetCause(NotReadyCause::kAcquisitionUnavailable,
+                     "acquisition unavailable: " + s.message());
+  else
+    board_->ClearCause(NotReadyCause::kAcquisitionUnavailable);
 }
 
 LiveMetrics Station::LiveValues() {
@@ -343,7 +396,11 @@ double TestDeadlineS(const Recipe& r, const SafetyOptions& safety) {
 void Station::Serve() {
   std::atomic<bool> serving{true};
   std::thread health([&] { HealthLoop(serving); });
-  ServeQueue();
+  {
+    const PeriodicTask looks(std::chrono::milliseconds(std::lround(config_.health.period_ms)),
+                             [this] { LookAtDrivers(); });
+    ServeQueue();
+  }
   serving = false;
   health.join();
 }
@@ -401,7 +458,11 @@ void Station::ServeQueue() {
       test_started_ = std::chrono::steady_clock::now();
       test_deadline_s_ = TestDeadlineS(*recipe(), config_.safety);
     }
-    const db::TestRecord r = sequencer_->RunTest(request.serial, request.work);
+    db::TestRecord r;
+    {
+      std::lock_guard<std::mutex> fixture_lock(fixture_use_mu_);  // no idle look meanwhile
+      r = sequencer_->RunTest(request.serial, request.work);
+    }
     metrics_.OnTest(r);
     ShowStoreFailure();
     spdlog::info("[{}] {} {}", r.serial, analysis::ToString(r.outcome),

@@ -14,6 +14,7 @@
 #include "db/store.h"
 #include "drivers/factory/factory.h"
 #include "station/config.h"
+#include "station/health.h"
 #include "station/http_api.h"
 #include "station/plc/plc_server.h"
 #include "station/recipe.h"
@@ -32,8 +33,8 @@ class Station {
   // with none, it throws), opens the store (recovering interrupted tests as
   // ABORTED; a damaged, emptied or foreign file throws db::StoreRefused; acknowledged
   // verdicts the store lost are logged and shown, db::Store::loss_on_open), makes the drivers
-  // and connects them. A fixture or DAQ that does not answer
-  // yet is not fatal: the station says so and retries at the next test. A bad recipe,
+  // and connects them. A fixture or DAQ that does not answer yet is not fatal: the station
+  // says so (a NotReadyCause) and retries while idle (Serve) and at the next test. A bad recipe,
   // config or database is fatal (throws with the cause).
   // `bench`: a simulated bench shared with a fixture emulator (the demo); normally null.
   explicit Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench = nullptr);
@@ -44,8 +45,9 @@ class Station {
   // Serves the API; the port actually bound is http_port().
   void StartHttp(const std::string& web_root = "");
   int http_port() const;
-  // The fixture and the DAQ answered (at start, or at the latest test); otherwise the board's
-  // not_ready_reason says what did not.
+  // No cause of not being ready is raised (station/health.h): the board's not_ready_code
+  // and not_ready_reason say which are. While Serve runs, the fixture controller and the DAQ
+  // are looked at every health.period_ms when no test runs or waits.
   bool ready() const;
 
   // Runs one test now, on the calling thread.
@@ -115,6 +117,13 @@ class Station {
   bool stop_ = false;
 
   void ServeQueue();
+  void ConnectDrivers();
+  void RestoreBoard();
+  // The idle look (station/health.h); Serve calls it every health.period_ms.
+  void LookAtDrivers();
+  // Held by a test and by an idle look: never both at once.
+  std::mutex fixture_use_mu_;
+  std::unique_ptr<FixtureProbe> probe_;
   // After each test: a failed store write makes the station not ready, naming the cause.
   void ShowStoreFailure();
   bool showing_store_failure_ = false;

@@ -1,5 +1,7 @@
 #include "station/status_board.h"
 
+#include <ctime>
+
 #include "station/sequencer.h"  // ToString(SeqState)
 
 namespace eol::station {
@@ -15,6 +17,41 @@ nlohmann::json RecordSummary(const db::TestRecord& r) {
       {"finished_at", r.finished_at},
       {"kind", r.kind},  // a master part's self-check is no production unit
       {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}}};
+}
+
+void VerdictCounts::Add(analysis::Outcome outcome) {
+  switch (outcome) {
+    case analysis::Outcome::kPass:
+      ++pass;
+      break;
+    case analysis::Outcome::kFail:
+      ++fail;
+      break;
+    case analysis::Outcome::kError:
+      ++error;
+      break;
+    case analysis::Outcome::kAborted:
+      ++aborted;
+      break;
+  }
+}
+
+std::string LocalDay(std::chrono::system_clock::time_point t) {
+  const std::time_t tt = std::chrono::system_clock::to_time_t(t);
+  std::tm local{};
+  localtime_r(&tt, &local);
+  char day[16];
+  std::strftime(day, sizeof day, "%Y-%m-%d", &local);
+  return day;
+}
+
+std::chrono::system_clock::time_point LocalMidnight(std::chrono::system_clock::time_point t) {
+  const std::time_t tt = std::chrono::system_clock::to_time_t(t);
+  std::tm local{};
+  localtime_r(&tt, &local);
+  local.tm_hour = local.tm_min = local.tm_sec = 0;
+  local.tm_isdst = -1;  // whatever holds at midnight
+  return std::chrono::system_clock::from_time_t(std::mktime(&local));
 }
 
 StatusBoard::StatusBoard(std::string station_id, std::string recipe_id, std::string recipe_hash)
@@ -42,21 +79,27 @@ void StatusBoard::OnVerdict(const db::TestRecord& record) {
   last_ = RecordSummary(record);
   recent_.push_front(last_);
   while (recent_.size() > 20) recent_.pop_back();
-  switch (record.outcome) {
-    case analysis::Outcome::kPass:
-      ++pass_;
-      break;
-    case analysis::Outcome::kFail:
-      ++fail_;
-      break;
-    case analysis::Outcome::kError:
-      ++error_;
-      break;
-    case analysis::Outcome::kAborted:
-      ++aborted_;
-      break;
-  }
+  const std::string today = LocalDay(std::chrono::system_clock::now());
+  if (today != day_) counts_ = VerdictCounts{};
+  day_ = today;
+  counts_.Add(record.outcome);
   PushEventLocked({{"type", "verdict"}, {"record", last_}});
+  if (!message_.empty()) {
+    message_.clear();
+    PushEventLocked({{"type", "message"}, {"message", ""}});
+  }
+}
+
+void StatusBoard::Restore(const std::vector<db::TestRecord>& newest_first, VerdictCounts counts,
+                          std::string day) {
+  std::lock_guard<std::mutex> lock(mu_);
+  recent_.clear();
+  for (const db::TestRecord& r : newest_first) {
+    if (recent_.size() == 20) break;
+    recent_.push_back(RecordSummary(r));
+  }
+  counts_ = counts;
+  day_ = std::move(day);
 }
 
 void StatusBoard::SetRecipe(const std::string& recipe_id, const std::string& recipe_hash) {
@@ -78,13 +121,43 @@ void StatusBoard::SetSimulation(const std::string& why) {
   simulation_ = why;
 }
 
-void StatusBoard::SetReadiness(bool ready, const std::string& why) {
+void StatusBoard::SetCause(NotReadyCause cause, const std::string& detail) {
   std::lock_guard<std::mutex> lock(mu_);
-  if (ready == ready_ && why == not_ready_reason_) return;
-  ready_ = ready;
-  not_ready_reason_ = ready ? "" : why;
-  PushEventLocked(
-      {{"type", "readiness"}, {"ready", ready_}, {"not_ready_reason", not_ready_reason_}});
+  const auto it = causes_.find(cause);
+  if (it != causes_.end() && it->second == detail) return;
+  causes_[cause] = detail;
+  nlohmann::json event = ReadinessLocked();
+  event["type"] = "readiness";
+  PushEventLocked(std::move(event));
+}
+
+void StatusBoard::ClearCause(NotReadyCause cause) {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (causes_.erase(cause) == 0) return;
+  nlohmann::json event = ReadinessLocked();
+  event["type"] = "readiness";
+  PushEventLocked(std::move(event));
+}
+
+bool StatusBoard::HasCause(NotReadyCause cause) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return causes_.count(cause) > 0;
+}
+
+nlohmann::json StatusBoard::ReadinessLocked() const {
+  std::string reason;
+  nlohmann::json all = nlohmann::json::array();
+  for (const auto& [cause, detail] : causes_) {
+    reason += (reason.empty() ? "" : "; ") + detail;
+    all.push_back(
+        {{"code", Code(cause)}, {"reason", detail}, {"operator_text", OperatorText(cause)}});
+  }
+  const bool ready = causes_.empty();
+  return {{"ready", ready},
+          {"not_ready_reason", reason},
+          {"not_ready_code", ready ? "" : Code(causes_.begin()->first)},
+          {"not_ready_text", ready ? "" : OperatorText(causes_.begin()->first)},
+          {"not_ready", all}};
 }
 
 void StatusBoard::SetLockout(const nlohmann::json& lockout) {
@@ -96,19 +169,24 @@ void StatusBoard::SetLockout(const nlohmann::json& lockout) {
 
 nlohmann::json StatusBoard::Snapshot() const {
   std::lock_guard<std::mutex> lock(mu_);
-  return {{"station_id", station_id_},
-          {"state", state_ ? ToString(*state_) : "idle"},
-          {"serial", serial_},
-          {"detail", detail_},
-          {"message", message_},
-          {"ready", ready_},
-          {"not_ready_reason", not_ready_reason_},
-          {"simulation", simulation_},
-          {"recipe", {{"id", recipe_id_}, {"hash", recipe_hash_}}},
-          {"counts", {{"pass", pass_}, {"fail", fail_}, {"error", error_}, {"aborted", aborted_}}},
-          {"last", last_},
-          {"recent", recent_},
-          {"lockout", lockout_}};
+  nlohmann::json s = ReadinessLocked();
+  s.update({{"station_id", station_id_},
+            {"state", state_ ? ToString(*state_) : "idle"},
+            {"serial", serial_},
+            {"detail", detail_},
+            {"message", message_},
+            {"simulation", simulation_},
+            {"recipe", {{"id", recipe_id_}, {"hash", recipe_hash_}}},
+            {"counts",
+             {{"pass", counts_.pass},
+              {"fail", counts_.fail},
+              {"error", counts_.error},
+              {"aborted", counts_.aborted},
+              {"day", day_}}},
+            {"last", last_},
+            {"recent", recent_},
+            {"lockout", lockout_}});
+  return s;
 }
 
 std::vector<std::pair<std::uint64_t, nlohmann::json>> StatusBoard::EventsAfter(

@@ -24,12 +24,20 @@ void GetEvents(ApiContext& c, const httplib::Request&, httplib::Response& res) {
                       "the station serves at most " + std::to_string(c.options.limits.max_streams) +
                           " event streams at once; close one (another tab?)"});
   auto last = std::make_shared<std::uint64_t>(c.board.last_event());
+  auto opened = std::make_shared<bool>(false);
   res.set_header("Cache-Control", "no-cache");
   res.set_chunked_content_provider(
-      "text/event-stream", [&c, last](std::size_t, httplib::DataSink& sink) {
-        const auto events = c.board.EventsAfter(*last, std::chrono::milliseconds(1000));
+      "text/event-stream", [&c, last, opened](std::size_t, httplib::DataSink& sink) {
+        if (!*opened) {  // a browser reconnects 1 s after losing the stream (default: 3 s)
+          *opened = true;
+          const std::string retry = "retry: 1000\n\n";
+          if (!sink.write(retry.data(), retry.size())) return false;
+        }
+        // A quiet half second is a "ping" event: the page calls the station offline when
+        // nothing at all arrived for 1.5 s (station/web/app.js), and a proxy keeps the stream.
+        const auto events = c.board.EventsAfter(*last, std::chrono::milliseconds(500));
         if (events.empty()) {
-          const std::string ping = ": keep-alive\n\n";
+          const std::string ping = "event: ping\ndata: {}\n\n";
           return sink.write(ping.data(), ping.size());
         }
         for (const auto& [seq, e] : events) {

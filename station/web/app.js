@@ -137,7 +137,7 @@ function renderHistory(status) {
     t.appendChild(row);
   }
   const c = status.counts || {};
-  $("counts").textContent = `PASS ${c.pass || 0} · FAIL ${c.fail || 0} · ERROR ${c.error || 0}` +
+  $("counts").textContent = (c.day ? "Today: " : "") + `PASS ${c.pass || 0} · FAIL ${c.fail || 0} · ERROR ${c.error || 0}` +
       ` · ABORTED ${c.aborted || 0}`;
 }
 
@@ -386,11 +386,46 @@ function renderSimulation(why) {
   b.textContent = why ? "SIMULATION: " + why + ", not production results" : "";
 }
 
-// Ready: the fixture and the DAQ answered.
-function renderReadiness(ready, why) {
+// Readiness (station/health.h): what the operator does in large type, the technical reason
+// under it, the cause's code in data-code. `r` is /api/status or a "readiness" event.
+function renderReadiness(r) {
   const b = $("not-ready");
-  b.hidden = ready !== false;
-  b.textContent = b.hidden ? "" : "NOT READY: " + why;
+  b.hidden = r.ready !== false;
+  b.dataset.code = b.hidden ? "" : r.not_ready_code || "";
+  if (b.hidden) {
+    b.replaceChildren();
+    return;
+  }
+  b.replaceChildren(el("span", {class: "what"}, "NOT READY: " + (r.not_ready_text || r.not_ready_reason)),
+                    el("span", {class: "why"}, r.not_ready_reason || ""));
+}
+
+// --- The link to the station: offline within 2 s of losing it. ---
+// The event stream sends something at least every 0.5 s (a "ping" when nothing happens);
+// nothing for OFFLINE_AFTER_MS, or the stream failing, is a lost station: the verdict is
+// greyed (it may be old) and Start is disabled until the stream is back.
+const OFFLINE_AFTER_MS = 1500;
+let lastHeard = 0, offline = true;
+
+function setOffline(now) {
+  if (now === offline) return;
+  offline = now;
+  const c = $("connection");
+  c.textContent = now ? "station offline" : "live";
+  c.className = now ? "offline" : "online";
+  document.body.classList.toggle("offline", now);
+  $("offline").hidden = !now;
+  $("start").disabled = now;
+  if (!now) refreshStatus().catch(() => {});  // what happened while the link was down
+}
+
+function heard() {
+  lastHeard = performance.now();
+  setOffline(false);
+}
+
+function watchLink() {
+  setInterval(() => { if (performance.now() - lastHeard > OFFLINE_AFTER_MS) setOffline(true); }, 250);
 }
 
 // Events of each kind received over the stream. A status fetched while an event of a kind
@@ -408,7 +443,7 @@ async function refreshStatus() {
   const fresh = (...kinds) => kinds.every(k => (eventsSeen[k] || 0) === (before[k] || 0));
   if (fresh("lockout")) renderLockout(s.lockout);
   renderSimulation(s.simulation);
-  if (fresh("readiness")) renderReadiness(s.ready, s.not_ready_reason);
+  if (fresh("readiness")) renderReadiness(s);
   $("station").textContent = "EOL station " + s.station_id;
   if (fresh("message")) $("message").textContent = s.message || "";
   renderHistory(s);
@@ -469,10 +504,36 @@ function loadWork() {
   $("token-row").hidden = !$("token").value;
 }
 
+// When the shown refusal was made, and when the latest test began (page time, ms): a verdict
+// clears only a refusal made before its test began (a serial refused while that test ran must
+// still be scanned again).
+let problemAt = -1, testBeganAt = -1;
+
 function startStatus(text, problem) {
   const s = $("start-status");
   s.textContent = text;
   s.className = problem ? "problem" : "";
+  if (problem) {
+    problemAt = performance.now();
+    refusalCue();
+  }
+}
+
+// A short low tone for a scan that did not start a test (made in the page: no sound file,
+// nothing loaded). Counted in body[data-cues] for the tests.
+function refusalCue() {
+  document.body.dataset.cues = Number(document.body.dataset.cues || 0) + 1;
+  try {
+    const ctx = refusalCue.ctx || (refusalCue.ctx = new AudioContext());
+    const tone = ctx.createOscillator(), gain = ctx.createGain();
+    tone.frequency.value = 330;
+    gain.gain.value = 0.25;
+    tone.connect(gain).connect(ctx.destination);
+    tone.start();
+    tone.stop(ctx.currentTime + 0.35);
+  } catch (e) {
+    // no audio device: the red text stands alone
+  }
 }
 
 // POST /api/tests as any client does: no token while the station has none configured (the
@@ -506,8 +567,19 @@ async function startTest(serial) {
   }
 }
 
+// Offline, Start is disabled and the form cannot submit: a scanner's Enter is answered here,
+// and its serial does not stay in the field to be glued to the next scan.
+function refuseScanWhileOffline(e) {
+  if (e.key !== "Enter" || !offline) return;
+  e.preventDefault();
+  const serial = $("scan").value.trim();
+  $("scan").value = "";
+  if (serial) startStatus(serial + " not started: station offline", true);
+}
+
 function setupStart() {
   loadWork();
+  $("scan").addEventListener("keydown", refuseScanWhileOffline);
   $("start-form").addEventListener("submit", e => {
     e.preventDefault();
     const serial = $("scan").value.trim();
@@ -521,38 +593,53 @@ function setupStart() {
   keepScanFocus();
 }
 
+// What each kind of event does, with its parsed data.
+const HANDLERS = {
+  ping: () => {},
+  state: e => {
+    renderStates(e.state);
+    if (e.state === "check_interlocks" && e.detail === "") {
+      testBeganAt = performance.now();
+      showRunning(e.serial);
+    }
+  },
+  verdict: e => {
+    // A new verdict: what was said about the station before its test began is old news.
+    $("message").textContent = "";
+    if ($("start-status").className === "problem" && problemAt < testBeganAt) startStatus("");
+    showResult(e.record);
+    refreshStatus().catch(() => {});
+  },
+  recipe: () => { loadRecipe(); },
+  lockout: e => renderLockout(e.lockout),
+  readiness: e => renderReadiness(e),
+  message: e => { $("message").textContent = e.message; },
+};
+
+// The event stream. The browser reconnects a lost one by itself (every second: the station
+// sends "retry: 1000"); one it gave up on (an HTTP error answered) is opened anew.
+function openStream() {
+  const source = new EventSource("/api/events");
+  for (const [kind, handle] of Object.entries(HANDLERS)) {
+    source.addEventListener(kind, ev => {
+      heard();
+      eventsSeen[kind] = (eventsSeen[kind] || 0) + 1;
+      handle(JSON.parse(ev.data));
+    });
+  }
+  source.onopen = heard;
+  source.onerror = () => {
+    setOffline(true);
+    if (source.readyState === EventSource.CLOSED) setTimeout(openStream, 1000);
+  };
+}
+
 async function main() {
   setupStart();
   await loadRecipe();
   await refreshStatus().catch(e => { $("message").textContent = e.message; });
-  const source = new EventSource("/api/events");
-  const events = {
-    addEventListener(kind, handle) {
-      source.addEventListener(kind, ev => { eventsSeen[kind] = (eventsSeen[kind] || 0) + 1; handle(ev); });
-    },
-  };
-  source.onopen = () => {
-    $("connection").textContent = "live";
-    $("connection").className = "online";
-    refreshStatus().catch(() => {});  // what happened while the stream was down
-  };
-  source.onerror = () => { $("connection").textContent = "reconnecting…"; $("connection").className = "offline"; };
-  events.addEventListener("state", ev => {
-    const e = JSON.parse(ev.data);
-    renderStates(e.state);
-    if (e.state === "check_interlocks") showRunning(e.serial);
-  });
-  events.addEventListener("verdict", ev => {
-    showResult(JSON.parse(ev.data).record);
-    refreshStatus().catch(() => {});
-  });
-  events.addEventListener("recipe", () => { loadRecipe(); });
-  events.addEventListener("lockout", ev => { renderLockout(JSON.parse(ev.data).lockout); });
-  events.addEventListener("readiness", ev => {
-    const e = JSON.parse(ev.data);
-    renderReadiness(e.ready, e.not_ready_reason);
-  });
-  events.addEventListener("message", ev => { $("message").textContent = JSON.parse(ev.data).message; });
+  openStream();
+  watchLink();
 }
 
 main();

@@ -10,6 +10,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -466,6 +467,155 @@ TEST(OperatorPage, AsksForTheOperatorsTokenWhenTheStationHasTokens) {
   ASSERT_EQ(tests.size(), 1u) << "the refused scan must not have started a test";
   EXPECT_EQ(j["verdict"], tests[0]["outcome"]);
   station.Stop(SIGTERM, 20s);
+}
+
+// Issue 36, live health, in a real browser against a real fixture controller (`eol
+// fixture-sim` over Modbus TCP) and the daemon in its own process. check_health.mjs asks for
+// each step; the test acts and answers with the time it acted (wall clock, ms).
+class HealthSteps {
+ public:
+  HealthSteps(ChildProcess& browser, std::string dir) : browser_(browser), dir_(std::move(dir)) {}
+  // Waits for the browser to ask for `name`, runs `act`, then says when it acted.
+  bool Do(const std::string& name, const std::function<void()>& act) {
+    if (!browser_.WaitFor(
+            [&](const std::string& o) {
+              return o.find("step: " + name + "\n") != std::string::npos;
+            },
+            90s))
+      return false;
+    const auto acted = std::chrono::duration_cast<std::chrono::milliseconds>(
+                           std::chrono::system_clock::now().time_since_epoch())
+                           .count();
+    act();
+    std::ofstream(dir_ + "/" + name + ".done.tmp") << acted;
+    std::filesystem::rename(dir_ + "/" + name + ".done.tmp", dir_ + "/" + name + ".done");
+    return true;
+  }
+
+ private:
+  ChildProcess& browser_;
+  const std::string dir_;
+};
+
+// `eol fixture-sim` on `port` (0: a free one, written to DIR/fixture.port).
+std::unique_ptr<ChildProcess> StartFixtureSim(const eol::testing::TempDir& dir, int port) {
+  std::filesystem::remove(dir / "fixture.port");
+  auto sim = std::make_unique<ChildProcess>(
+      std::vector<std::string>{EOL_BINARY, "fixture-sim", "--port", std::to_string(port),
+                               "--ready-file", dir / "fixture.port", "--part", "ROTOR-ON-FIXTURE"});
+  EXPECT_TRUE(sim->WaitFor(
+      [&](const std::string&) { return std::filesystem::exists(dir / "fixture.port"); }, 30s))
+      << sim->output();
+  return sim;
+}
+
+TEST(OperatorPage, FollowsTheFixtureControllerAndShowsALostStationWithin2s) {
+  const std::string node = BrowserCheckNode();
+  ASSERT_FALSE(node.empty());
+  eol::testing::TempDir dir;
+  auto fixture = StartFixtureSim(dir, 0);
+  int fixture_port = 0;
+  std::ifstream(dir / "fixture.port") >> fixture_port;
+  ASSERT_GT(fixture_port, 0);
+  nlohmann::json config = {
+      {"station_id", "page-health"},
+      {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
+      {"db", dir / "s.sqlite"},
+      {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
+      {"fixture", {{"driver", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", fixture_port}}},
+      {"daq", {{"driver", "sim"}, {"relay", "external"}}}};  // health.period_ms: 500 (default)
+  int port = 0;
+  auto station = StartPageStation(dir, config, &port);
+  ASSERT_GT(port, 0);
+  config["http"]["port"] = port;  // the restarted daemon comes back where the page looks
+
+  const std::string artifacts = std::filesystem::path(EOL_BINARY).parent_path() / "artifacts";
+  std::filesystem::create_directories(artifacts);
+  ChildProcess browser(
+      {node, kBrowserDir + "/check_health.mjs", "http://127.0.0.1:" + std::to_string(port),
+       dir.path(), artifacts, "HEALTH-1", "HEALTH-2", "HEALTH-3"},
+      /*merge_stderr=*/false);
+  HealthSteps steps(browser, dir.path());
+  ASSERT_TRUE(steps.Do("stop_fixture", [&] { fixture->Stop(SIGKILL, 10s); })) << browser.output();
+  ASSERT_TRUE(steps.Do("start_fixture", [&] { fixture = StartFixtureSim(dir, fixture_port); }))
+      << browser.output();
+  ASSERT_TRUE(steps.Do("freeze_daemon", [&] { kill(station->pid(), SIGSTOP); }))
+      << browser.output();
+  ASSERT_TRUE(steps.Do("kill_daemon", [&] { station->Stop(SIGKILL, 10s); })) << browser.output();
+  ASSERT_TRUE(steps.Do("restart_daemon", [&] {
+    int again = 0;
+    station = StartPageStation(dir, config, &again);
+    EXPECT_EQ(again, port);
+  })) << browser.output();
+  const auto code = browser.Wait(120s);
+  ASSERT_TRUE(code.has_value()) << "browser did not finish";
+  ASSERT_EQ(*code, 0) << browser.output() << station->output();
+  const std::string last_line =
+      browser.output().substr(browser.output().rfind('\n', browser.output().size() - 2) + 1);
+  const auto j = nlohmann::json::parse(last_line);
+
+  EXPECT_EQ(j["at_start"]["connection"], "live");
+  EXPECT_FALSE(j["at_start"]["start_disabled"].get<bool>());
+  EXPECT_TRUE(j["at_start"]["not_ready"].is_null()) << j["at_start"];
+  // The controller killed while the station idles: NOT READY with the cause's code and the
+  // operator's words, within one health period (500 ms) plus one failed read and the page's
+  // own delay; the daemon itself is still live. Back within one period after it returns.
+  const nlohmann::json& lost = j["fixture_lost"];
+  EXPECT_LE(lost["ms"].get<int>(), 1500) << lost;
+  EXPECT_EQ(lost["not_ready"]["code"], "fixture_unreachable") << lost;
+  EXPECT_NE(lost["not_ready"]["text"].get<std::string>().find(
+                "Fixture controller not answering - call maintenance"),
+            std::string::npos)
+      << lost;
+  EXPECT_EQ(lost["connection"], "live");
+  EXPECT_LE(j["fixture_back"]["ms"].get<int>(), 1500) << j["fixture_back"];
+  EXPECT_TRUE(j["fixture_back"]["not_ready"].is_null()) << j["fixture_back"];
+  // A scan while HEALTH-2 ran: refused with the reason and a cue, still shown after HEALTH-2's
+  // verdict (that serial was not tested).
+  EXPECT_EQ(j["busy"]["start_status"],
+            "HEALTH-2-B not started: busy: a test is running or waiting");
+  EXPECT_EQ(j["busy"]["cues"], 1);
+  EXPECT_TRUE(j["after_second"]["start_status_problem"].get<bool>()) << j["after_second"];
+  // No stale driver text under the next verdict.
+  const std::string text = j["after_second"]["page_text"];
+  for (const char* stale : {"Connection refused", "fixture unavailable", "NOT READY"})
+    EXPECT_EQ(text.find(stale), std::string::npos) << stale << " still on the page:\n" << text;
+  // The daemon hung: offline within 2 s, Start disabled, the verdict greyed.
+  const nlohmann::json& frozen = j["frozen"];
+  EXPECT_LE(frozen["ms"].get<int>(), 2000) << frozen;
+  EXPECT_TRUE(frozen["start_disabled"].get<bool>());
+  EXPECT_TRUE(frozen["offline_banner"].get<bool>());
+  EXPECT_NE(frozen["verdict_filter"].get<std::string>().find("grayscale(1)"), std::string::npos)
+      << frozen["verdict_filter"];
+  // A scan while it is dead is refused on the page (the serial does not stay in the field).
+  EXPECT_EQ(j["refused_offline"]["start_status"], "HEALTH-3 not started: station offline");
+  EXPECT_EQ(j["refused_offline"]["scan_field"], "");
+  // The daemon back: live, Start enabled; the refusal stays until the next verdict (started
+  // by the API, not the page) clears it.
+  EXPECT_EQ(j["back"]["connection"], "live");
+  EXPECT_FALSE(j["back"]["start_disabled"].get<bool>());
+  EXPECT_TRUE(j["back"]["start_status_problem"].get<bool>()) << j["back"];
+  // Shift continuity: the restarted daemon's "Last results" and counts come from the store.
+  EXPECT_EQ(j["back"]["history"], (nlohmann::json{"HEALTH-2", "HEALTH-1"})) << j["back"];
+  std::smatch counts;
+  const std::string counts_text = j["back"]["counts"];
+  ASSERT_TRUE(std::regex_search(counts_text, counts,
+                                std::regex("^Today: PASS ([0-9]+) · FAIL ([0-9]+) · ERROR 0")))
+      << counts_text;
+  EXPECT_EQ(std::stoi(counts[1]) + std::stoi(counts[2]), 2) << counts_text;
+  EXPECT_EQ(j["after_third"]["start_status"], "");
+  EXPECT_FALSE(j["after_third"]["start_status_problem"].get<bool>());
+  EXPECT_EQ(j["after_third"]["message"], "");
+  for (const char* verdict : {"first", "second", "third"})
+    EXPECT_TRUE(j[verdict] == "PASS" || j[verdict] == "FAIL") << verdict << ": " << j[verdict];
+  std::printf(
+      "page: not ready %d ms after the controller was killed, ready %d ms after it "
+      "returned; offline %d ms after the daemon hung; live %d ms after its restart\n",
+      lost["ms"].get<int>(), j["fixture_back"]["ms"].get<int>(), frozen["ms"].get<int>(),
+      j["back"]["ms"].get<int>());
+  for (const auto& shot : j["screenshots"])
+    EXPECT_GT(std::filesystem::file_size(shot.get<std::string>()), 10000u) << shot;
+  station->Stop(SIGTERM, 20s);
 }
 
 // Issue 17: the engineer page (GET /engineer, linked from the operator page) against a
