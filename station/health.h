@@ -1,4 +1,4 @@
-// The station's live health (issue 36): why it is not ready, as typed causes, and the idle
+// The station's live health: why it is not ready, as typed causes, and the idle
 // look at the fixture controller that raises and clears the fixture's causes without a test.
 //
 // Every reason the station is not ready is one NotReadyCause with a stable code (the API's
@@ -17,8 +17,8 @@
 //
 // Adding a cause: a value in NotReadyCause (its place is its priority: the first raised is
 // the one the page headlines), its code and operator text in health.cc (the test
-// health_test.cc fails when one is missing or a code is used twice), then SetCause where it
-// is detected and ClearCause where it is known to be gone.
+// tests/station/live_health_test.cc fails when one is missing or a code is used twice), then
+// SetCause where it is detected and ClearCause where it is known to be gone.
 #pragma once
 
 #include <chrono>
