@@ -48,7 +48,8 @@ json Limit(const char* name, std::optional<double> lo, std::optional<double> hi,
 
 json DesignLimits(const analysis::MotionalImpedance& n) {
   const double a = n.ResidueOhmPerS();
-  const std::string until = " Design limit (eol recipe-new) until eol teach replaces it.";
+  const std::string until =
+      " First bounds from the design (eol recipe-new); eol teach sets them from golden units.";
   return json::array(
       {Limit("resonance_f_hz", 0.95 * n.f0_hz, 1.08 * n.f0_hz,
              "First torsional mode of the clamped rotor; a soft magnet bond lowers it." + until),

@@ -4,8 +4,8 @@
 // ProposeRecipe derives, from the motor's chain (analysis/model/chain_prediction.h) or from
 // that chain calibrated to measured good units (CalibrateToGolden):
 //   - the excited band one octave either side of the good rotor's mode f0 ([f0/2, 2 f0],
-//     rounded out to 10 Hz; lowered to keep 0.8 of the analysis window's lower edge), and the
-//     analysis f0 window [0.625 f0, 1.75 f0] inside it (and below 0.9 of the all-soft mode);
+//     rounded out to 10 Hz; its lower edge at most 0.8 of the window's), and the analysis f0
+//     window [0.625 f0, 1.75 f0] inside it (its lower edge at most 0.9 of the all-soft mode);
 //     the band must stay below 0.45 of the sample rate;
 //   - the excitation designed for time (analysis/signal/excitation_design.h, the code behind
 //     `eol design-excitation`) from the requirement std(f0) = shift_fraction x (f0 - f0 of a
@@ -13,8 +13,9 @@
 //     itself is to find; by default a thousandth of it, so that the production spread, not
 //     the test's noise, limits detection, and the residue and Q (whose relative noise is about
 //     Q times std(f0)/f0) stay far below their good units' spread. On the ten-pole chain:
-//     0.014 Hz (the shipped fast recipe's 0.0085 Hz was set to keep the 5 s recipe's). The
-//     record is the shortest that meets it; the amplitude stays at what the amplifier and the
+//     0.014 Hz, met by 2 periods (0.516 s) at 8 V, which reach 0.0062 Hz (the shipped fast
+//     recipe: 0.0085 Hz in 0.474 s, set to keep the 5 s recipe's). The record is the
+//     shortest that meets it; the amplitude stays at what the amplifier and the
 //     current range allow (DesignExcitationForTime would lower it where the shortest record
 //     has room to spare; the residue and the second-mode test gain from it), and the recipe's
 //     sigma_f0_hz states what that excitation reaches;

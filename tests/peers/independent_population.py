@@ -54,13 +54,14 @@ freedom per line).
 
 Second motor (--motor pmsm-8pole-heavy, issue 37): another design drawn by the same physics
 and spreads, eight heavier magnets on a heavier rotor (magnets 1e-5 each, pole body 6.4e-5,
-hub 3e-5, clamp collar 8.7e-6 kg m^2; bonds 2060, bridges 8 x 1230, shaft 9800, fixture 4420
-N m/rad, loss factors at w_ref = 2 pi 588 rad/s) and another winding (R 1.1 ohm, L 4.5 mH, T 0.09
-N m/A): the good rotor rings near 588 Hz in its fixture, about 50 % above the ten-pole one.
-Its measurement is the excitation its recipe plays (--f-lo/--f-hi/--spacing/--peak-v/--periods
-/--crest, the lines at whole multiples of the spacing inside the band; defaults per motor:
-recipes/pmsm-8pole-heavy.json's 280-1180 Hz at 5.2322 Hz, 8 V peak, 2 periods, crest 1.54). The classes keep their names: three_soft is three of the eight
-magnets, all_soft all eight.
+hub 3e-5, clamp collar 8.7e-6 kg m^2; bonds 2060, bridges 8 x 1230, shaft 9800, fixture
+4420 N m/rad, loss factors at w_ref = 2 pi 588 rad/s) and another winding (R 1.1 ohm,
+L 4.5 mH, T 0.09 N m/A): the good rotor rings near 588 Hz in its fixture, about 50 % above
+the ten-pole one. Its measurement is the excitation its recipe plays (--f-lo, --f-hi,
+--spacing, --peak-v, --periods, --crest; the lines at whole multiples of the spacing inside
+the band; defaults per motor: recipes/pmsm-8pole-heavy.json's 280-1180 Hz at 6.8847 Hz, 8 V
+peak, 2 periods, crest 1.525). The classes keep their names: three_soft is three of the
+eight magnets, all_soft all eight.
 
 Output in --out: unit-NNNN.csv (f_hz,re_ohm,im_ohm,sigma_ohm), and truth.csv: unit, class,
 first_mode_hz (lowest mode of the undamped chain; with a very soft bond it is that
@@ -99,7 +100,7 @@ NOMINAL_8POLE = dict(NOMINAL, j_magnet=1.0e-5, j_pole=6.4e-5, j_hub=3.0e-5, j_cl
 # crest)
 MOTORS = {
     "pmsm-10pole": (NOMINAL, 10, 390.0, (200.0, 800.0, 1.0, 2.0, 4, 1.7)),
-    "pmsm-8pole-heavy": (NOMINAL_8POLE, 8, 588.0, (280.0, 1180.0, 5.2322, 8.0, 2, 1.54)),
+    "pmsm-8pole-heavy": (NOMINAL_8POLE, 8, 588.0, (280.0, 1180.0, 6.8847, 8.0, 2, 1.525)),
 }
 
 
