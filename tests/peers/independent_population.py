@@ -59,8 +59,9 @@ hub 3e-5, clamp collar 8.7e-6 kg m^2; bonds 2060, bridges 8 x 1230, shaft 9800, 
 L 4.5 mH, T 0.09 N m/A): the good rotor rings near 588 Hz in its fixture, about 50 % above
 the ten-pole one. Its measurement is the excitation its recipe plays (--f-lo, --f-hi,
 --spacing, --peak-v, --periods, --crest; the lines at whole multiples of the spacing inside
-the band; defaults per motor: recipes/pmsm-8pole-heavy.json's 280-1180 Hz at 6.8847 Hz, 8 V
-peak, 2 periods, crest 1.525). The classes keep their names: three_soft is three of the
+the band; defaults per motor: 280-1180 Hz at 6.8847 Hz, 8 V peak, 2 periods, crest 1.525, the
+excitation of recipes/pmsm-8pole-heavy.json within a percent: its line grid follows the golden
+units' Q). The classes keep their names: three_soft is three of the
 eight magnets, all_soft all eight.
 
 Output in --out: unit-NNNN.csv (f_hz,re_ohm,im_ohm,sigma_ohm), and truth.csv: unit, class,
