@@ -160,6 +160,14 @@ std::vector<std::string> ForeignGoldenUnits(const Recipe& r,
   return out;
 }
 
+std::string ForeignGoldenRefusal(const Recipe& recipe, const std::vector<std::string>& foreign,
+                                 const std::string& how_to_force) {
+  std::string why = "the golden units are not recipe " + recipe.id + "'s motor:";
+  for (const std::string& f : foreign) why += " " + f + ";";
+  return why + " teach a recipe made for their motor, or " + how_to_force +
+         " to teach this one from them (recorded in the taught recipe)";
+}
+
 json TeachSummaryJson(const analysis::TeachSummary& s, const analysis::TeachOptions& o) {
   json limits = json::array(), stats = json::array(), masks = json::array();
   const json bond_index = s.bond_index ? BondIndexJson(*s.bond_index) : json(nullptr);
@@ -233,9 +241,35 @@ analysis::GoldenUnit GoldenFromRecord(const db::TestRecord& r, const std::string
   return u;
 }
 
+namespace {
+
+// The latest stored test of each serial as a golden unit; ERROR, ABORTED and untested serials
+// are skipped with the reason.
+std::vector<analysis::GoldenUnit> StoredGoldenUnits(db::Store& store, std::mutex& store_mu,
+                                                    const std::vector<std::string>& serials,
+                                                    json* skipped) {
+  std::vector<analysis::GoldenUnit> golden;
+  std::lock_guard<std::mutex> lock(store_mu);
+  for (const std::string& serial : serials) {
+    const auto latest = store.LatestOfSerial(serial);
+    if (!latest || latest->outcome == analysis::Outcome::kError ||
+        latest->outcome == analysis::Outcome::kAborted) {
+      skipped->push_back(
+          serial + (latest ? ": latest test is " + std::string(analysis::ToString(latest->outcome))
+                           : ": no test stored"));
+      continue;
+    }
+    const auto full = store.Test(latest->id, true);
+    if (full) golden.push_back(GoldenFromRecord(*full, serial));
+  }
+  return golden;
+}
+
+}  // namespace
+
 TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe& recipe,
                            const std::vector<std::string>& serials,
-                           const analysis::TeachOptions& options) {
+                           const analysis::TeachOptions& options, bool force_foreign) {
   TeachResult result;
   for (const std::string& serial : serials) {
     std::string why;
@@ -245,36 +279,30 @@ TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe&
       return result;
     }
   }
-  std::vector<analysis::GoldenUnit> golden;
   json skipped = json::array();
-  {
-    std::lock_guard<std::mutex> lock(store_mu);
-    for (const std::string& serial : serials) {
-      const auto latest = store.LatestOfSerial(serial);
-      if (!latest || latest->outcome == analysis::Outcome::kError ||
-          latest->outcome == analysis::Outcome::kAborted) {
-        skipped.push_back(serial + (latest ? ": latest test is " +
-                                                 std::string(analysis::ToString(latest->outcome))
-                                           : ": no test stored"));
-        continue;
-      }
-      const auto full = store.Test(latest->id, true);
-      if (full) golden.push_back(GoldenFromRecord(*full, serial));
-    }
+  const std::vector<analysis::GoldenUnit> golden =
+      StoredGoldenUnits(store, store_mu, serials, &skipped);
+  const json previous = {{"id", recipe.id}, {"version", recipe.version}, {"hash", recipe.hash}};
+  const std::vector<std::string> foreign = ForeignGoldenUnits(recipe, golden);
+  if (!foreign.empty() && !force_foreign) {
+    result.kind = TeachResult::Kind::kForeignUnits;
+    result.message = ForeignGoldenRefusal(recipe, foreign, "\"force_foreign\": true");
+    result.report = {{"foreign", foreign}, {"skipped", skipped}, {"previous", previous}};
+    return result;
   }
   analysis::TeachOptions for_motor = options;  // the bond index for the recipe's motor
   if (recipe.bond_index) for_motor.bond_residue_to_f0 = recipe.bond_index->residue_to_f0;
   const analysis::TeachSummary summary = analysis::TeachLimits(recipe.limits, golden, for_motor);
   result.report = TeachSummaryJson(summary, options);
   result.report["skipped"] = skipped;
-  result.report["previous"] = {
-      {"id", recipe.id}, {"version", recipe.version}, {"hash", recipe.hash}};
+  result.report["previous"] = previous;
+  result.report["foreign_forced"] = foreign;
   if (!summary.usable) {
     result.kind = TeachResult::Kind::kNotUsable;
     result.message = summary.message;
     return result;
   }
-  const json proposed = TaughtRecipeJson(recipe, summary, options);
+  const json proposed = TaughtRecipeJson(recipe, summary, options, foreign);
   try {
     const Recipe checked = ParseRecipe(proposed, "taught recipe");
     result.report["recipe"] = proposed;

@@ -47,6 +47,11 @@ inline constexpr double kForeignF0Share = 0.15;
 inline constexpr double kForeignFactor = 1.5;
 std::vector<std::string> ForeignGoldenUnits(const Recipe& recipe,
                                             const std::vector<analysis::GoldenUnit>& golden);
+// The refusal of ForeignGoldenUnits' findings, one text for `eol teach` and POST /api/teach:
+// "the golden units are not recipe <id>'s motor: <each finding>; teach a recipe made for their
+// motor, or <how_to_force> to teach this one from them (recorded in the taught recipe)".
+std::string ForeignGoldenRefusal(const Recipe& recipe, const std::vector<std::string>& foreign,
+                                 const std::string& how_to_force);
 
 // The recipe's JSON with the taught limits and masks, the winding reference relearned
 // (RelearnWindingReference), version + 1, a note in the description. `forced_foreign` holds
@@ -72,18 +77,24 @@ struct TeachResult {
     kBadSerial,      // a serial is malformed (message names it); nothing was read
     kNotUsable,      // the summary says the units cannot teach; report says why
     kInvalidRecipe,  // the taught recipe fails validation (message names the field)
+    kForeignUnits,   // the golden units are another motor's (ForeignGoldenUnits), not forced
   };
   Kind kind = Kind::kProposed;
-  std::string message;  // why, for kBadSerial and kInvalidRecipe
+  std::string message;  // why, for kBadSerial, kInvalidRecipe and kForeignUnits
   // kProposed and kNotUsable: TeachSummaryJson plus "skipped" (["<serial>: <why>"]) and
-  // "previous" ({id, version, hash} of `recipe`); kProposed adds "recipe" and "recipe_hash".
+  // "previous" ({id, version, hash} of `recipe`); kProposed adds "recipe", "recipe_hash" and
+  // "foreign_forced" (the findings taught from under force_foreign, else empty).
+  // kForeignUnits: {"foreign": [each finding], "skipped", "previous"}.
   nlohmann::json report;
 };
 
-// `store_mu` is held only while reading `store`, not while teaching.
+// `store_mu` is held only while reading `store`, not while teaching. Golden units of another
+// motor (ForeignGoldenUnits) are refused (kForeignUnits, ForeignGoldenRefusal) unless
+// `force_foreign`: then taught, and the proposed recipe records it (TaughtRecipeJson), as
+// `eol teach --force-foreign` does.
 TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe& recipe,
                            const std::vector<std::string>& serials,
-                           const analysis::TeachOptions& options);
+                           const analysis::TeachOptions& options, bool force_foreign = false);
 
 // Detectability options for the recipe's excitation and fit; `k_fixture_nm_per_rad` > 0
 // replaces the chain's fixture spring; the good-unit spread is the recipe's two-sided limits

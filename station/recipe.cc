@@ -360,7 +360,8 @@ void RequireNominalPasses(const JsonObject& o, const Recipe& r,
   o.Require(v.outcome == analysis::Outcome::kPass, "nominal",
             "the recipe's own nominal motor (the good motor it expects) fails its limits: " + why +
                 ". The limits and the nominal describe different motors: teach the limits from "
-                "this motor's golden units (eol teach) or correct the nominal");
+                "this motor's golden units (eol teach) or correct the nominal (`eol recipe-new "
+                "--golden` calibrates it to measured good units)");
   const ConditionWindows& w = r.conditions;
   if (w.r_ref_ohm <= 0.0) return;
   const double t = WindingTemperatureC(n.r_ohm, w.r_ref_ohm, w.t_ref_c);

@@ -29,6 +29,7 @@ void AddPodCommand(CLI::App& app);
 void AddRecipeApproveCommand(CLI::App& app);
 void AddPlantBenchCommand(CLI::App& app);
 void AddDesignExcitationCommand(CLI::App& app);
+void AddRecipeNewCommand(CLI::App& app);
 void AddDbBenchCommand(CLI::App& app);
 
 }  // namespace eol::station::cli

@@ -17,6 +17,7 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/recipe.h"
+#include "station/recipe_design.h"
 
 namespace eol::station::cli {
 namespace {
@@ -58,12 +59,7 @@ void Scale(analysis::Limit& window, double factor) {
 Recipe Designed(const Recipe& recipe, const analysis::ExcitationDesign& d,
                 const analysis::ExcitationRequirement& requirement,
                 const analysis::ExcitationDrive& own) {
-  Recipe next = recipe;
-  next.excitation = d.excitation;
-  next.periods = d.chosen.periods;
-  next.transient_periods = 0;
-  next.analysis.frf_method = analysis::FrfMethod::kTransientLpm;
-  next.analysis.frf.transient_periods = 0;
+  Recipe next = WithDesignedExcitation(recipe, d);
   Scale(next.conditions.excitation_v_rms, d.chosen.v_rms / own.v_rms);
   Scale(next.conditions.excitation_a_rms, d.chosen.a_rms / own.a_rms);
   next.excitation_design = requirement;

@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   eol::station::cli::AddCycleBenchCommand(app);
   eol::station::cli::AddDbBenchCommand(app);
   eol::station::cli::AddDesignExcitationCommand(app);
+  eol::station::cli::AddRecipeNewCommand(app);
   eol::station::cli::AddPodCommand(app);
   eol::station::cli::AddRecipeApproveCommand(app);
   eol::station::cli::AddPlantBenchCommand(app);

@@ -67,11 +67,7 @@ int RunTeach(const TeachArgs& a) {
   progress.reset();  // ends the line before the results
   const std::vector<std::string> foreign = ForeignGoldenUnits(recipe, golden);
   if (!foreign.empty()) {
-    std::string why = "the golden units are not recipe " + recipe.id + "'s motor:";
-    for (const std::string& f : foreign) why += " " + f + ";";
-    why +=
-        " teach a recipe made for their motor, or --force-foreign to teach this one from them "
-        "(recorded in the taught recipe)";
+    const std::string why = ForeignGoldenRefusal(recipe, foreign, "--force-foreign");
     if (!a.force_foreign) {
       std::cerr << "eol teach: refused: " << why << std::endl;
       if (a.json)

@@ -136,7 +136,9 @@ void PostTeach(ApiContext& c, const httplib::Request& req, httplib::Response& re
       body["serials"].empty())
     return Send(res, BadRequest("bad_request", "body must be {\"serials\": [\"...\", ...]}"));
   analysis::TeachOptions options;
+  bool force_foreign = false;
   try {
+    force_foreign = body.value("force_foreign", false);
     options.method = body.value("method", options.method);
     options.confidence = body.value("confidence", options.confidence);
     options.coverage = body.value("coverage", options.coverage);
@@ -153,7 +155,7 @@ void PostTeach(ApiContext& c, const httplib::Request& req, httplib::Response& re
     serials.push_back(s.get<std::string>());
   }
   const auto recipe = c.handlers.current_recipe();
-  Send(res, TeachReply(TeachFromStore(*c.db, c.db_mu, *recipe, serials, options)));
+  Send(res, TeachReply(TeachFromStore(*c.db, c.db_mu, *recipe, serials, options, force_foreign)));
 }
 
 }  // namespace
@@ -165,6 +167,12 @@ HttpReply TeachReply(const TeachResult& result) {
       return {200, result.report};
     case Kind::kNotUsable:
       return {422, result.report};
+    case Kind::kForeignUnits: {  // the error, and the findings beside it
+      HttpReply reply =
+          ToReply({ApiErrorKind::kUnprocessable, "foreign_golden_units", result.message});
+      reply.body.update(result.report);
+      return reply;
+    }
     case Kind::kBadSerial:
       return ToReply({ApiErrorKind::kBadRequest, "bad_serial", result.message});
     case Kind::kInvalidRecipe:

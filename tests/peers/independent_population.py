@@ -52,6 +52,18 @@ section 3), var Z = |Z|^2 / P (s_U^2 / |U|^2 + s_I^2 / |I|^2 - 2 Re(s_UI / (U I*
 sample (co)variances pooled over 11 neighbouring lines (4 periods alone give 3 degrees of
 freedom per line).
 
+Second motor (--motor pmsm-8pole-heavy, issue 37): another design drawn by the same physics
+and spreads, eight heavier magnets on a heavier rotor (magnets 1e-5 each, pole body 6.4e-5,
+hub 3e-5, clamp collar 8.7e-6 kg m^2; bonds 2060, bridges 8 x 1230, shaft 9800, fixture
+4420 N m/rad, loss factors at w_ref = 2 pi 588 rad/s) and another winding (R 1.1 ohm,
+L 4.5 mH, T 0.09 N m/A): the good rotor rings near 588 Hz in its fixture, about 50 % above
+the ten-pole one. Its measurement is the excitation its recipe plays (--f-lo, --f-hi,
+--spacing, --peak-v, --periods, --crest; the lines at whole multiples of the spacing inside
+the band; defaults per motor: 280-1180 Hz at 6.8847 Hz, 8 V peak, 2 periods, crest 1.525, the
+excitation of recipes/pmsm-8pole-heavy.json within a percent: its line grid follows the golden
+units' Q). The classes keep their names: three_soft is three of the
+eight magnets, all_soft all eight.
+
 Output in --out: unit-NNNN.csv (f_hz,re_ohm,im_ohm,sigma_ohm), and truth.csv: unit, class,
 first_mode_hz (lowest mode of the undamped chain; with a very soft bond it is that
 magnet's local mode), k_fixture, defect_size (the stiffness loss a: that of the one soft
@@ -80,6 +92,25 @@ NOMINAL = dict(
     r_ohm=0.5, l_h=2.0e-3, t_nm_per_a=0.05)
 
 CLASSES = {"good": 0, "one_soft": 1, "three_soft": 3, "all_soft": MAGNETS}
+
+# The second motor (docstring): its own nominal parts, the same materials' loss factors.
+NOMINAL_8POLE = dict(NOMINAL, j_magnet=1.0e-5, j_pole=6.4e-5, j_hub=3.0e-5, j_clamp=8.7e-6,
+                     k_bond=2060.0, k_bridge=1230.0, k_shaft=9800.0, k_fixture=4420.0,
+                     r_ohm=1.1, l_h=4.5e-3, t_nm_per_a=0.09)
+# name: (nominal parts, magnets, w_ref, measurement defaults f_lo, f_hi, spacing, peak, periods,
+# crest)
+MOTORS = {
+    "pmsm-10pole": (NOMINAL, 10, 390.0, (200.0, 800.0, 1.0, 2.0, 4, 1.7)),
+    "pmsm-8pole-heavy": (NOMINAL_8POLE, 8, 588.0, (280.0, 1180.0, 6.8847, 8.0, 2, 1.525)),
+}
+
+
+def select_motor(name):
+    """Makes `name` the motor every function below draws."""
+    global NOMINAL, MAGNETS, W_REF, CLASSES
+    NOMINAL, MAGNETS, w_ref, _ = MOTORS[name]
+    W_REF = 2.0 * np.pi * w_ref
+    CLASSES = {"good": 0, "one_soft": 1, "three_soft": 3, "all_soft": MAGNETS}
 
 
 def chain_matrices(p, r_bond, rigid=False):
@@ -180,6 +211,7 @@ def draw_bonds(rng, soft_count, loss_lo, loss_hi):
 
 def measure(z, rng, periods=4, f_lines=601, peak_v=2.0, crest=1.7, s_u=2e-3, s_i=1e-3,
             n_samples=8000, pool=11):
+    # n_samples: samples per period (8 kHz / line spacing).
     """Z estimate and its sigma from P periods of a periodic multisine (docstring)."""
     k = np.arange(1, z.size + 1)
     amp = peak_v / (crest * np.sqrt(f_lines / 2.0))
@@ -221,12 +253,27 @@ def main():
     ap.add_argument("--poor-loss-factor", type=float, default=NOMINAL["eta_poor"],
                     help="loss factor of a soft bond (default %g; the good adhesive's is %g)"
                     % (NOMINAL["eta_poor"], NOMINAL["eta_bond"]))
+    ap.add_argument("--motor", choices=sorted(MOTORS), default="pmsm-10pole",
+                    help="the motor type drawn (default pmsm-10pole)")
+    for opt, i, kind in (("--f-lo", 0, float), ("--f-hi", 1, float), ("--spacing", 2, float),
+                         ("--peak-v", 3, float), ("--periods", 4, int), ("--crest", 5, float)):
+        ap.add_argument(opt, type=kind, default=None, dest=opt[2:].replace("-", "_"),
+                        help="measurement (default: the motor's, see above)")
     ap.add_argument("--nominal", action="store_true",
                     help="print the nominal chain's first modes and exit")
     ap.add_argument("--loss-table", action="store_true",
                     help="print the nominal first mode against the stiffness loss and exit")
     a = ap.parse_args()
-    f_hz = np.arange(200.0, 800.0 + 0.5, 1.0)
+    select_motor(a.motor)
+    defaults = MOTORS[a.motor][3]
+    for i, name in enumerate(("f_lo", "f_hi", "spacing", "peak_v", "periods", "crest")):
+        if getattr(a, name) is None:
+            setattr(a, name, defaults[i])
+    if not (0 < a.f_lo < a.f_hi < 4000.0 and a.spacing > 0 and a.peak_v > 0 and a.periods >= 2):
+        ap.error("measurement: need 0 < f-lo < f-hi < 4000, spacing > 0, peak-v > 0, periods >= 2")
+    f_hz = a.spacing * np.arange(np.ceil(a.f_lo / a.spacing - 1e-9),
+                                 np.floor(a.f_hi / a.spacing + 1e-9) + 1.0)
+    sample_rate = 8000.0
 
     if a.nominal:
         p = nominal_parts()
@@ -239,7 +286,7 @@ def main():
     if a.loss_table:
         p = nominal_parts()
         good = first_mode_hz(p, np.ones(MAGNETS))
-        print("loss  all ten  three  one   (first mode Hz in the fixture; good %.1f Hz)" % good)
+        print("loss  all     three  one   (first mode Hz in the fixture; good %.1f Hz)" % good)
         for loss in (0.2, 0.4, 0.6, 0.8, 0.85, 0.9, 0.92, 0.94, 0.95, 0.96, 0.98, 0.99):
             modes = []
             for n in (MAGNETS, 3, 1):
@@ -268,12 +315,14 @@ def main():
             p = draw_parts(rng)
             p["eta_poor"] = a.poor_loss_factor
             r, size = draw_bonds(rng, CLASSES[cls], a.loss_lo, a.loss_hi)
-            zh, sigma = measure(impedance(p, r, f_hz), rng)
+            zh, sigma = measure(impedance(p, r, f_hz), rng, periods=a.periods, f_lines=f_hz.size,
+                                peak_v=a.peak_v, crest=a.crest,
+                                n_samples=int(round(sample_rate / a.spacing)))
             name = "unit-%04d" % (idx + 1)
             with open(os.path.join(a.out, name + ".csv"), "w") as f:
                 f.write("f_hz,re_ohm,im_ohm,sigma_ohm\n")
                 for fk, zk, sk in zip(f_hz, zh, sigma):
-                    f.write("%.1f,%.9g,%.9g,%.6g\n" % (fk, zk.real, zk.imag, sk))
+                    f.write("%.4f,%.9g,%.9g,%.6g\n" % (fk, zk.real, zk.imag, sk))
             tw.writerow([name, cls, "%.3f" % first_mode_hz(p, r), "%.2f" % p["k_fixture"],
                          "%.4f" % size] + ["%.4f" % x for x in r] + ["%.4f" % (1.0 - x) for x in r]
                         + ["%.3f" % p["clamp_pressure_bar"]])

@@ -57,6 +57,7 @@ def run_population(a, seed, workdir):
               "--loss-lo", str(a.loss_lo), "--loss-hi", str(a.loss_hi)]
     if a.poor_loss_factor is not None:
         counts += ["--poor-loss-factor", str(a.poor_loss_factor)]
+    counts += ["--motor", a.motor] + a.generator_arg
     subprocess.run([sys.executable, os.path.join(HERE, "independent_population.py"),
                     "--out", pop, "--seed", str(seed)] + counts, check=True)
     with open(os.path.join(pop, "truth.csv")) as f:
@@ -107,6 +108,10 @@ def main():
                     help="largest bond stiffness loss of a soft magnet (generator)")
     ap.add_argument("--poor-loss-factor", type=float,
                     help="loss factor of a soft bond (generator; default: the generator's)")
+    ap.add_argument("--motor", default="pmsm-10pole",
+                    help="the generator's motor type (independent_population.py --motor)")
+    ap.add_argument("--generator-arg", action="append", default=[],
+                    help="extra argument passed to independent_population.py (repeat)")
     ap.add_argument("--hits", help="write the per-unit hit/miss CSV here and fit POD with eol pod")
     ap.add_argument("--pod-svg", help="with --hits: the POD figure (eol pod --pod-svg)")
     ap.add_argument("--clamp-pressure", action="store_true",

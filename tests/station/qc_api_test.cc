@@ -40,6 +40,7 @@ class QcApi : public ::testing::Test {
     config["sim"] = {{"clamp_close_s", 0.02},
                      {"clamp_open_s", 0.02},
                      {"population", {{"defect_share", 0.0}, {"seed", 5}}}};
+    Configure(config);
     std::ofstream(dir_ / "station.json") << config.dump();
     station_ = std::make_unique<ChildProcess>(
         std::vector<std::string>{EOL_BINARY, "station", "--config", dir_ / "station.json"});
@@ -49,6 +50,9 @@ class QcApi : public ::testing::Test {
     http_ = std::make_unique<httplib::Client>("127.0.0.1", PortFromReadyLine(station_->output()));
     http_->set_read_timeout(120, 0);
   }
+
+  // Changes the station's configuration before it starts.
+  virtual void Configure(nlohmann::json& /*config*/) {}
 
   // Runs a test of `serial` and returns its stored outcome, or why there is none.
   std::string Test(const std::string& serial) {
@@ -124,6 +128,59 @@ TEST_F(QcApi, EngineersTeachFromStoredUnitsAndTheProposalIsAValidNextVersion) {
   EXPECT_EQ(in_use["hash"], approved["hash"]);
   EXPECT_NE(in_use["hash"], taught["recipe_hash"]) << "the approval is part of the recipe";
   EXPECT_EQ(Test("AFTER-TEACH"), "PASS");
+}
+
+// A line of another motor: the simulated rotors ring near 565 Hz, about 45 % above the
+// ten-pole recipe's 395 Hz (they FAIL its limits, and are stored).
+class QcApiForeignMotor : public QcApi {
+ protected:
+  void Configure(nlohmann::json& config) override {
+    config["sim"]["population"]["f_fixture_hz"] = 565.0;
+  }
+};
+
+// Issue 37: POST /api/teach refuses golden units of another motor as `eol teach` does (the
+// same finding and sentence, station/qc_service.h ForeignGoldenRefusal), naming the quantity
+// and by how much; "force_foreign": true teaches from them and the proposal records it.
+TEST_F(QcApiForeignMotor, TeachRefusesGoldenUnitsOfAnotherMotorUnlessForced) {
+  nlohmann::json serials = nlohmann::json::array();
+  for (int i = 0; i < 8; ++i) {
+    const std::string serial = "OTHER-" + std::to_string(i);
+    ASSERT_EQ(Test(serial), "FAIL") << station_->output();
+    serials.push_back(serial);
+  }
+  nlohmann::json body = {{"serials", serials}, {"allow_few_units", true}};
+  auto res = http_->Post("/api/teach", Bearer(kEngineer), body.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 422) << res->body;
+  const auto refused = nlohmann::json::parse(res->body);
+  EXPECT_EQ(refused["error"]["code"], "foreign_golden_units") << res->body;
+  const std::string message = refused["error"]["message"].get<std::string>();
+  EXPECT_NE(message.find("the golden units are not recipe pmsm-10pole's motor: resonance_f_hz: "
+                         "the golden units' median 56"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("% from the recipe's 395 Hz (more than 15 %)"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("\"force_foreign\": true"), std::string::npos) << message;
+  ASSERT_EQ(refused["foreign"].size(), 1u) << res->body;
+  EXPECT_FALSE(refused.contains("recipe"));
+
+  body["force_foreign"] = true;
+  res = http_->Post("/api/teach", Bearer(kEngineer), body.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const auto taught = nlohmann::json::parse(res->body);
+  EXPECT_EQ(taught["foreign_forced"], refused["foreign"]);
+  EXPECT_NE(taught["recipe"]["description"].get<std::string>().find(
+                "golden units of another motor than the recipe expects"),
+            std::string::npos);
+  EXPECT_EQ(taught["recipe"]["approval"]["note"],
+            "taught from golden units of another motor, forced (--force-foreign)");
+  body["force_foreign"] = "yes";
+  res = http_->Post("/api/teach", Bearer(kEngineer), body.dump(), "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400) << res->body;
 }
 
 TEST_F(QcApi, DetectabilityReportsEveryDefectClassAndRejectsBadParameters) {
