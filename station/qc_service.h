@@ -37,7 +37,7 @@ struct WindingReference {
 WindingReference RelearnWindingReference(const Recipe& recipe,
                                          const analysis::TeachSummary& summary);
 
-// Golden units of another motor (issue 37): the medians of the golden units' resonance_f_hz,
+// Golden units of another motor: the medians of the golden units' resonance_f_hz,
 // winding_r_ohm, winding_l_h and motional_residue_ohm_per_s against what the recipe expects:
 // the centre of its two-sided limit on each (else its excitation_design nominal motor), and
 // for f0 also its analysis f0 window. One sentence per quantity that disagrees: f0 more than

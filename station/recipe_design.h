@@ -1,4 +1,4 @@
-// A recipe designed from a motor's design data (`eol recipe-new`, issue 37), and the designed
+// A recipe designed from a motor's design data (`eol recipe-new`), and the designed
 // excitation written into a recipe (shared with `eol design-excitation`).
 //
 // ProposeRecipe derives, from the motor's chain (analysis/model/chain_prediction.h) or from

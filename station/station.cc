@@ -121,7 +121,7 @@ void Station::ConnectDrivers() {
   board_->ClearCause(NotReadyCause::kDriversNotConnected);  // tried: their own causes stand
 }
 
-// Shift continuity (issue 36): "Last results" and the day's counts as the store holds them,
+// Shift continuity: "Last results" and the day's counts as the store holds them,
 // so that a restart shows what the shift did so far.
 void Station::RestoreBoard() {
   const auto now = std::chrono::system_clock::now();

@@ -42,7 +42,7 @@ class StatusBoard {
   void OnState(const std::string& serial, SeqState state, const std::string& detail);
   // A finished, stored record. The counts start again on a new local day.
   void OnVerdict(const db::TestRecord& record);
-  // Shift continuity (issue 36), at start before any verdict: the newest stored tests
+  // Shift continuity, at start before any verdict: the newest stored tests
   // (newest first; the last 20 are kept, as OnVerdict keeps them) and the counts of `day`
   // (LocalDay) so far, as the store holds them. The lamp ("last") stays empty: no unit was
   // tested since the start.

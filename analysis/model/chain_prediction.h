@@ -1,4 +1,4 @@
-// What a motor's own torsional chain predicts for its end-of-line test (issue 37), so that a
+// What a motor's own torsional chain predicts for its end-of-line test, so that a
 // recipe for a new motor type is derived from its design data (`eol recipe-new`,
 // station/recipe_design.h) instead of from the ten-pole motor's constants:
 //   - the mode the test fits: of the good rotor, and of rotors with half and with all of their

@@ -37,7 +37,7 @@ namespace eol::analysis {
 // d ln A / (-d ln f0) of a softer bond (all magnets): the physics direction of the defect, of
 // the ten-pole motor (its chain and the independent generator). A property of the motor's
 // chain, not a constant: another chain has another ratio (a heavier rotor with another
-// winding: 3.5-4 near its detection limit, issue 37). The recipe states it per motor
+// winding: 3.5-4 near its detection limit). The recipe states it per motor
 // ("bond_index": {"residue_to_f0": ...}); this value is its default.
 inline constexpr double kResidueToF0 = 12.0;
 inline constexpr double kMaxResidueToF0 = 1000.0;

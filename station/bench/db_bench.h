@@ -11,7 +11,7 @@
 //   - the export of one day of tests (Tests, keyset pages of 10,000, with and without curves)
 //     and of one day's measurement rows (MeasurementRows): rows per second;
 // and the file's size: bytes per test and the growth per year at the line's rate. Last, what
-// the store's guards cost at that size (issue 34): opening it (PRAGMA quick_check, read-only
+// the store's guards cost at that size: opening it (PRAGMA quick_check, read-only
 // and as the station's writer) and finishing a test as the station does (BeginTest +
 // FinishTest, one at a time), with and without the checkpoint after each verdict; these
 // `finish_samples` x 2 tests ("GUARD-...") are added after every other figure is taken, then

@@ -1,6 +1,6 @@
 // Capacity benchmark of the station's HTTP API (issue 14): the latency of GET /api/status
 // while `streams` event streams stay open, `slow` slow connections dribble request heads
-// (issue 34) and `clients` clients poll at once, and the
+// and `clients` clients poll at once, and the
 // process's peak memory while one client sends a chunked body of `chunked_bytes` to
 // POST /api/tests. The API is the daemon's (HttpApi on the real server and gate, a real SQLite
 // store), in this process on 127.0.0.1; the clients are threads of the same process, so the
@@ -17,7 +17,7 @@ struct HttpBenchOptions {
   int streams = 100;  // open GET /api/events connections during the poll
   int clients = 200;  // concurrent pollers of GET /api/status, one request each at a time
   int slow = 0;       // slow connections during the poll: a request head, one byte every 500 ms,
-                      // reconnecting when the server cuts one off (issue 34)
+                      // reconnecting when the server cuts one off
   double seconds = 10.0;                             // duration of the poll
   std::size_t chunked_bytes = std::size_t{1} << 30;  // the chunked body offered (1 GiB)
 };

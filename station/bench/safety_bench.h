@@ -3,7 +3,7 @@
 // relay opening, over many tests on the simulated bench with the real sequencer and watchdog.
 // Target (issue 5): excitation off within 50 ms.
 //
-// A fifth row, "station_stops", measures the controller's side (issue 34): the station
+// A fifth row, "station_stops", measures the controller's side: the station
 // closes the relay, writes station_alive for 100..400 ms, then stops dead as a SIGKILL
 // leaves it; the reaction is from its last alive write to the relay seen open (polled every
 // ms), against the controller's alive timeout of 250 ms. Its `errors` counts the trials in

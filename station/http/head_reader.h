@@ -1,5 +1,5 @@
 // Reads each HTTP request's head (and a small body) on one thread with poll(), before a
-// request worker is taken (issue 34: sixteen slow connections, one per worker, timed the API
+// request worker is taken (sixteen slow connections, one per worker, timed the API
 // out; two hundred answered /api/status once in fourteen tries). A connection reaches a
 // worker only with its whole head (request line and headers, up to the empty line) and, when
 // it has a Content-Length of at most `prefetch_body_bytes`, its whole body, in hand.

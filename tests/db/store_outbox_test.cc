@@ -59,7 +59,7 @@ TEST(StoreOutbox, EveryStoredRecordQueuesOnceInOrderAndCursorsAreIndependent) {
 }
 
 // A refused finish writes none of the record, but the test does not stay RUNNING: it is
-// finished as ERROR and queued as such (issue 34); a test cut short by a crash is recovered
+// finished as ERROR and queued as such; a test cut short by a crash is recovered
 // as ABORTED at the next open and queued then.
 TEST(StoreOutbox, AFailedFinishQueuesItsErrorAndRecoveredTestsAreQueued) {
   eol::testing::TempDir dir;

@@ -65,7 +65,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     req.body = text;
     const auto parsed = eol::station::http::ParseBody(req);
     if (const ApiError* e = std::get_if<ApiError>(&parsed)) {
-      // too_deep: nesting beyond station/http/request.h's depth limit (issue 34's stack).
+      // too_deep: nesting beyond station/http/request.h's depth limit.
       if (e->code != "bad_json" && e->code != "too_large" && e->code != "too_deep")
         Finding("ParseBody refused with " + e->code);
     } else {

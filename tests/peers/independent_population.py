@@ -52,7 +52,7 @@ section 3), var Z = |Z|^2 / P (s_U^2 / |U|^2 + s_I^2 / |I|^2 - 2 Re(s_UI / (U I*
 sample (co)variances pooled over 11 neighbouring lines (4 periods alone give 3 degrees of
 freedom per line).
 
-Second motor (--motor pmsm-8pole-heavy, issue 37): another design drawn by the same physics
+Second motor (--motor pmsm-8pole-heavy): another design drawn by the same physics
 and spreads, eight heavier magnets on a heavier rotor (magnets 1e-5 each, pole body 6.4e-5,
 hub 3e-5, clamp collar 8.7e-6 kg m^2; bonds 2060, bridges 8 x 1230, shaft 9800, fixture
 4420 N m/rad, loss factors at w_ref = 2 pi 588 rad/s) and another winding (R 1.1 ohm,

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The information limit beside the taught recipe (issue 37): what the best linear rule does
+"""The information limit beside the taught recipe: what the best linear rule does
 with labelled units of the independent generator, and what the station's taught recipe does
 with the same units, per defect class.
 

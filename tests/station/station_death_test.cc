@@ -1,4 +1,4 @@
-// The station dying in excitation (issue 34): `eol station` in its own process on `eol
+// The station dying in excitation: `eol station` in its own process on `eol
 // fixture-sim` over Modbus TCP. Killed (SIGKILL) or frozen (SIGSTOP) while the relay is
 // closed, it sends nothing more, and the fixture controller opens the relay by itself within
 // its alive timeout (250 ms after the last station_alive), as a third Modbus client reading

@@ -1,4 +1,4 @@
-// Live health on the operator page (issue 36; tests/peers/operator_page_test.cc): the fixture
+// Live health on the operator page (tests/peers/operator_page_test.cc): the fixture
 // controller stops and returns while the station idles, then the daemon hangs, dies and is
 // started again, and the page must follow each within its bound. The C++ test does each step
 // when this script asks for it: the script prints "step: NAME", the test acts and writes
