@@ -499,6 +499,16 @@ std::string Gain(double v) {
   return os.str();
 }
 
+// The calibration under `shift` needs a parameter at kOutsideTolerances or more: a structure
+// may hide in it (a fixture spring taken up by the stiffness), so the pairs are tried.
+bool AtTheEdge(const EffectFitter& fitter, const Eigen::VectorXd& shift) {
+  const TolerancePrior* prior = fitter.prior();
+  if (!prior || shift.size() != prior->size()) return false;
+  for (const ToleranceDeviation& d : prior->Physical(shift))
+    if (std::abs(d.tolerances) >= kOutsideTolerances) return true;
+  return false;
+}
+
 // The pair step (diagnosis.h "Which" 4): a pair wins only when each member is significant
 // against the calibrated single of the other, in sample (BIC) and on held-out lines. Returns the
 // new winner (or `best`); the pairs go into *ranking, the pairs that beat the winner's evidence
@@ -712,7 +722,8 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
   std::map<std::string, HeldOutGap> heldout;
   std::vector<GapRival> rejected;
   if (best && o.try_pairs && library.size() >= 2 &&
-      !Consistent(Pool(best->nominal, best->effects, formed), o))
+      (!Consistent(Pool(best->nominal, best->effects, formed), o) ||
+       AtTheEdge(fitter, best->shift)))
     winner = ChoosePair(fitter, singles, seeds, *best, none, o, &heldout, &ranking, &rejected);
   std::stable_sort(ranking.begin(), ranking.end(), BetterRank);
   s.ranking = ranking;

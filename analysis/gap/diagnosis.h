@@ -36,7 +36,8 @@
 //      answer is "none" when the nominal's residual is consistent with the noise (no
 //      significant band, and noise test z <= noise_z_max or sigma_scale <= max_sigma_scale)
 //      and "unexplained" when it is not;
-//   4. when the winner still leaves a residual inconsistent with the noise, pairs are fitted
+//   4. when the winner still leaves a residual inconsistent with the noise, or its calibration
+//      needs a parameter at 2 tolerances or more (a structure may hide in it), pairs are fitted
 //      (the pair_candidates best singles among themselves, and the winner with every other
 //      effect); a plausible pair with a better score wins when each member is significant
 //      against the calibrated single of the other: the pair's BIC is min_score_gain below that
