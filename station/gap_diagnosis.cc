@@ -161,6 +161,19 @@ void DiagnoseGapReport(const GapRunOptions& o, GapReport* r) {
   analysis::GapOptions go;
   go.try_pairs = o.try_pairs;
   go.effects = o.effects;
+  go.calibrate = o.calibrate;
+  r->tolerance_source = "default";
+  if (r->simulation.tolerances) {
+    go.tolerances = *r->simulation.tolerances;
+    r->tolerance_source = "simulation";
+  }
+  if (!o.tolerances.empty()) {
+    std::string why;
+    if (!analysis::ParseTolerances(o.tolerances, &go.tolerances, &why))
+      throw std::invalid_argument("--tolerances: " + why);
+    r->tolerance_source = "given";
+  }
+  r->tolerances = go.tolerances;
   r->gap = analysis::DiagnoseGap(r->calibration.nominal, units, go);
   if (!r->gap.usable) throw GapNotUsable(r->gap.message);
   // A residual a little above the files' sigma with nothing to explain it: the usual cause is
@@ -250,7 +263,8 @@ io::Chart GapChart(const GapReport& r) {
   for (std::size_t k = 0; k < f.size(); ++k) {
     const std::complex<double> hm = meas.frf.value[k];
     const std::complex<double> hs = n.At(f[k]);
-    const std::complex<double> hc = analysis::EvaluateNetwork(n, r.gap.winner, f[k]);
+    const std::complex<double> hc =
+        analysis::EvaluateNetwork(r.gap.nominal_after, r.gap.winner, f[k]);
     if (mobility) {
       m1.push_back(std::abs(hm));
       s1.push_back(std::abs(hs));

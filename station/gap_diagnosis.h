@@ -41,6 +41,12 @@ struct GapRunOptions {
   double fallback_inertia_kg_m2 = 0.0;        // impedance only: the recipe's rotor inertia
   std::vector<analysis::EffectKind> effects;  // only these; empty: every effect
   bool try_pairs = true;
+  // The nominal calibrated under the design's tolerances (analysis/gap/tolerance.h) in every
+  // fit; false: kept at the simulation's values (--fixed-nominal).
+  bool calibrate = true;
+  // "name=value,..." over the simulation's tolerances (a motor JSON's), else the defaults
+  // (--tolerances); a bad one throws std::invalid_argument naming it.
+  std::string tolerances;
 };
 
 // The calibration or the diagnosis cannot be used (the message says why, naming the input).

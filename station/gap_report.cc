@@ -46,6 +46,14 @@ json Bands(const std::vector<analysis::BandGap>& bands) {
   return j;
 }
 
+// Physical offsets (analysis/gap/tolerance.h): {name: {offset, tolerances}}.
+json Offsets(const std::vector<analysis::ToleranceDeviation>& offsets) {
+  json j = json::object();
+  for (const auto& d : offsets)
+    j[d.name] = {{"offset", Num(d.offset)}, {"tolerances", Num(d.tolerances)}};
+  return j;
+}
+
 std::string Fmt(const char* format, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, v);
@@ -77,6 +85,24 @@ json GapReportJson(const GapReport& r) {
   j["effects"] = names;
   j["rival"] = g.rival;
   j["rival_score_gap"] = g.rival.empty() ? json(nullptr) : Num(g.rival_score_gap);
+  json rivals = json::array();
+  for (const auto& x : g.rivals)
+    rivals.push_back({{"effect", x.effect}, {"score_gap", Num(x.score_gap)}, {"note", x.note}});
+  j["rivals"] = rivals;
+  j["calibration_offsets"] = Offsets(g.calibration);
+  j["tolerances"] = {{"r", r.tolerances.r},
+                     {"l", r.tolerances.l},
+                     {"torque_constant", r.tolerances.torque_constant},
+                     {"inertia", r.tolerances.inertia},
+                     {"stiffness", r.tolerances.stiffness},
+                     {"damping", r.tolerances.damping_factor},
+                     {"daq_gain", r.tolerances.daq_gain},
+                     {"source", r.tolerance_source},
+                     {"calibrate", !g.calibration.empty()}};
+  j["beyond_tolerance"] = {{"found", g.beyond.found},
+                           {"g", Num(g.beyond.g_beyond)},
+                           {"cost_gain", Num(g.beyond.cost_gain)},
+                           {"offsets", Offsets(g.beyond.offsets)}};
   const analysis::RankedEffect* w = Winner(g);
   j["params"] = w ? ParamsValue(w->params) : json::object();
   j["gap_before"] = Num(g.gap_before);
@@ -141,6 +167,16 @@ json GapReportJson(const GapReport& r) {
     for (const auto& e : sp.effect)
       eff.push_back({{"effect", analysis::ToString(e.kind)}, {"params", e.params}});
     j["split"] = {{"g_nominal", Num(sp.g_nominal)},
+                  {"g_within_tolerance", Num(sp.g_within)},
+                  {"g_beyond_tolerance", Num(sp.g_beyond)},
+                  {"g_structure", Num(sp.g_structure)},
+                  {"share_within_tolerance", Num(sp.share_within)},
+                  {"share_beyond_tolerance", Num(sp.share_beyond)},
+                  {"share_structure_within_tolerance", Num(sp.share_structure_within)},
+                  {"share_left_within_tolerance", Num(sp.share_left_within)},
+                  {"heldout_g_within_tolerance", Num(sp.heldout_g_within)},
+                  {"heldout_g_beyond_tolerance", Num(sp.heldout_g_beyond)},
+                  {"heldout_g_structure", Num(sp.heldout_g_structure)},
                   {"g_refit", Num(sp.g_refit)},
                   {"g_refit_effect", Num(sp.g_refit_effect)},
                   {"share_calibration", Num(sp.share_calibration)},
@@ -195,9 +231,11 @@ json GapReportJson(const GapReport& r) {
   }
   j["score_rule"] =
       "cost = -2 ln L of the normalised residual (chi2, or the Student t's for sigma on few "
-      "degrees of freedom); an effect is there when its BIC = cost + p ln(2K) is at least 10 "
-      "below none's; which one: the lowest score = cost + Laplace Occam penalty - 2 ln(the "
-      "effect's prior odds, analysis/gap/diagnosis.h GapOptions::prior_odds)";
+      "degrees of freedom); every fit calibrates the nominal within the design's tolerances, "
+      "prior = their -2 ln p; an effect is there when its BIC = cost + prior + p ln(2K) is at "
+      "least 10 below the calibrated none's; which one: the lowest score = cost + prior + "
+      "Laplace Occam penalty - 2 ln(the effect's prior odds, analysis/gap/diagnosis.h "
+      "GapOptions::prior_odds)";
   j["residual_form"] = g.residual_form;
   j["residual_admittance_hz"] = g.admittance_hz;
   j["message"] = g.message;
@@ -258,9 +296,26 @@ std::string GapReportText(const GapReport& r) {
          << Fmt("%.3f", f.gap_after_refit) << " (calibration, not an unmodelled effect)\n";
   }
   os << "WHICH        " << g.effect << "\n";
-  if (!g.rival.empty())
-    os << "  rival      " << g.rival << ", evidence within " << Fmt("%.1f", g.rival_score_gap)
-       << " of the winner's: the data hardly tell the two apart\n";
+  for (const auto& x : g.rivals)
+    os << "  rival      " << x.effect << ", evidence " << Fmt("%+.1f", x.score_gap)
+       << " against the answer's: " << x.note << "\n";
+  if (!g.calibration.empty()) {
+    os << "  calibrated within the tolerances:";
+    for (const auto& d : g.calibration)
+      os << " " << d.name << " " << Fmt("%+.1f %%", 100.0 * d.offset) << " ("
+         << Fmt("%+.1f", d.tolerances) << ")";
+    os << "\n";
+  }
+  if (g.beyond.found) {
+    os << "  beyond the tolerances: a calibration with no prior reaches g "
+       << Fmt("%.3f", g.beyond.g_beyond) << " (-2 ln L " << Fmt("%.1f", g.beyond.cost_gain)
+       << " lower) with";
+    for (const auto& d : g.beyond.offsets)
+      if (std::abs(d.tolerances) >= 2.0)
+        os << " " << d.name << " " << Fmt("%+.1f %%", 100.0 * d.offset) << " ("
+           << Fmt("%+.1f", d.tolerances) << " tolerances)";
+    os << ": " << (g.winner.empty() ? "the finding" : "the alternative to the structure") << "\n";
+  }
   if (const analysis::RankedEffect* w = Winner(g)) {
     for (const auto& p : w->params) os << "               " << ParamText(p) << "\n";
   }
@@ -282,8 +337,20 @@ std::string GapReportText(const GapReport& r) {
   if (g.split.available) {
     const analysis::GapSplit& sp = g.split;
     auto pct = [](double v) { return std::isfinite(v) ? Fmt("%.1f %%", 100.0 * v) : "n/a"; };
-    os << "CALIBRATION AND STRUCTURE (share of the excess g^2 - E|r|^2)\n"
-       << "  nominal (simulation)                g " << Fmt("%.3f", sp.g_nominal) << "\n"
+    os << "CALIBRATION AND STRUCTURE (share of the excess g^2 - E|r|^2; held out "
+       << sp.heldout_method << " in brackets)\n"
+       << "  nominal (simulation)                g " << Fmt("%.3f", sp.g_nominal) << " ("
+       << Fmt("%.3f", sp.heldout_g_nominal) << ")\n"
+       << "  calibrated within the tolerances    g " << Fmt("%.3f", sp.g_within) << " ("
+       << Fmt("%.3f", sp.heldout_g_within) << ")   closes " << pct(sp.share_within) << "\n"
+       << "  + " << (g.winner.empty() ? std::string("no effect") : g.effect) << " (structure)   g "
+       << Fmt("%.3f", sp.g_structure) << " (" << Fmt("%.3f", sp.heldout_g_structure)
+       << ")   closes " << pct(sp.share_structure_within) << "; left " << pct(sp.share_left_within)
+       << "\n"
+       << "  or calibrated beyond them (no prior) g " << Fmt("%.3f", sp.g_beyond) << " ("
+       << Fmt("%.3f", sp.heldout_g_beyond) << ")   closes " << pct(sp.share_beyond)
+       << " on top of within\n"
+       << "  with no prior from the start:\n"
        << "  refit of the nominal's parameters   g " << Fmt("%.3f", sp.g_refit) << "   closes "
        << pct(sp.share_calibration) << " (calibration)\n"
        << "  + " << (g.winner.empty() ? std::string("no effect") : g.effect)

@@ -2,8 +2,10 @@
 //
 // JSON (stable names, SI units; NaN is written as null):
 //   quantity            "impedance" | "mobility"
-//   effect              the winner: an effect name, "a+b" for a pair, "none" (consistent with
-//                       the noise) or "unexplained" (not noise, but no candidate explains it)
+//   effect              the winner: an effect name, "a+b" for a pair, "none" (the nominal
+//                       calibrated within the design's tolerances is consistent with the
+//                       noise), "calibration_beyond_tolerance" (only a calibration beyond them
+//                       is) or "unexplained" (not noise, but no candidate explains it)
 //   effects             the winner's effect names (empty for none / unexplained)
 //   rival, rival_score_gap  another effect (as many members) whose evidence is within 4.6 of
 //                       the winner's (score minus the winner's): the data hardly tell them
@@ -33,7 +35,25 @@
 //                       simulation; inertia_source says where J_r came from (GapReport)
 //   refit               [{measurement, params {name: {value, sigma}}, gap_after_refit}]: the
 //                       nominal refitted to each measurement (not an unmodelled effect)
-//   split               calibration and structure apart (diagnosis.h GapSplit): {g_nominal,
+//   rivals              [{effect, score_gap, note}]: every rival answer with its evidence
+//                       (score minus the answer's) and why it is not the answer (a pair
+//                       rejected: which member is not significant, by how much)
+//   tolerances          {r, l, torque_constant, inertia, stiffness, damping, daq_gain, source}:
+//                       the prior's sds (damping a factor) and "default" | "simulation" |
+//                       "given"; calibrate false when the nominal was kept fixed
+//   calibration_offsets {name: {offset, tolerances}}: the physical offsets (r, l,
+//                       torque_constant, inertia, stiffness, damping, daq_gain; relative, and in
+//                       tolerances) the answer's calibration within the tolerances implies
+//                       (analysis/gap/tolerance.h); {} when the nominal is kept fixed
+//   beyond_tolerance    {found, g, cost_gain, offsets}: the nominal calibrated with no prior
+//                       (diagnosis.h CalibrationFinding); found: -2 ln L at least 10 lower than
+//                       within the tolerances and a parameter at 2 or more tolerances
+//   split               calibration and structure apart (diagnosis.h GapSplit): three ways
+//                       {g_within_tolerance, g_structure, g_beyond_tolerance,
+//                       share_within_tolerance, share_structure_within_tolerance,
+//                       share_left_within_tolerance, share_beyond_tolerance,
+//                       heldout_g_within_tolerance, heldout_g_structure,
+//                       heldout_g_beyond_tolerance}, and as before issue 38 {g_nominal,
 //                       g_refit, g_refit_effect, share_calibration, share_structure,
 //                       share_left, heldout_g_nominal, heldout_g_refit_effect, heldout_method,
 //                       refit {R_ohm, L_h, Rp_ohm, f0_hz, Q | gain_rad_per_s2_per_a,
@@ -80,6 +100,10 @@ struct GapReport {
   // recipe's rotor, assumed because the simulation names none: meaningless for another
   // machine) or "" (unknown).
   std::string inertia_source;
+  // The design's tolerances the nominal was calibrated under, and where they came from:
+  // "default", "simulation" (its motor JSON) or "given" (--tolerances).
+  analysis::NominalTolerances tolerances;
+  std::string tolerance_source = "default";
   analysis::GapSummary gap;
   std::vector<analysis::FeatureSummary> features;  // per measured unit
   std::optional<GapPrediction> prediction;

@@ -117,8 +117,11 @@ RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit, const GapOpt
   r.effect = JoinNames(fit.effects);
   r.chi2 = fit.chi2;
   r.cost = fit.cost;
-  r.bic = fit.cost + fit.n_params * std::log(std::max(fit.residuals, 1));
-  r.score = fit.cost + fit.occam + PriorPenalty(fit.effects, o);
+  r.nominal = fit.nominal;
+  r.shift = fit.shift;
+  r.prior = fit.prior;
+  r.bic = fit.cost + fit.prior + fit.n_params * std::log(std::max(fit.residuals, 1));
+  r.score = fit.Evidence() + PriorPenalty(fit.effects, o);
   r.gap_after = fit.residuals > 0 ? std::sqrt(fit.chi2 / fit.residuals) : 0.0;
   r.converged = fit.converged;
   for (std::size_t e = 0; e < fit.effects.size(); ++e) {
@@ -132,7 +135,7 @@ RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit, const GapOpt
     }
   }
   for (const AppliedEffect& e : fit.effects) {
-    for (const DerivedParam& d : DeriveEffectParams(fitter.nominal(), e)) {
+    for (const DerivedParam& d : DeriveEffectParams(fit.nominal, e)) {
       // First-order sigma of a derived value is not propagated here; the fitted one is.
       r.params.push_back({d.name, d.unit, d.value, std::numeric_limits<double>::quiet_NaN()});
     }
@@ -145,22 +148,22 @@ RankedEffect Rank(const EffectFitter& fitter, const EffectFit& fit, const GapOpt
       break;
     }
   }
-  const NominalNetwork& nominal = fitter.nominal();
+  const NominalNetwork& nominal = fit.nominal;
   for (const AppliedEffect& e : fit.effects) {
     if (!r.plausible || e.kind != EffectKind::kSecondMode ||
         nominal.quantity != Quantity::kImpedanceOhm)
       continue;
     const double lo = fitter.f_lo_hz(), hi = fitter.f_hi_hz();
     const double first = FirstModeHz(nominal, fit.effects, lo, hi);
-    const double f0 = nominal.motional.f0_hz;
+    const double f0 = fitter.nominal().motional.f0_hz;  // the simulation's mode
     std::ostringstream os;
     os.precision(4);
     if (first > 0.0 && std::abs(e.params[0] / first - 1.0) < kModeSeparation) {
       os << "second_mode: at " << e.params[0] << " Hz, within 4 % of the first mode (" << first
          << " Hz): the measured mode re-drawn, not a second one";
     } else if (first == 0.0 && f0 > lo && f0 < hi) {
-      // The structure moved the nominal's in-band mode out of the band: the second_mode is
-      // then the only mode left there, the measured one re-drawn.
+      // The structure or the calibration moved the simulation's in-band mode out of the band:
+      // the second_mode is then the only mode left there, the measured one re-drawn.
       os << "second_mode: at " << e.params[0] << " Hz, the only mode in the band (the other "
          << "effects move the nominal's " << f0 << " Hz out of it): the measured mode re-drawn";
     }
@@ -214,19 +217,22 @@ std::vector<Fold> HeldOutFolds(const std::vector<GapUnit>& units, std::string* m
   return folds;
 }
 
-HeldOutGap HeldOut(const EffectFitter& fitter, const std::vector<AppliedEffect>& winner,
-                   const GapOptions& o) {
+// Held-out g of `effects` with the nominal as `mode` says, refitted on each fold (HeldOutFolds)
+// from `from`, against the simulation's nominal on the same lines.
+HeldOutGap HeldOut(const EffectFitter& fitter, const NominalNetwork& from, NominalFit mode,
+                   const std::vector<AppliedEffect>& effects, int iterations) {
   const std::vector<GapUnit>& units = fitter.units();
   HeldOutGap h;
   const std::vector<Fold> folds = HeldOutFolds(units, &h.method);
   double before = 0.0, after = 0.0;
   int n = 0;
   for (const auto& [fit_on, predict] : folds) {
-    const EffectFit fit = fitter.Fit(winner, fit_on, o.max_iterations);
+    const EffectFit fit = fitter.FitFrom(from, mode, effects, fit_on, iterations);
     int m = 0;
-    after += fitter.Chi2(fit.effects, predict, &m);
-    before += fitter.Chi2({}, predict);
-    h.cost_after += fitter.Cost(fit.effects, predict);
+    double cost = 0.0;
+    after += fitter.Chi2With(fit.nominal, fit.effects, predict, &cost);
+    before += fitter.Chi2({}, predict, &m);
+    h.cost_after += cost;
     h.cost_before += fitter.Cost({}, predict);
     n += m;
   }
@@ -235,28 +241,22 @@ HeldOutGap HeldOut(const EffectFitter& fitter, const std::vector<AppliedEffect>&
   return h;
 }
 
-// The nominal alone and with the winner, each refitted on the masked lines from the nominal
-// and from a fresh calibration of the first unit (a large f0 shift is out of LM's reach from
-// the simulation's values); the lower cost wins.
-struct Refit {
-  NominalNetwork nominal;
-  EffectFit fit;
-};
-Refit BestRefit(const EffectFitter& fitter, const std::vector<NominalNetwork>& starts,
-                const std::vector<AppliedEffect>& effects, const LineMask& mask, int iterations) {
-  Refit best;
-  best.fit.cost = std::numeric_limits<double>::infinity();
+// The lowest cost + prior of the fits of `effects` in `mode` from each start nominal.
+EffectFit BestFrom(const EffectFitter& fitter, const std::vector<NominalNetwork>& starts,
+                   NominalFit mode, const std::vector<AppliedEffect>& effects, const LineMask& mask,
+                   int iterations) {
+  EffectFit best;
+  best.cost = std::numeric_limits<double>::infinity();
   for (const NominalNetwork& n : starts) {
-    Refit r;
-    r.fit = fitter.FitWithNominal(n, effects, mask, iterations, &r.nominal);
-    if (std::isfinite(r.fit.cost) && r.fit.cost < best.fit.cost) best = r;
+    EffectFit f = fitter.FitFrom(n, mode, effects, mask, iterations);
+    if (std::isfinite(f.cost) && f.cost + f.prior < best.cost + best.prior) best = std::move(f);
   }
   return best;
 }
 
-GapSplit SplitGap(const EffectFitter& fitter, const std::vector<AppliedEffect>& winner,
-                  const GapOptions& o) {
-  GapSplit s;
+// The simulation's nominal and, when the first unit calibrates on its own, that unit's motional
+// part (a large f0 shift is out of LM's reach from the simulation's values).
+std::vector<NominalNetwork> CalibrationStarts(const EffectFitter& fitter) {
   const NominalNetwork& nominal = fitter.nominal();
   std::vector<NominalNetwork> starts = {nominal};
   const GapUnit& first = fitter.units().front();
@@ -272,53 +272,98 @@ GapSplit SplitGap(const EffectFitter& fitter, const std::vector<AppliedEffect>& 
     n.rigid = fresh.nominal.rigid;
     starts.push_back(n);
   }
+  return starts;
+}
+
+// The nominal alone, calibrated within the tolerances (the diagnosis' "none"; the simulation's
+// nominal itself when the options keep it fixed) and beyond them (no prior).
+struct Calibrations {
+  EffectFit within, beyond;
+};
+Calibrations Calibrate(const EffectFitter& fitter, const GapOptions& o) {
+  const std::vector<NominalNetwork> starts = CalibrationStarts(fitter);
+  Calibrations c;
+  c.within = BestFrom(fitter, starts, fitter.mode(), {}, {}, o.max_iterations);
+  c.beyond = BestFrom(fitter, starts, NominalFit::kFree, {}, {}, o.max_iterations);
+  if (!(c.beyond.cost <= c.within.cost)) c.beyond = c.within;  // no prior can only fit better
+  return c;
+}
+
+// The three ways the gap shrinks and the old two-way split (GapSplit), with held-out g.
+GapSplit SplitGap(const EffectFitter& fitter, const Calibrations& cal, const RankedEffect& answer,
+                  const HeldOutGap& answer_heldout, const GapOptions& o) {
+  GapSplit s;
   const LineMask all;
   int residuals = 0;
   const double chi2_nominal = fitter.Chi2({}, all, &residuals);
-  const double lines = residuals / 2.0;
   double expected = 0.0;
   for (const GapUnit& u : fitter.units())
     expected += ExpectedR2(u.sigma_dof) * static_cast<double>(u.size());
-  expected /= lines;
-  const Refit cal = BestRefit(fitter, starts, {}, all, o.max_iterations);
-  s.refit = cal.nominal;
-  Refit both = cal;
-  if (!winner.empty()) {
-    // From the simulation's nominal (the effect as diagnosed) and from the refitted one.
-    both = BestRefit(fitter, {nominal, cal.nominal}, winner, all, o.max_iterations);
-    if (!(both.fit.cost <= cal.fit.cost)) both = cal;  // the effect may not make it worse
+  expected /= residuals / 2.0;
+  auto g_of = [&](double chi2) { return std::sqrt(chi2 / residuals); };
+  EffectFit both = cal.beyond;
+  if (!answer.effects.empty()) {
+    // From the answer's calibrated nominal (the effect as diagnosed) and from the free one.
+    both = BestFrom(fitter, {answer.nominal, cal.beyond.nominal}, NominalFit::kFree, answer.effects,
+                    all, o.max_iterations);
+    if (!(both.cost <= cal.beyond.cost)) both = cal.beyond;  // the effect may not make it worse
   }
+  s.refit = cal.beyond.nominal;
   s.refit_effect = both.nominal;
-  s.effect = both.fit.effects;
-  s.g_nominal = std::sqrt(chi2_nominal / residuals);
-  s.g_refit = std::sqrt(cal.fit.chi2 / residuals);
-  s.g_refit_effect = std::sqrt(both.fit.chi2 / residuals);
+  s.effect = both.effects;
+  s.g_nominal = g_of(chi2_nominal);
+  s.g_within = g_of(cal.within.chi2);
+  s.g_refit = s.g_beyond = g_of(cal.beyond.chi2);
+  s.g_structure = answer.effects.empty() ? s.g_within : g_of(answer.chi2);
+  s.g_refit_effect = g_of(both.chi2);
   const double x0 = s.g_nominal * s.g_nominal - expected;
-  auto excess = [&](double g) { return g * g - expected; };
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  s.share_calibration = x0 > 0.0 ? (x0 - excess(s.g_refit)) / x0 : nan;
-  s.share_structure = x0 > 0.0 ? (excess(s.g_refit) - excess(s.g_refit_effect)) / x0 : nan;
-  s.share_left = x0 > 0.0 ? excess(s.g_refit_effect) / x0 : nan;
-  // Held out: interleaved lines (one unit) or leave-one-unit-out, both refitted together from
-  // the full fit.
-  const std::vector<GapUnit>& units = fitter.units();
-  const std::vector<Fold> folds = HeldOutFolds(units, &s.heldout_method);
-  double before = 0.0, after = 0.0;
-  int n = 0;
-  for (const auto& [fit_on, predict] : folds) {
-    NominalNetwork refitted;
-    // Started at the full fit, which the half of the lines only nudges.
-    const EffectFit f = fitter.FitWithNominal(both.nominal, both.fit.effects, fit_on,
-                                              std::min(o.max_iterations, 60), &refitted);
-    int m = 0;
-    after += fitter.Chi2With(refitted, f.effects, predict);
-    before += fitter.Chi2({}, predict, &m);
-    n += m;
-  }
-  s.heldout_g_nominal = n > 0 ? std::sqrt(before / n) : 0.0;
-  s.heldout_g_refit_effect = n > 0 ? std::sqrt(after / n) : 0.0;
+  auto share = [&](double g_from, double g_to) {
+    return x0 > 0.0 ? (g_from * g_from - g_to * g_to) / x0 : nan;
+  };
+  s.share_within = share(s.g_nominal, s.g_within);
+  s.share_beyond = share(s.g_within, s.g_beyond);
+  s.share_structure_within = share(s.g_within, s.g_structure);
+  s.share_left_within = x0 > 0.0 ? (s.g_structure * s.g_structure - expected) / x0 : nan;
+  s.share_calibration = share(s.g_nominal, s.g_refit);
+  s.share_structure = share(s.g_refit, s.g_refit_effect);
+  s.share_left = x0 > 0.0 ? (s.g_refit_effect * s.g_refit_effect - expected) / x0 : nan;
+  // Held out: each refitted on the folds from its full fit, which half the lines only nudge.
+  const int iterations = std::min(o.max_iterations, 60);
+  const HeldOutGap within = HeldOut(fitter, cal.within.nominal, fitter.mode(), {}, iterations);
+  const HeldOutGap beyond = HeldOut(fitter, cal.beyond.nominal, NominalFit::kFree, {}, iterations);
+  const HeldOutGap together =
+      HeldOut(fitter, both.nominal, NominalFit::kFree, both.effects, iterations);
+  s.heldout_method = within.method;
+  s.heldout_g_nominal = within.gap_before;
+  s.heldout_g_within = within.gap_after;
+  s.heldout_g_beyond = beyond.gap_after;
+  s.heldout_g_structure = answer.effects.empty() ? within.gap_after : answer_heldout.gap_after;
+  s.heldout_g_refit_effect = together.gap_after;
   s.available = true;
   return s;
+}
+
+// How many tolerances make a parameter "outside its tolerance" in the finding.
+constexpr double kOutsideTolerances = 2.0;
+
+// A calibration that needs parameters outside their tolerances (CalibrationFinding).
+CalibrationFinding FindBeyondTolerance(const EffectFitter& fitter, const Calibrations& cal,
+                                       const GapOptions& o) {
+  CalibrationFinding f;
+  int residuals = 0;
+  fitter.Chi2({}, {}, &residuals);
+  f.g_beyond = std::sqrt(cal.beyond.chi2 / residuals);
+  f.cost_gain = cal.within.cost + cal.within.prior - cal.beyond.cost;
+  const TolerancePrior* prior = fitter.prior();
+  if (!prior || cal.beyond.shift.size() != prior->size()) return f;
+  f.offsets = prior->Physical(cal.beyond.shift);
+  std::sort(f.offsets.begin(), f.offsets.end(), [](const auto& a, const auto& b) {
+    return std::abs(a.tolerances) > std::abs(b.tolerances);
+  });
+  f.found = f.cost_gain >= o.min_score_gain &&
+            std::abs(f.offsets.front().tolerances) >= kOutsideTolerances;
+  return f;
 }
 
 bool CheckUnits(const std::vector<GapUnit>& units, std::string* why) {
@@ -351,6 +396,246 @@ bool CheckUnits(const std::vector<GapUnit>& units, std::string* why) {
   return true;
 }
 
+// The units with their residual form (GapOptions::residual_form); the form and the admittance
+// lines into *s.
+std::vector<GapUnit> FormUnits(const NominalNetwork& nominal, const std::vector<GapUnit>& units,
+                               const GapOptions& o, GapSummary* s) {
+  std::vector<GapUnit> formed = units;
+  std::size_t lines = 0, admittance_lines = 0;
+  s->admittance_hz.resize(formed.size());
+  for (std::size_t u = 0; u < formed.size(); ++u) {
+    ChooseResidualForm(formed[u], nominal.quantity == Quantity::kImpedanceOhm, o.residual_form);
+    lines += formed[u].size();
+    admittance_lines += formed[u].admittance ? formed[u].size() : 0;
+    for (std::size_t k = 0; k < formed[u].admittance_line.size(); ++k)
+      if (formed[u].admittance_line[k]) {
+        s->admittance_hz[u].push_back(formed[u].freq_hz[k]);
+        ++admittance_lines;
+      }
+  }
+  s->residual_form = admittance_lines == 0       ? "impedance"
+                     : admittance_lines == lines ? "admittance"
+                                                 : "mixed";
+  return formed;
+}
+
+// No significant band, and the residual either passes the noise test or is uniformly at most
+// max_sigma_scale above sigma (the sigma is off, not the model).
+bool Consistent(const Pooled& p, const GapOptions& o) {
+  return FindGapBands(p.f, p.chi2, p.dof, o.bands).empty() &&
+         (p.Z() <= o.noise_z_max || p.SigmaScale() <= o.max_sigma_scale);
+}
+
+RankedEffect RankNone(const EffectFit& within) {
+  RankedEffect none;
+  none.effect = "none";
+  none.nominal = within.nominal;
+  none.shift = within.shift;
+  none.prior = within.prior;
+  none.chi2 = within.chi2;
+  none.cost = within.cost;
+  none.bic = within.cost + within.prior;
+  none.score = within.Evidence();
+  none.gap_after = within.residuals > 0 ? std::sqrt(within.chi2 / within.residuals) : 0.0;
+  return none;
+}
+
+// A single's lowest-cost basin and the nominal it sat on: where its pairs start.
+struct Seed {
+  AppliedEffect effect;
+  NominalNetwork nominal;
+};
+
+// Every effect of the library that applies, fitted alone (best first); each one's lowest-cost
+// basin into *seeds (the pairs start there: the two effects together fit there).
+std::vector<RankedEffect> FitSingles(const EffectFitter& fitter,
+                                     const std::vector<EffectKind>& library, const GapOptions& o,
+                                     std::map<EffectKind, Seed>* seeds) {
+  std::vector<RankedEffect> singles;
+  const bool mobility = fitter.nominal().quantity == Quantity::kMobility;
+  for (EffectKind kind : library) {
+    if (mobility && kind != EffectKind::kSecondMode && kind != EffectKind::kChannelDelay) continue;
+    const EffectFit fit = fitter.FitKinds({kind}, {}, {}, o.max_iterations);
+    if (fit.effects.empty()) continue;
+    (*seeds)[kind] = fit.lowest_cost.empty()
+                         ? Seed{fit.effects.front(), fit.nominal}
+                         : Seed{fit.lowest_cost.front(), fit.lowest_cost_nominal};
+    singles.push_back(Rank(fitter, fit, o));
+  }
+  std::sort(singles.begin(), singles.end(), BetterRank);
+  return singles;
+}
+
+// The pairs to fit: the pair_candidates best singles among themselves, and the best single
+// with every other.
+std::vector<RankedEffect> FitPairs(const EffectFitter& fitter,
+                                   const std::vector<RankedEffect>& singles,
+                                   std::map<EffectKind, Seed>& seeds, const RankedEffect& best,
+                                   const GapOptions& o) {
+  std::set<std::pair<EffectKind, EffectKind>> pairs;
+  auto add = [&](EffectKind a, EffectKind b) {
+    if (a == b || !seeds.count(a) || !seeds.count(b)) return;
+    pairs.insert({std::min(a, b), std::max(a, b)});
+  };
+  const std::size_t top = std::min<std::size_t>(singles.size(), o.pair_candidates);
+  for (std::size_t i = 0; i < top; ++i)
+    for (std::size_t j = i + 1; j < top; ++j)
+      add(singles[i].effects.front().kind, singles[j].effects.front().kind);
+  for (const auto& [kind, fit] : seeds) add(best.effects.front().kind, kind);
+  std::vector<RankedEffect> ranks;
+  for (const auto& [a, b] : pairs) {
+    const EffectFit fit = fitter.FitKinds({a, b}, {seeds[a].effect, seeds[b].effect}, {},
+                                          o.max_iterations, {seeds[a].nominal, seeds[b].nominal});
+    if (fit.effects.size() == 2) ranks.push_back(Rank(fitter, fit, o));
+  }
+  std::sort(ranks.begin(), ranks.end(), BetterRank);
+  return ranks;
+}
+
+std::string Gain(double v) {
+  std::ostringstream os;
+  os.precision(3);
+  os << v;
+  return os.str();
+}
+
+// The calibration under `shift` needs a parameter at kOutsideTolerances or more: a structure
+// may hide in it (a fixture spring taken up by the stiffness), so the pairs are tried.
+bool AtTheEdge(const EffectFitter& fitter, const Eigen::VectorXd& shift) {
+  const TolerancePrior* prior = fitter.prior();
+  if (!prior || shift.size() != prior->size()) return false;
+  for (const ToleranceDeviation& d : prior->Physical(shift))
+    if (std::abs(d.tolerances) >= kOutsideTolerances) return true;
+  return false;
+}
+
+// The pair step (diagnosis.h "Which" 4): a pair wins only when each member is significant
+// against the calibrated single of the other, in sample (BIC) and on held-out lines. Returns the
+// new winner (or `best`); the pairs go into *ranking, the pairs that beat the winner's evidence
+// but failed a test into *rejected with why.
+RankedEffect ChoosePair(const EffectFitter& fitter, const std::vector<RankedEffect>& singles,
+                        std::map<EffectKind, Seed>& seeds, const RankedEffect& best,
+                        const RankedEffect& none, const GapOptions& o,
+                        std::map<std::string, HeldOutGap>* heldout,
+                        std::vector<RankedEffect>* ranking, std::vector<GapRival>* rejected) {
+  const std::vector<RankedEffect> pairs = FitPairs(fitter, singles, seeds, best, o);
+  ranking->insert(ranking->end(), pairs.begin(), pairs.end());
+  auto single = [&](EffectKind kind) -> const RankedEffect& {
+    for (const RankedEffect& r : singles)
+      if (r.effects.front().kind == kind) return r;
+    return none;
+  };
+  auto held = [&](const RankedEffect& r) -> const HeldOutGap& {
+    auto it = heldout->find(r.effect);
+    if (it == heldout->end())
+      it = heldout
+               ->emplace(r.effect,
+                         HeldOut(fitter, r.nominal, fitter.mode(), r.effects, o.max_iterations))
+               .first;
+    return it->second;
+  };
+  for (const RankedEffect& pair : pairs) {
+    if (!pair.plausible || pair.score >= best.score) break;
+    std::string why;
+    for (int m = 0; m < 2 && why.empty(); ++m) {
+      // Member m is significant when the pair beats the single of the other member.
+      const RankedEffect& other = single(pair.effects[1 - m].kind);
+      const std::string member = ToString(pair.effects[m].kind);
+      if (pair.bic > other.bic - o.min_score_gain)
+        why = member + " is not significant against " + other.effect + " alone (BIC " +
+              Gain(other.bic - pair.bic) + " lower, " + Gain(o.min_score_gain) + " needed)";
+      else if (held(pair).cost_after > held(other).cost_after - o.min_score_gain)
+        why = member + " is not significant against " + other.effect +
+              " alone on held-out lines (-2 ln L " +
+              Gain(held(other).cost_after - held(pair).cost_after) + " lower, " +
+              Gain(o.min_score_gain) + " needed)";
+    }
+    if (why.empty()) return pair;
+    rejected->push_back({pair.effect, pair.score - best.score, "a pair rejected: " + why});
+  }
+  return best;
+}
+
+// The rivals of the winner (GapOptions::rival_margin): every other plausible candidate that is
+// an effect by BIC too, within the margin of the winner's evidence, or better than it but
+// rejected as a pair; `rival` is the first of the winner's size (as before issue 38).
+void AddRivals(const RankedEffect& winner, const RankedEffect& none,
+               const std::vector<GapRival>& rejected, const GapOptions& o, GapSummary* s) {
+  s->rivals = rejected;
+  for (const RankedEffect& r : s->ranking) {
+    if (!r.plausible || r.effect == winner.effect || r.effect == "none" ||
+        r.bic > none.bic - o.min_score_gain || r.score - winner.score >= o.rival_margin)
+      continue;
+    bool listed = false;
+    for (const GapRival& x : rejected) listed = listed || x.effect == r.effect;
+    if (listed) continue;
+    s->rivals.push_back({r.effect, std::max(0.0, r.score - winner.score),
+                         "the data hardly tell it from the answer"});
+    if (s->rival.empty() && r.effects.size() == winner.effects.size()) {
+      s->rival = r.effect;
+      s->rival_score_gap = std::max(0.0, r.score - winner.score);
+    }
+  }
+}
+
+void Describe(const GapOptions& o, GapSummary* s) {
+  std::ostringstream os;
+  os.precision(4);
+  if (s->effect == "none") {
+    os << "no unmodelled effect: ";
+    os << (s->split.available && s->split.g_within < s->gap_before - 1e-9
+               ? "the nominal calibrated within the design's tolerances leaves a residual "
+                 "consistent with the noise (g "
+               : "the residual is consistent with the noise (g = ")
+       << s->gap_before;
+    if (s->split.available && s->split.g_within < s->gap_before - 1e-9)
+      os << " -> " << s->split.g_within;
+    os << ", noise test z = " << s->noise_z_before << ", no significant band";
+    if (s->noise_z_before > o.noise_z_max && s->sigma_scale <= o.max_sigma_scale)
+      os << "; uniformly above sigma: it implies sigma x " << s->sigma_scale;
+    os << ")";
+  } else if (s->effect == "unexplained") {
+    os << "the gap (g = " << s->gap_before << ") is not explained by any candidate effect";
+  } else if (s->effect == kBeyondTolerance) {
+    os << "a calibration beyond the design's tolerances explains the gap: g " << s->gap_before
+       << " -> " << s->beyond.g_beyond << "; no candidate effect explains it";
+  } else {
+    os << s->effect << " explains the gap: g " << s->gap_before << " -> " << s->gap_after
+       << " (held out, " << s->heldout.method << ": " << s->heldout.gap_before << " -> "
+       << s->heldout.gap_after << ")";
+    if (s->noise_z_after > o.noise_z_max || !s->where_after.empty())
+      os << "; a significant residual remains";
+    if (!s->rival.empty())
+      os << "; the data hardly tell it from " << s->rival << " (evidence within "
+         << s->rival_score_gap << ")";
+  }
+  if (s->beyond.found && s->effect != kBeyondTolerance) {
+    const ToleranceDeviation& d = s->beyond.offsets.front();
+    os << "; a calibration beyond the tolerances would reach g = " << s->beyond.g_beyond << " with "
+       << d.name << " at " << d.tolerances << " tolerances (the alternative to "
+       << (s->winner.empty() ? "the answer" : "the structure") << ")";
+  }
+  s->message = os.str();
+}
+
+// Where the gap is before and after the answer, and each unit's g.
+void WhereAndUnits(const EffectFitter& fitter, const std::vector<GapUnit>& units,
+                   const Pooled& before, const std::vector<GapBand>& bands_before,
+                   const GapOptions& o, GapSummary* s) {
+  const Pooled after = Pool(s->nominal_after, s->winner, fitter.units());
+  s->noise_z_after = after.Z();
+  s->where = WithGaps(bands_before, before, after);
+  s->where_after = WithGaps(FindGapBands(after.f, after.chi2, after.dof, o.bands), before, after);
+  for (std::size_t u = 0; u < units.size(); ++u) {
+    const LineMask m = UnitMask(fitter.units(), u, false);
+    int n = 0;
+    const double chi2_before = fitter.Chi2({}, m, &n);
+    const double chi2_after = fitter.Chi2With(s->nominal_after, s->winner, m);
+    s->units.push_back(
+        {units[u].name, n / 2, std::sqrt(chi2_before / n), std::sqrt(chi2_after / n)});
+  }
+}
+
 }  // namespace
 
 bool GapOptions::IsValid(std::string* why) const {
@@ -367,6 +652,7 @@ bool GapOptions::IsValid(std::string* why) const {
   for (const auto& [kind, odds] : prior_odds)
     if (!(odds > 0.0 && std::isfinite(odds))) return fail("prior_odds must be positive and finite");
   if (pair_candidates < 2) return fail("pair_candidates must be at least 2");
+  if (!tolerances.IsValid(why)) return false;
   if (max_iterations < 1) return fail("max_iterations must be at least 1");
   return true;
 }
@@ -404,61 +690,27 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
     s.message = "invalid measurement: " + why;
     return s;
   }
-  std::vector<GapUnit> formed = units;
-  std::size_t lines = 0, admittance_lines = 0;
-  s.admittance_hz.resize(formed.size());
-  for (std::size_t u = 0; u < formed.size(); ++u) {
-    ChooseResidualForm(formed[u], nominal.quantity == Quantity::kImpedanceOhm, o.residual_form);
-    lines += formed[u].size();
-    admittance_lines += formed[u].admittance ? formed[u].size() : 0;
-    for (std::size_t k = 0; k < formed[u].admittance_line.size(); ++k)
-      if (formed[u].admittance_line[k]) {
-        s.admittance_hz[u].push_back(formed[u].freq_hz[k]);
-        ++admittance_lines;
-      }
-  }
-  s.residual_form = admittance_lines == 0       ? "impedance"
-                    : admittance_lines == lines ? "admittance"
-                                                : "mixed";
-  const EffectFitter fitter(nominal, formed);
-  const LineMask all;
-  s.chi2_before = fitter.Chi2({}, all, &s.residuals);
+  const std::vector<GapUnit> formed = FormUnits(nominal, units, o, &s);
+  EffectFitter fitter(nominal, formed, o.calibrate ? NominalFit::kTolerance : NominalFit::kFixed,
+                      o.tolerances);
+  s.chi2_before = fitter.Chi2({}, {}, &s.residuals);
   s.gap_before = std::sqrt(s.chi2_before / s.residuals);
   const Pooled pooled_before = Pool(nominal, {}, formed);
   s.noise_z_before = pooled_before.Z();
   s.sigma_scale = pooled_before.SigmaScale();
   const std::vector<GapBand> bands_before =
       FindGapBands(pooled_before.f, pooled_before.chi2, pooled_before.dof, o.bands);
-  // No significant band, and the residual either passes the test or is uniformly at most
-  // max_sigma_scale above sigma (the sigma is off, not the model).
-  const bool nominal_consistent = bands_before.empty() && (s.noise_z_before <= o.noise_z_max ||
-                                                           s.sigma_scale <= o.max_sigma_scale);
 
-  // Singles.
+  // "none" is the nominal calibrated within the tolerances; every candidate starts there.
+  const Calibrations cal = Calibrate(fitter, o);
+  fitter.SetStartNominal(cal.within.nominal);
+  const RankedEffect none = RankNone(cal.within);
   const std::vector<EffectKind> library =
       o.effects.empty() ? EffectsFor(nominal.quantity) : o.effects;
-  std::vector<RankedEffect> singles;
-  std::map<EffectKind, AppliedEffect> single_fit;
-  for (EffectKind kind : library) {
-    if (nominal.quantity == Quantity::kMobility && kind != EffectKind::kSecondMode &&
-        kind != EffectKind::kChannelDelay)
-      continue;
-    const EffectFit fit = fitter.FitKinds({kind}, {}, all, o.max_iterations);
-    if (fit.effects.empty()) continue;
-    // Pairs start from the lowest-cost basin: the two effects together fit there.
-    single_fit[kind] = fit.lowest_cost.empty() ? fit.effects.front() : fit.lowest_cost.front();
-    singles.push_back(Rank(fitter, fit, o));
-  }
-  std::sort(singles.begin(), singles.end(), BetterRank);
-  RankedEffect none;
-  none.effect = "none";
-  none.chi2 = s.chi2_before;
-  none.cost = fitter.Cost({}, all);
-  none.score = none.bic = none.cost;
-  none.gap_after = s.gap_before;
+  std::map<EffectKind, Seed> seeds;
+  const std::vector<RankedEffect> singles = FitSingles(fitter, library, o, &seeds);
   std::vector<RankedEffect> ranking = singles;
   ranking.push_back(none);
-
   // Whether: BIC, min_score_gain below none; which: the best evidence among those.
   const RankedEffect* best = nullptr;
   for (const RankedEffect& r : singles)
@@ -467,117 +719,43 @@ GapSummary DiagnoseGap(const NominalNetwork& nominal, const std::vector<GapUnit>
       break;
     }
   RankedEffect winner = best ? *best : none;
-
-  // Pairs, when the best single leaves a residual inconsistent with the noise.
-  if (best && o.try_pairs && library.size() >= 2) {
-    const Pooled after = Pool(nominal, best->effects, formed);
-    const bool consistent = FindGapBands(after.f, after.chi2, after.dof, o.bands).empty() &&
-                            (after.Z() <= o.noise_z_max || after.SigmaScale() <= o.max_sigma_scale);
-    if (!consistent) {
-      std::set<std::pair<EffectKind, EffectKind>> pairs;
-      auto add = [&](EffectKind a, EffectKind b) {
-        if (a == b || !single_fit.count(a) || !single_fit.count(b)) return;
-        pairs.insert({std::min(a, b), std::max(a, b)});
-      };
-      const std::size_t top = std::min<std::size_t>(singles.size(), o.pair_candidates);
-      for (std::size_t i = 0; i < top; ++i)
-        for (std::size_t j = i + 1; j < top; ++j)
-          add(singles[i].effects.front().kind, singles[j].effects.front().kind);
-      for (const auto& [kind, fit] : single_fit) add(best->effects.front().kind, kind);
-      std::vector<RankedEffect> pair_ranks;
-      for (const auto& [a, b] : pairs) {
-        const EffectFit fit =
-            fitter.FitKinds({a, b}, {single_fit[a], single_fit[b]}, all, o.max_iterations);
-        if (fit.effects.size() == 2) pair_ranks.push_back(Rank(fitter, fit, o));
-      }
-      std::sort(pair_ranks.begin(), pair_ranks.end(), BetterRank);
-      // Each member significant on its own: against each member's single fit in sample, and
-      // against the winner on held-out lines.
-      auto single_bic = [&](EffectKind kind) {
-        for (const RankedEffect& r : singles)
-          if (r.effects.front().kind == kind) return r.bic;
-        return none.bic;
-      };
-      const HeldOutGap winner_heldout = HeldOut(fitter, best->effects, o);
-      for (const RankedEffect& pair : pair_ranks) {
-        if (!pair.plausible || pair.score >= winner.score) break;
-        if (pair.bic > single_bic(pair.effects[0].kind) - o.min_score_gain ||
-            pair.bic > single_bic(pair.effects[1].kind) - o.min_score_gain)
-          continue;
-        const HeldOutGap h = HeldOut(fitter, pair.effects, o);
-        if (h.cost_after <= winner_heldout.cost_after - o.min_score_gain) {
-          winner = pair;
-          break;
-        }
-      }
-      ranking.insert(ranking.end(), pair_ranks.begin(), pair_ranks.end());
-    }
-  }
+  std::map<std::string, HeldOutGap> heldout;
+  std::vector<GapRival> rejected;
+  if (best && o.try_pairs && library.size() >= 2 &&
+      (!Consistent(Pool(best->nominal, best->effects, formed), o) ||
+       AtTheEdge(fitter, best->shift)))
+    winner = ChoosePair(fitter, singles, seeds, *best, none, o, &heldout, &ranking, &rejected);
   std::stable_sort(ranking.begin(), ranking.end(), BetterRank);
   s.ranking = ranking;
 
+  s.beyond = FindBeyondTolerance(fitter, cal, o);
   if (winner.effect == "none") {
-    s.effect = nominal_consistent ? "none" : "unexplained";
+    s.effect = Consistent(Pool(none.nominal, {}, formed), o) ? "none"
+               : s.beyond.found && Consistent(Pool(cal.beyond.nominal, {}, formed), o)
+                   ? kBeyondTolerance
+                   : "unexplained";
   } else {
     s.effect = winner.effect;
     s.winner = winner.effects;
-    // The rival: the best other plausible candidate of the winner's size that is an effect too
-    // (its BIC passes), within rival_margin of the winner's evidence.
-    for (const RankedEffect& r : s.ranking) {
-      if (!r.plausible || r.effect == winner.effect || r.effects.size() != winner.effects.size() ||
-          r.bic > none.bic - o.min_score_gain)
-        continue;
-      if (r.score - winner.score < o.rival_margin) {
-        s.rival = r.effect;
-        s.rival_score_gap = std::max(0.0, r.score - winner.score);
-      }
-      break;
-    }
+    AddRivals(winner, none, rejected, o, &s);
   }
-  s.chi2_after = winner.effect == "none" ? s.chi2_before : winner.chi2;
+  const bool beyond = s.effect == kBeyondTolerance;
+  s.nominal_after = beyond ? cal.beyond.nominal : winner.nominal;
+  s.chi2_after = beyond ? cal.beyond.chi2 : winner.chi2;
   s.gap_after = std::sqrt(s.chi2_after / s.residuals);
-  const Pooled pooled_after = Pool(nominal, s.winner, formed);
-  s.noise_z_after = pooled_after.Z();
-  s.where = WithGaps(bands_before, pooled_before, pooled_after);
-  s.where_after =
-      WithGaps(FindGapBands(pooled_after.f, pooled_after.chi2, pooled_after.dof, o.bands),
-               pooled_before, pooled_after);
-  for (std::size_t u = 0; u < units.size(); ++u) {
-    const LineMask m = UnitMask(formed, u, false);
-    int n = 0;
-    const double before = fitter.Chi2({}, m, &n);
-    const double after = fitter.Chi2(s.winner, m);
-    s.units.push_back({units[u].name, n / 2, std::sqrt(before / n), std::sqrt(after / n)});
-  }
+  if (const TolerancePrior* prior = fitter.prior(); prior && winner.shift.size() == prior->size())
+    s.calibration = prior->Physical(winner.shift);
+  WhereAndUnits(fitter, units, pooled_before, bands_before, o, &s);
   if (s.winner.empty() || !o.heldout) {
     s.heldout = {s.gap_before, s.gap_before, s.winner.empty() ? "none" : "skipped"};
   } else {
-    s.heldout = HeldOut(fitter, s.winner, o);
+    const auto it = heldout.find(winner.effect);
+    s.heldout = it != heldout.end()
+                    ? it->second
+                    : HeldOut(fitter, winner.nominal, fitter.mode(), s.winner, o.max_iterations);
   }
-
-  s.split = SplitGap(fitter, s.winner, o);
-
-  std::ostringstream os;
-  os.precision(4);
-  if (s.effect == "none") {
-    os << "no unmodelled effect: the residual is consistent with the noise (g = " << s.gap_before
-       << ", noise test z = " << s.noise_z_before << ", no significant band";
-    if (s.noise_z_before > o.noise_z_max)
-      os << "; uniformly above sigma: it implies sigma x " << s.sigma_scale;
-    os << ")";
-  } else if (s.effect == "unexplained") {
-    os << "the gap (g = " << s.gap_before << ") is not explained by any candidate effect";
-  } else {
-    os << s.effect << " explains the gap: g " << s.gap_before << " -> " << s.gap_after
-       << " (held out, " << s.heldout.method << ": " << s.heldout.gap_before << " -> "
-       << s.heldout.gap_after << ")";
-    if (s.noise_z_after > o.noise_z_max || !s.where_after.empty())
-      os << "; a significant residual remains";
-    if (!s.rival.empty())
-      os << "; the data hardly tell it from " << s.rival << " (evidence within "
-         << s.rival_score_gap << ")";
-  }
-  s.message = os.str();
+  s.split = SplitGap(fitter, cal, winner, s.heldout, o);
+  Describe(o, &s);
   s.usable = true;
   return s;
 }

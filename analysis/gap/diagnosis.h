@@ -8,9 +8,22 @@
 // each unit's sigma_dof into account (residual.h: F-distributed lines when sigma is
 // estimated).
 //
-// Which (the nominal's parameters stay at the simulation's values):
+// Calibration first (issue 38): a unit is never its simulation. Every fit below (none, each
+// effect, each pair) refits the nominal's own parameters with it under a Gaussian prior of the
+// design's tolerances (tolerance.h: R 10 %, L 8 %, torque constant 6 %, J 6 %, k 15 %,
+// damping x3, DAQ gain 1 %; GapOptions::tolerances), the prior's -2 ln p in the cost and its
+// Gaussian Occam term in the evidence (effect_fit.h). "none" is the nominal calibrated within
+// the tolerances: an effect is named only where that calibration cannot reach the data and the
+// effect's evidence beats it. The nominal is also calibrated with no prior; when that fits
+// min_score_gain better (-2 ln L) and needs a parameter at 2 or more tolerances, the report
+// names it (CalibrationFinding: which parameter, by how many tolerances) beside the answer, the
+// alternative to the structure; when nothing else explains a gap it does, the answer is
+// kBeyondTolerance. GapOptions::calibrate = false keeps the nominal at the simulation's values
+// (the diagnosis before issue 38).
+//
+// Which:
 //   1. every effect of the library (effects.h) is fitted on top of the nominal, its
-//      parameters shared by all units (one fixture, one cable);
+//      parameters shared by all units (one fixture, one cable), the nominal calibrated with it;
 //   2. cost = -2 ln L of the residual (effect_fit.h: chi2 for exact sigma, the Student t's
 //      for sigma on few degrees of freedom; "none" is the nominal's cost); whether an effect
 //      is there is judged by BIC = cost + p ln(2K) (p fitted parameters), which effect by the
@@ -23,14 +36,16 @@
 //      answer is "none" when the nominal's residual is consistent with the noise (no
 //      significant band, and noise test z <= noise_z_max or sigma_scale <= max_sigma_scale)
 //      and "unexplained" when it is not;
-//   4. when the winner still leaves a residual inconsistent with the noise, pairs are fitted
+//   4. when the winner still leaves a residual inconsistent with the noise, or its calibration
+//      needs a parameter at 2 tolerances or more (a structure may hide in it), pairs are fitted
 //      (the pair_candidates best singles among themselves, and the winner with every other
-//      effect); a plausible pair with a better score wins when each member is significant on
-//      its own: the pair's BIC is min_score_gain below each member's single fit, and on
-//      held-out lines (below)
-//      its predictive cost is min_score_gain below the winner's (so a delay or a series
-//      resistance cannot ride along on a mis-modelled effect). Its name joins the two with "+"
-//      in EffectKind order ("second_mode+channel_delay").
+//      effect); a plausible pair with a better score wins when each member is significant
+//      against the calibrated single of the other: the pair's BIC is min_score_gain below that
+//      single's, and on held-out lines (below) its predictive cost is min_score_gain below
+//      that single's (so a delay or a series resistance cannot ride along on a mis-modelled
+//      effect or a calibration). Its name joins the two with "+" in EffectKind order
+//      ("second_mode+channel_delay"). A pair that beats the winner's evidence but fails a
+//      test is reported among the rivals with why (GapSummary::rivals).
 // Held out: one unit -> two-fold interleaved lines (fit the winner on the even lines, predict
 // the odd ones, and the reverse; every line is predicted by a fit that did not see it);
 // several units -> leave-one-unit-out. gap_before there is the nominal's g on the same lines.
@@ -45,9 +60,13 @@
 
 #include "analysis/gap/effect_fit.h"
 #include "analysis/gap/residual.h"
+#include "analysis/gap/tolerance.h"
 #include "analysis/model/effects.h"
 
 namespace eol::analysis {
+
+// The answer when only a calibration beyond the tolerances explains the gap.
+inline constexpr const char* kBeyondTolerance = "calibration_beyond_tolerance";
 
 struct GapOptions {
   BandSearchOptions bands;
@@ -86,6 +105,10 @@ struct GapOptions {
   int max_iterations = 200;
   bool heldout = true;
   std::vector<EffectKind> effects;  // the library to try; empty: EffectsFor(quantity)
+  // The nominal's own parameters refitted in every fit under the tolerances' prior
+  // (tolerance.h); false: kept at the simulation's values.
+  bool calibrate = true;
+  NominalTolerances tolerances;
 
   bool IsValid(std::string* why) const;
 };
@@ -100,11 +123,14 @@ struct NamedValue {
 struct RankedEffect {
   std::string effect;  // "none", a name, or "a+b"
   std::vector<AppliedEffect> effects;
+  NominalNetwork nominal;  // the calibrated nominal the effects sit on
+  Eigen::VectorXd shift;   // its identifiable log-shifts from the simulation's (tolerance.h)
+  double prior = 0.0;      // the tolerances' -2 ln p of the shift
   std::vector<NamedValue> params;  // fitted, then derived (effects.h)
   double chi2 = 0.0;
   double cost = 0.0;   // -2 ln L (effect_fit.h)
-  double bic = 0.0;    // cost + p ln(2K): whether there is an effect
-  double score = 0.0;  // cost + occam - 2 ln(prior odds) (Laplace evidence): which effect
+  double bic = 0.0;    // cost + prior + p ln(2K) (p: the effects' parameters): whether
+  double score = 0.0;  // cost + prior + occam - 2 ln(prior odds) (Laplace evidence): which
   double gap_after = 0.0;
   bool plausible = true;
   bool converged = true;
@@ -124,25 +150,53 @@ struct HeldOutGap {
   double cost_before = 0.0, cost_after = 0.0;  // predictive -2 ln L on the held-out lines
 };
 
-// Calibration and structure apart: the excess X(g) = g^2 - E|r|^2 over the
-// noise, split in the order a person would fix it:
-//   calibration  the nominal's own parameters (R, L, Rp, f0, Q; mobility g, a) refitted:
-//                share_calibration = (X(g_nominal) - X(g_refit)) / X(g_nominal)
-//   structure    the winner's effect on top, fitted together with the nominal's parameters:
-//                share_structure = (X(g_refit) - X(g_refit_effect)) / X(g_nominal)
-//   left         share_left = X(g_refit_effect) / X(g_nominal)
-// (shares NaN when the nominal's g is within the noise). heldout_g_refit_effect: the two
-// together on held-out lines (as HeldOutGap), against heldout_g_nominal on the same lines.
+// Calibration and structure apart: the excess X(g) = g^2 - E|r|^2 over the noise, as shares
+// of X(g_nominal) (NaN when the nominal's g is within the noise), three ways:
+//   within     the nominal calibrated within the tolerances ("none"):
+//              share_within = (X(g_nominal) - X(g_within)) / X0
+//   structure  the answer's effect on top, calibrated within the tolerances with it:
+//              share_structure_within = (X(g_within) - X(g_structure)) / X0, and
+//              share_left_within = X(g_structure) / X0 (the three add to 1)
+//   beyond     the alternative to the structure: the nominal calibrated with no prior:
+//              share_beyond = (X(g_within) - X(g_beyond)) / X0
+// and, as before issue 38, calibration (no prior) then structure on top of it:
+//   share_calibration = (X0 - X(g_refit)) / X0 (g_refit = g_beyond), share_structure =
+//   (X(g_refit) - X(g_refit_effect)) / X0, share_left = X(g_refit_effect) / X0.
+// Held out (as HeldOutGap, each refitted on the folds): heldout_g_within, heldout_g_beyond,
+// heldout_g_structure, heldout_g_refit_effect, against heldout_g_nominal on the same lines.
 struct GapSplit {
   bool available = false;
   std::string message;  // why not, when not
-  double g_nominal = 0.0, g_refit = 0.0, g_refit_effect = 0.0;
+  double g_nominal = 0.0, g_within = 0.0, g_beyond = 0.0, g_structure = 0.0;
+  double share_within = 0.0, share_beyond = 0.0, share_structure_within = 0.0;
+  double share_left_within = 0.0;
+  double heldout_g_within = 0.0, heldout_g_beyond = 0.0, heldout_g_structure = 0.0;
+  double g_refit = 0.0, g_refit_effect = 0.0;
   double share_calibration = 0.0, share_structure = 0.0, share_left = 0.0;
   double heldout_g_nominal = 0.0, heldout_g_refit_effect = 0.0;
   std::string heldout_method;
   NominalNetwork refit;         // the nominal alone, refitted
   NominalNetwork refit_effect;  // refitted together with the effect
   std::vector<AppliedEffect> effect;
+};
+
+// Another answer the data hardly rule out, with its evidence: score minus the winner's, and why
+// it is not the answer ("the data hardly tell it from the answer", or why a pair was rejected).
+struct GapRival {
+  std::string effect;
+  double score_gap = 0.0;
+  std::string note;
+};
+
+// The nominal calibrated with no prior, against the calibration within the tolerances: found
+// when it fits at least min_score_gain better (-2 ln L against -2 ln L plus the prior) and a
+// parameter sits at 2 or more tolerances; offsets: the physical parameters (tolerance.h) the
+// free calibration implies, largest first in tolerances.
+struct CalibrationFinding {
+  bool found = false;
+  double g_beyond = 0.0;
+  double cost_gain = 0.0;
+  std::vector<ToleranceDeviation> offsets;
 };
 
 struct UnitGap {
@@ -159,6 +213,12 @@ struct GapSummary {
   std::vector<AppliedEffect> winner;  // empty for none / unexplained
   std::string rival;                  // GapOptions::rival_margin; "" when none
   double rival_score_gap = 0.0;       // its score minus the winner's (>= 0)
+  std::vector<GapRival> rivals;       // every rival answer with its evidence (AddRivals)
+  // The nominal the answer sits on (calibrated within the tolerances, or beyond them for
+  // kBeyondTolerance), and the physical offsets that calibration implies (tolerance.h).
+  NominalNetwork nominal_after;
+  std::vector<ToleranceDeviation> calibration;
+  CalibrationFinding beyond;
   double gap_before = 0.0, gap_after = 0.0;
   double chi2_before = 0.0, chi2_after = 0.0;
   int residuals = 0;                                 // 2K

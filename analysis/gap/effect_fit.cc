@@ -108,6 +108,7 @@ double Logit(double u) {
 struct Layout {
   std::vector<EffectSpec> specs;
   std::vector<AppliedEffect> shape;  // kinds and parameter counts
+  int own = 0;                       // the nominal's own parameters ahead of the effects' theta
 
   int size() const {
     int n = 0;
@@ -225,7 +226,7 @@ double PriorWidth(const Layout& layout, const std::vector<AppliedEffect>& at, st
 
 // True when theta i is a bounded parameter (fitted on the logistic map of its range).
 bool IsBounded(const Layout& layout, long index) {
-  long i = 0;
+  long i = layout.own;  // the nominal's own parameters come first, unbounded
   for (const EffectSpec& spec : layout.specs)
     for (const EffectParamSpec& ps : spec.params)
       if (i++ == index) return ps.bounded;
@@ -446,7 +447,7 @@ bool Selected(const LineMask& mask, std::size_t unit, std::size_t line) {
 }
 
 EffectFitter::EffectFitter(const NominalNetwork& nominal, const std::vector<GapUnit>& units)
-    : nominal_(nominal), units_(units) {
+    : nominal_(nominal), start_nominal_(nominal), units_(units) {
   f_lo_ = std::numeric_limits<double>::infinity();
   f_hi_ = 0.0;
   for (const GapUnit& u : units_) {
@@ -490,9 +491,16 @@ double EffectFitter::Cost(std::span<const AppliedEffect> effects, const LineMask
 std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
                                                       std::span<const AppliedEffect> base,
                                                       const LineMask& mask) const {
-  const Lines l = Collect(nominal_, units_, base, mask);
+  return StartsAt(kind, base, mask, start_nominal_);
+}
+
+std::vector<std::vector<double>> EffectFitter::StartsAt(EffectKind kind,
+                                                        std::span<const AppliedEffect> base,
+                                                        const LineMask& mask,
+                                                        const NominalNetwork& at) const {
+  const Lines l = Collect(at, units_, base, mask);
   const EffectSpec spec = Spec(kind);
-  const MotionalImpedance& m = nominal_.motional;
+  const MotionalImpedance& m = at.motional;
   auto s_of = [](double f) { return Cplx(0.0, TwoPi() * f); };
   double red = 0.0;
   switch (kind) {
@@ -541,7 +549,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       for (double kappa : LogSpace(0.02, 30.0, 24)) kappas.push_back(kappa);
       for (double kappa : kappas) {
         trial.back().params = {kappa, FixtureLossKeepingQ(kappa, m.q)};
-        c.push_back({-Cost(trial, mask), trial.back().params});
+        c.push_back({-CostAt(at, trial, mask), trial.back().params});
       }
       return Best(c, 2);
     }
@@ -577,7 +585,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
           for (double mu : {0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0})
             for (double q2 : {10.0, 40.0, 150.0}) {
               trial.back().params = {mu, f2, q2, x};
-              c.push_back({-Cost(trial, mask), trial.back().params});
+              c.push_back({-CostAt(at, trial, mask), trial.back().params});
             }
       // The coupled mode is a few percent wide: a fine scan of f2 over the band's lines (at
       // most 200) puts it where the data show it, which the coarse grid above cannot.
@@ -591,7 +599,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       double mu_rigid = 0.1, best_cost = std::numeric_limits<double>::infinity();
       for (double mu : LogSpace(1e-3, 3.0, 40)) {
         trial.back().params = {mu, 19.0 * f_hi_, 30.0, 0.0};
-        const double cost = Cost(trial, mask);
+        const double cost = CostAt(at, trial, mask);
         if (cost < best_cost) {
           best_cost = cost;
           mu_rigid = mu;
@@ -605,7 +613,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
             const double mu =
                 std::clamp(mu_rigid * (1.0 - r * r) / ((1.0 - x) * (1.0 - x)), 1e-3, 10.0);
             trial.back().params = {mu, fs[i], q2, x};
-            c.push_back({-Cost(trial, mask), trial.back().params});
+            c.push_back({-CostAt(at, trial, mask), trial.back().params});
           }
       }
       // The best start at the rotor and at each node, so LM sees every basin.
@@ -644,7 +652,7 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
       trial.push_back({kind, {0.0}});
       for (double lambda : {0.003, 0.01, 0.03, 0.1, 0.25}) {
         trial.back().params[0] = lambda;
-        c.push_back({-Cost(trial, mask), {lambda}});
+        c.push_back({-CostAt(at, trial, mask), {lambda}});
       }
       return Best(c, 2);
     }
@@ -685,73 +693,6 @@ std::vector<std::vector<double>> EffectFitter::Starts(EffectKind kind,
   return {};
 }
 
-EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineMask& mask,
-                            int max_iterations) const {
-  EffectFit out;
-  out.effects = start;
-  const Lines lines = Collect(nominal_, units_, {}, mask);
-  out.residuals = static_cast<int>(2 * lines.f.size());
-  const Layout layout = MakeLayout(start, nominal_, f_lo_, f_hi_);
-  out.n_params = layout.size();
-  if (out.n_params == 0 || lines.f.empty()) {
-    out.chi2 = Chi2(start, mask);
-    out.cost = Cost(start, mask);
-    out.converged = true;
-    return out;
-  }
-  LeastSquaresProblem problem;
-  problem.parameters = layout.size();
-  problem.residuals = out.residuals;
-  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
-    Residual(nominal_, lines, layout, t, r);
-  };
-  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* j) {
-    DifferenceJacobian(problem.residual, t, false, j);
-  };
-  LeastSquaresSettings settings;
-  settings.max_iterations = max_iterations;
-  settings.ftol = kLmTol;
-  settings.xtol = kLmTol;
-  Eigen::VectorXd theta = layout.ToTheta(start);
-  LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, &theta, settings);
-  out.iterations = outcome.iterations;
-  out.converged = outcome.converged;
-  if (!out.converged && outcome.termination == Termination::kMaxIterations) {
-    // A parameter that drifts along a flat direction (a bounded one towards its bound, where
-    // the logit's steps never meet xtol) keeps LM from stopping though the cost has settled:
-    // one more run, and a cost that moved by less than kSettledCost in it counts as converged
-    // (far below anything the model selection resolves).
-    Eigen::VectorXd r0;
-    problem.residual(theta, &r0);
-    outcome = MinimizeLeastSquares(problem, &theta, settings);
-    out.iterations += outcome.iterations;
-    Eigen::VectorXd r1;
-    problem.residual(theta, &r1);
-    out.converged = outcome.converged || r0.squaredNorm() - r1.squaredNorm() < kSettledCost;
-  }
-  out.effects = layout.FromTheta(theta);
-  Eigen::VectorXd r;
-  problem.residual(theta, &r);
-  out.cost = r.squaredNorm();
-  out.chi2 = Chi2(out.effects, mask);
-  // Covariance in theta from the Jacobian at the optimum, then natural units.
-  Eigen::MatrixXd jac;
-  DifferenceJacobian(problem.residual, theta, true, &jac);
-  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(problem.parameters, problem.parameters,
-                                                  std::numeric_limits<double>::quiet_NaN());
-  Eigen::MatrixXd inverse;
-  const Eigen::MatrixXd information = jac.transpose() * jac;
-  if (InvertInformation(information, &inverse)) cov = inverse;
-  out.occam = OccamPenalty(layout, out.effects, information);
-  out.occam += BoundedPenalty(layout, problem.residual, theta, r, jac);
-  int i = 0;
-  out.sigma.resize(out.effects.size());
-  for (std::size_t e = 0; e < out.effects.size(); ++e)
-    for (std::size_t p = 0; p < out.effects[e].params.size(); ++p, ++i)
-      out.sigma[e].push_back(std::abs(layout.Slope(out.effects, e, p)) * std::sqrt(cov(i, i)));
-  return out;
-}
-
 namespace {
 
 // The nominal's own parameters as logarithms: impedance R, L, Rp, f0, Q; mobility g, a.
@@ -776,7 +717,169 @@ NominalNetwork WithMotional(NominalNetwork n, const Eigen::VectorXd& t) {
   return n;
 }
 
+// Levenberg-Marquardt on the problem from theta; a run stopped by max_iterations whose cost has
+// settled (moved by less than kSettledCost in one more run) counts as converged: a parameter
+// that drifts along a flat direction (a bounded one towards its bound, where the logit's steps
+// never meet xtol) keeps LM from stopping though nothing the model selection resolves changes.
+LeastSquaresOutcome Minimize(const LeastSquaresProblem& problem, int max_iterations,
+                             Eigen::VectorXd* theta, bool* converged) {
+  LeastSquaresSettings settings;
+  settings.max_iterations = max_iterations;
+  settings.ftol = kLmTol;
+  settings.xtol = kLmTol;
+  LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, theta, settings);
+  *converged = outcome.converged;
+  if (!outcome.converged && outcome.termination == Termination::kMaxIterations) {
+    Eigen::VectorXd r0, r1;
+    problem.residual(*theta, &r0);
+    const int first = outcome.iterations;
+    outcome = MinimizeLeastSquares(problem, theta, settings);
+    outcome.iterations += first;
+    problem.residual(*theta, &r1);
+    *converged = outcome.converged || r0.squaredNorm() - r1.squaredNorm() < kSettledCost;
+  }
+  return outcome;
+}
+
+// ln det of a symmetric positive definite matrix (infinity when it is not).
+double LogDet(const Eigen::MatrixXd& a) {
+  const Eigen::LLT<Eigen::MatrixXd> llt(a);
+  if (llt.info() != Eigen::Success) return std::numeric_limits<double>::infinity();
+  return 2.0 * Eigen::MatrixXd(llt.matrixL()).diagonal().array().log().sum();
+}
+
+// The effects' information with the nominal's own parameters (the first `own` of theta)
+// integrated out: the Schur complement H_ee - H_en H_nn^-1 H_ne of the full information H.
+Eigen::MatrixXd EffectInformation(const Eigen::MatrixXd& h, int own) {
+  const long n = h.rows() - own;
+  if (own == 0) return h;
+  const Eigen::MatrixXd hnn = h.topLeftCorner(own, own);
+  const Eigen::MatrixXd hne = h.topRightCorner(own, n);
+  return h.bottomRightCorner(n, n) - hne.transpose() * hnn.ldlt().solve(hne);
+}
+
+// The Laplace evidence's penalty (effect_fit.h) and the effects' sigmas at the optimum.
+void Evidence(const Layout& layout, const ResidualFn& residual, const Eigen::VectorXd& theta,
+              const Eigen::VectorXd& r, const TolerancePrior* prior, EffectFit* out) {
+  const int own = layout.own;
+  Eigen::MatrixXd jac;
+  DifferenceJacobian(residual, theta, true, &jac);
+  // The information in the whitened shift z = W d (the prior's own coordinates, where it is
+  // N(0, I)) rather than in u: dz/du = (I - z z^T / K^2) / s flattens near the radius, where
+  // the information in u would fall below the prior's and its ln det turn negative.
+  Eigen::MatrixXd jz = jac;
+  if (prior && own > 0) {
+    const Eigen::VectorXd u = theta.head(own);
+    const Eigen::VectorXd z = prior->Whitened(u);
+    const double s = std::sqrt(1.0 + u.squaredNorm() / (kMaxTolerances * kMaxTolerances));
+    const Eigen::MatrixXd dz_du = (Eigen::MatrixXd::Identity(own, own) -
+                                   z * z.transpose() / (kMaxTolerances * kMaxTolerances)) /
+                                  s;
+    const long lik = jac.rows() - own;
+    jz.topLeftCorner(lik, own) = jac.topLeftCorner(lik, own) * dz_du.inverse();
+    jz.bottomLeftCorner(own, own).setIdentity();
+  }
+  const Eigen::MatrixXd information = jz.transpose() * jz;  // the prior's rows included
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(theta.size(), theta.size(),
+                                                  std::numeric_limits<double>::quiet_NaN());
+  Eigen::MatrixXd inverse;
+  if (InvertInformation(information, &inverse)) cov = inverse;
+  // The nominal's Gaussian prior: ln det(I + C A) = ln det(I + A_zz) = ln det(H_zz).
+  out->occam = prior ? LogDet(information.topLeftCorner(own, own)) : 0.0;
+  out->occam += OccamPenalty(layout, out->effects, EffectInformation(information, own));
+  out->occam += BoundedPenalty(layout, residual, theta, r, jac);
+  long i = own;
+  for (std::size_t e = 0; e < out->effects.size(); ++e)
+    for (std::size_t p = 0; p < out->effects[e].params.size(); ++p, ++i)
+      out->sigma[e].push_back(std::abs(layout.Slope(out->effects, e, p)) * std::sqrt(cov(i, i)));
+}
+
 }  // namespace
+
+EffectFitter::EffectFitter(const NominalNetwork& nominal, const std::vector<GapUnit>& units,
+                           NominalFit mode, const NominalTolerances& tolerances)
+    : EffectFitter(nominal, units) {
+  mode_ = mode;
+  if (mode == NominalFit::kTolerance)
+    prior_ = std::make_shared<TolerancePrior>(nominal.quantity, tolerances);
+}
+
+EffectFit EffectFitter::Fit(const std::vector<AppliedEffect>& start, const LineMask& mask,
+                            int max_iterations) const {
+  return FitFrom(start_nominal_, mode_, start, mask, max_iterations);
+}
+
+EffectFit EffectFitter::FitFrom(const NominalNetwork& from, NominalFit mode,
+                                const std::vector<AppliedEffect>& start, const LineMask& mask,
+                                int max_iterations) const {
+  EffectFit out;
+  out.effects = start;
+  out.nominal = mode == NominalFit::kFixed ? nominal_ : from;
+  const Lines lines = Collect(nominal_, units_, {}, mask);
+  out.residuals = static_cast<int>(2 * lines.f.size());
+  Layout layout = MakeLayout(start, nominal_, f_lo_, f_hi_);
+  layout.own = mode == NominalFit::kFixed ? 0 : NominalParams(nominal_);
+  out.n_params = layout.size();
+  out.n_nominal = layout.own;
+  const int own = layout.own, total = own + layout.size();
+  const TolerancePrior* prior = mode == NominalFit::kTolerance ? prior_.get() : nullptr;
+  if (mode == NominalFit::kTolerance && !prior) {
+    out.cost = out.chi2 = std::numeric_limits<double>::infinity();
+    return out;
+  }
+  const Eigen::VectorXd base = NominalTheta(nominal_);
+  // The nominal's shift d: theta's head itself (kFree) or through the prior's coordinates.
+  auto shift = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
+    return prior ? prior->Shift(t.head(own)) : Eigen::VectorXd(t.head(own));
+  };
+  auto nominal_at = [&](const Eigen::VectorXd& t) {
+    return own > 0 ? WithMotional(nominal_, base + shift(t)) : nominal_;
+  };
+  if (total == 0 || lines.f.empty()) {
+    out.chi2 = Chi2With(out.nominal, start, mask, &out.cost);
+    out.converged = true;
+    return out;
+  }
+  const long rows = out.residuals + (prior ? prior->size() : 0);
+  const ResidualFn residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
+    Eigen::VectorXd lik;
+    Residual(nominal_at(t), lines, layout, t.tail(layout.size()), &lik);
+    r->resize(rows);
+    r->head(lik.size()) = lik;
+    if (prior) r->tail(prior->size()) = prior->Whitened(t.head(own));
+  };
+  LeastSquaresProblem problem;
+  problem.parameters = total;
+  problem.residuals = static_cast<int>(rows);
+  problem.residual = residual;
+  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* j) {
+    DifferenceJacobian(residual, t, false, j);
+  };
+  Eigen::VectorXd theta(total);
+  if (own > 0) {
+    const Eigen::VectorXd d0 = NominalTheta(out.nominal) - base;
+    theta.head(own) = prior ? prior->Coordinates(d0) : d0;
+  }
+  if (layout.size() > 0) theta.tail(layout.size()) = layout.ToTheta(start);
+  out.iterations = Minimize(problem, max_iterations, &theta, &out.converged).iterations;
+  out.nominal = nominal_at(theta);
+  out.effects = layout.size() > 0 ? layout.FromTheta(theta.tail(layout.size()))
+                                  : std::vector<AppliedEffect>{};
+  if (own > 0) out.shift = shift(theta);
+  Eigen::VectorXd r;
+  residual(theta, &r);
+  out.prior = prior ? prior->Penalty(out.shift) : 0.0;
+  out.cost = r.squaredNorm() - out.prior;
+  out.chi2 = Chi2With(out.nominal, out.effects, mask);
+  out.sigma.resize(out.effects.size());
+  if (mode == NominalFit::kFree) {  // a calibration beyond the tolerances: no evidence
+    for (std::size_t e = 0; e < out.effects.size(); ++e)
+      out.sigma[e].assign(out.effects[e].params.size(), std::numeric_limits<double>::quiet_NaN());
+    return out;
+  }
+  Evidence(layout, residual, theta, r, prior, &out);
+  return out;
+}
 
 double EffectFitter::Chi2With(const NominalNetwork& nominal, std::span<const AppliedEffect> effects,
                               const LineMask& mask, double* cost) const {
@@ -794,74 +897,65 @@ double EffectFitter::Chi2With(const NominalNetwork& nominal, std::span<const App
   return chi2;
 }
 
+double EffectFitter::CostAt(const NominalNetwork& at, std::span<const AppliedEffect> effects,
+                            const LineMask& mask) const {
+  double cost = 0.0;
+  Chi2With(at, effects, mask, &cost);
+  return cost;
+}
+
 EffectFit EffectFitter::FitWithNominal(const NominalNetwork& nominal,
                                        const std::vector<AppliedEffect>& start,
                                        const LineMask& mask, int max_iterations,
                                        NominalNetwork* refitted) const {
-  EffectFit out;
-  out.effects = start;
-  *refitted = nominal;
-  const Lines lines = Collect(nominal_, units_, {}, mask);
-  out.residuals = static_cast<int>(2 * lines.f.size());
-  const Layout layout = MakeLayout(start, nominal_, f_lo_, f_hi_);
-  const int own = NominalParams(nominal);
-  out.n_params = own + layout.size();
-  if (lines.f.empty()) {
-    out.chi2 = Chi2With(nominal, start, mask, &out.cost);
-    return out;
-  }
-  Eigen::VectorXd theta(out.n_params);
-  theta.head(own) = NominalTheta(nominal);
-  if (layout.size() > 0) theta.tail(layout.size()) = layout.ToTheta(start);
-  auto split = [&](const Eigen::VectorXd& t) {
-    return layout.size() > 0 ? layout.FromTheta(t.tail(layout.size()))
-                             : std::vector<AppliedEffect>{};
-  };
-  LeastSquaresProblem problem;
-  problem.parameters = out.n_params;
-  problem.residuals = out.residuals;
-  problem.residual = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r) {
-    const Eigen::VectorXd effects = t.tail(layout.size());
-    Residual(WithMotional(nominal, t), lines, layout, effects, r);
-  };
-  problem.jacobian = [&](const Eigen::VectorXd& t, Eigen::MatrixXd* jac) {
-    DifferenceJacobian(problem.residual, t, false, jac);
-  };
-  LeastSquaresSettings settings;
-  settings.max_iterations = max_iterations;
-  settings.ftol = kLmTol;
-  settings.xtol = kLmTol;
-  const LeastSquaresOutcome outcome = MinimizeLeastSquares(problem, &theta, settings);
-  out.iterations = outcome.iterations;
-  out.converged = outcome.converged;
-  *refitted = WithMotional(nominal, theta);
-  out.effects = split(theta);
-  out.chi2 = Chi2With(*refitted, out.effects, mask, &out.cost);
+  EffectFit out = FitFrom(nominal, NominalFit::kFree, start, mask, max_iterations);
+  *refitted = out.nominal;
   return out;
 }
 
 EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
                                  const std::vector<AppliedEffect>& seeds, const LineMask& mask,
-                                 int max_iterations) const {
-  std::vector<std::vector<AppliedEffect>> starts;
+                                 int max_iterations,
+                                 const std::vector<NominalNetwork>& seed_nominals) const {
+  // (the nominal a start begins at, the effects' start)
+  std::vector<std::pair<NominalNetwork, std::vector<AppliedEffect>>> starts;
   auto sorted = [](std::vector<AppliedEffect> v) {
     std::sort(v.begin(), v.end(),
               [](const AppliedEffect& a, const AppliedEffect& b) { return a.kind < b.kind; });
     return v;
   };
+  auto seed_nominal = [&](std::size_t i) {
+    return i < seed_nominals.size() ? seed_nominals[i] : start_nominal_;
+  };
   if (kinds.size() == 1) {
-    for (auto& p : Starts(kinds[0], {}, mask)) starts.push_back({{kinds[0], p}});
+    for (auto& p : StartsAt(kinds[0], {}, mask, start_nominal_))
+      starts.push_back({start_nominal_, {{kinds[0], p}}});
+    // With the nominal calibrated, an effect that re-draws the calibrated shift (a fixture
+    // spring: the mode far down) also starts from the simulation's nominal, where it is the
+    // whole shift: from the calibrated one LM must walk a valley the prior alone curves.
+    if (mode_ != NominalFit::kFixed) {
+      const auto at_sim = StartsAt(kinds[0], {}, mask, nominal_);
+      for (std::size_t i = 0; i < std::min<std::size_t>(at_sim.size(), 2); ++i)
+        starts.push_back({nominal_, {{kinds[0], at_sim[i]}}});
+    }
   } else {
-    // Each kind's starts on top of the other kinds' seeds, and all the seeds together.
-    starts.push_back(sorted(seeds));
+    // Each kind's starts on top of the other kinds' seeds (at the other's nominal), and all
+    // the seeds together (at each seed's nominal).
+    for (std::size_t i = 0; i < std::max<std::size_t>(1, seed_nominals.size()); ++i)
+      starts.push_back({seed_nominal(i), sorted(seeds)});
     for (std::size_t i = 0; i < kinds.size(); ++i) {
       std::vector<AppliedEffect> others;
+      std::size_t other = 0;
       for (std::size_t j = 0; j < seeds.size(); ++j)
-        if (j != i) others.push_back(seeds[j]);
-      for (auto& p : Starts(kinds[i], others, mask)) {
+        if (j != i) {
+          others.push_back(seeds[j]);
+          other = j;
+        }
+      const NominalNetwork at = seed_nominal(other);
+      for (auto& p : StartsAt(kinds[i], others, mask, at)) {
         std::vector<AppliedEffect> s = others;
         s.push_back({kinds[i], p});
-        starts.push_back(sorted(s));
+        starts.push_back({at, sorted(s)});
       }
     }
   }
@@ -881,8 +975,8 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
   // bound compete too: their evidence integrates the likelihood over their prior (effect_fit.h).
   std::vector<EffectFit> fits;
   std::vector<char> ok;
-  for (const auto& s : starts) {
-    EffectFit f = Fit(s, mask, max_iterations);
+  for (const auto& [at, s] : starts) {
+    EffectFit f = FitFrom(at, mode_, s, mask, max_iterations);
     if (!std::isfinite(f.cost)) continue;
     ok.push_back(admissible(f));
     fits.push_back(std::move(f));
@@ -894,14 +988,19 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
   }
   std::size_t lowest = 0;
   for (std::size_t i = 1; i < fits.size(); ++i)
-    if ((ok[i] && !ok[lowest]) || (ok[i] == ok[lowest] && fits[i].cost < fits[lowest].cost))
+    if ((ok[i] && !ok[lowest]) ||
+        (ok[i] == ok[lowest] &&
+         fits[i].cost + fits[i].prior < fits[lowest].cost + fits[lowest].prior))
       lowest = i;
   if (!ok[lowest]) return std::move(fits[lowest]);
   std::size_t chosen = lowest;
   for (std::size_t i = 0; i < fits.size(); ++i)
-    if (ok[i] && fits[i].cost + fits[i].occam < fits[chosen].cost + fits[chosen].occam) chosen = i;
+    if (ok[i] && fits[i].Evidence() < fits[chosen].Evidence()) chosen = i;
   EffectFit best = std::move(fits[chosen]);
-  if (chosen != lowest) best.lowest_cost = fits[lowest].effects;
+  if (chosen != lowest) {
+    best.lowest_cost = fits[lowest].effects;
+    best.lowest_cost_nominal = fits[lowest].nominal;
+  }
   return best;
 }
 

@@ -1,7 +1,12 @@
-// Fitting unmodelled effects (analysis/model/effects.h) on top of a fixed nominal network.
+// Fitting unmodelled effects (analysis/model/effects.h) on top of the nominal network.
 //
-// The nominal's parameters stay at the simulation's values; only the effects' parameters are
-// fitted, on every (selected) line of every unit, from the normalised residual
+// The nominal's own parameters (NominalFit): kFixed keeps them at the simulation's values;
+// kTolerance (the diagnosis' default) fits them with the effects under a Gaussian prior of the
+// design's tolerances (tolerance.h): theta starts with the identifiable log-shifts d of the
+// nominal (impedance: ln R, ln L, ln Rp, ln f0, ln Q; mobility: ln g, ln a), the residual gets
+// the prior's rows W d, and the evidence integrates them out (below); kFree fits them with no
+// prior (a calibration beyond the tolerances; no evidence). The effects' parameters are fitted
+// on every (selected) line of every unit, from the normalised residual
 //   r_uk = (H_meas(u,k) - H_model(f_uk)) / sigma_uk                 (impedance form)
 //   r_uk = (1/H_meas - 1/H_model) |H_meas|^2 / sigma_uk             (admittance form)
 // The admittance form is for a ratio Z = U / I whose current channel carries the noise: then
@@ -18,7 +23,13 @@
 // buying a narrow mode; nu = 0 (exact sigma) gives rho = 2 u, the chi2. The fits minimise
 // the cost (Levenberg-Marquardt on the residual scaled by sqrt(rho(u) / u)), and the model
 // selection (diagnosis.h) scores it.
-// Evidence: -2 ln p(data | effect) ~ cost + occam. For the unbounded parameters (Laplace)
+// Evidence: -2 ln p(data | effect) ~ cost + prior + occam. The nominal's shifts d under their
+// Gaussian prior (covariance C) pay ln det(I + C A_nn) = ln det C + ln det(A_nn + C^-1) (A the
+// information, A_nn its block for d: 0 for a shift the data leave to the prior, ln of
+// (prior width / posterior width)^2 for one they pin), and the effects' parameters are charged
+// on their information with d integrated out (the Schur complement A_ee - A_en (A_nn +
+// C^-1)^-1 A_ne): an effect that only re-draws a calibration within the tolerances pins
+// nothing the prior had not. For the effects' unbounded parameters (Laplace)
 //   occam = sum_i max(0, ln(lambda_i / 2 pi)),  lambda_i the eigenvalues of W A W,
 // A = J^T J the information in theta at the optimum and W the prior widths of the thetas
 // (uniform in ln(value) over the plausibility bounds for log-scaled parameters, in ln |value|
@@ -55,10 +66,12 @@
 #pragma once
 
 #include <complex>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "analysis/gap/tolerance.h"
 #include "analysis/model/effects.h"
 
 namespace eol::analysis {
@@ -108,26 +121,44 @@ void ChooseResidualForm(GapUnit& u, bool impedance_quantity, ResidualForm form);
 // mask[u][k] != 0: line k of unit u takes part. An empty mask selects every line.
 using LineMask = std::vector<std::vector<char>>;
 
+enum class NominalFit { kFixed, kTolerance, kFree };
+
 struct EffectFit {
   std::vector<AppliedEffect> effects;
+  NominalNetwork nominal;  // the nominal the effects sit on (refitted unless kFixed)
+  Eigen::VectorXd shift;   // its identifiable log-shifts d from the simulation's (empty: fixed)
+  double prior = 0.0;      // d^T C^-1 d (kTolerance): minimised with the cost
+  int n_nominal = 0;       // the nominal's own parameters fitted
   std::vector<std::vector<double>> sigma;  // per effect, per parameter, natural units (NaN:
                                            // not determined)
   double chi2 = 0.0;                       // on the selected lines
   double cost = 0.0;                       // sum rho (above), what the fit minimised
   double occam = 0.0;                      // the Laplace evidence's penalty (above)
   int residuals = 0;                       // 2 x selected lines
-  int n_params = 0;
+  int n_params = 0;                        // the effects' parameters
   bool converged = false;
   int iterations = 0;
   // FitKinds: the lowest-cost optimum's effects, kept when the answer is another basin with a
   // better evidence (empty otherwise); pairs start from it, where the fit of both is.
   std::vector<AppliedEffect> lowest_cost;
+  NominalNetwork lowest_cost_nominal;  // the nominal that basin sits on
+
+  // -2 ln of the evidence (above): what the basins and the candidates are compared by.
+  double Evidence() const { return cost + prior + occam; }
 };
 
 class EffectFitter {
  public:
   // f_lo_hz, f_hi_hz: the band the plausibility bounds refer to (the units' band).
   EffectFitter(const NominalNetwork& nominal, const std::vector<GapUnit>& units);
+  // The nominal's own parameters fitted as `mode` says (kTolerance: under `tolerances`).
+  EffectFitter(const NominalNetwork& nominal, const std::vector<GapUnit>& units, NominalFit mode,
+               const NominalTolerances& tolerances = {});
+  // Where the nominal starts in Fit and the nominal Starts scores its grids on (default: the
+  // simulation's; the diagnosis sets the calibrated one).
+  void SetStartNominal(const NominalNetwork& n) { start_nominal_ = n; }
+  NominalFit mode() const { return mode_; }
+  const TolerancePrior* prior() const { return prior_.get(); }
 
   const NominalNetwork& nominal() const { return nominal_; }
   const std::vector<GapUnit>& units() const { return units_; }
@@ -145,14 +176,17 @@ class EffectFitter {
   std::vector<std::vector<double>> Starts(EffectKind kind, std::span<const AppliedEffect> base,
                                           const LineMask& mask) const;
 
-  // Levenberg-Marquardt from `start` (every parameter of every effect is free).
+  // Levenberg-Marquardt from `start` (every parameter of every effect is free; the nominal's
+  // as mode() says, from the start nominal).
   EffectFit Fit(const std::vector<AppliedEffect>& start, const LineMask& mask,
                 int max_iterations) const;
+  // The same from the nominal `from` in another mode.
+  EffectFit FitFrom(const NominalNetwork& from, NominalFit mode,
+                    const std::vector<AppliedEffect>& start, const LineMask& mask,
+                    int max_iterations) const;
 
-  // Calibration and structure together: as Fit, with the nominal's own parameters free too
-  // (impedance: ln R, ln L, ln Rp, ln f0, ln Q; mobility: ln g, ln a; started from
-  // `nominal`). The refitted nominal goes to *refitted; the effects' parameters to the
-  // result (start may be empty: a refit of the nominal alone). n_params counts both.
+  // Calibration beyond the tolerances and structure together: FitFrom(nominal, kFree, ...),
+  // the refitted nominal also in *refitted (start may be empty: a refit of the nominal alone).
   EffectFit FitWithNominal(const NominalNetwork& nominal, const std::vector<AppliedEffect>& start,
                            const LineMask& mask, int max_iterations,
                            NominalNetwork* refitted) const;
@@ -166,11 +200,23 @@ class EffectFitter {
   // (IsPlausible) converged fits the one of best evidence (cost + occam); when that is not the
   // lowest-cost one, the lowest-cost one is kept in lowest_cost. The lowest cost of all only
   // when no fit is plausible and converged.
+  // seed_nominals: the nominal each seed's fit sat on (the pair's starts begin there; empty:
+  // the start nominal). With the nominal calibrated, a single also starts from the
+  // simulation's nominal (its two best starts there).
   EffectFit FitKinds(const std::vector<EffectKind>& kinds, const std::vector<AppliedEffect>& seeds,
-                     const LineMask& mask, int max_iterations) const;
+                     const LineMask& mask, int max_iterations,
+                     const std::vector<NominalNetwork>& seed_nominals = {}) const;
 
  private:
+  double CostAt(const NominalNetwork& at, std::span<const AppliedEffect> effects,
+                const LineMask& mask) const;
+  std::vector<std::vector<double>> StartsAt(EffectKind kind, std::span<const AppliedEffect> base,
+                                            const LineMask& mask, const NominalNetwork& at) const;
+
   NominalNetwork nominal_;
+  NominalNetwork start_nominal_;
+  NominalFit mode_ = NominalFit::kFixed;
+  std::shared_ptr<const TolerancePrior> prior_;
   std::vector<GapUnit> units_;
   double f_lo_ = 0.0, f_hi_ = 0.0;
 };

@@ -235,6 +235,7 @@ GapInput ReadMotorJson(const std::string& path, const std::vector<double>& lines
   const analysis::RotorChainParams& rotor = spec.rotor;
   in.inertia_kg_m2 = rotor.magnets * (rotor.magnet_inertia_kg_m2 + rotor.pole_inertia_kg_m2) +
                      rotor.hub_inertia_kg_m2;
+  in.tolerances = spec.tolerances;
   std::ostringstream os;
   os << "motor JSON " << spec.id << " (torsional chain, " << motor.chain.size()
      << " inertias) evaluated on the measured lines";

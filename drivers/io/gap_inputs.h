@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "analysis/frf.h"
+#include "analysis/gap/tolerance.h"
 #include "analysis/model/effects.h"
 
 namespace eol::io {
@@ -59,6 +60,8 @@ struct GapInput {
   // the rotor inertia when the model knows it (0 otherwise).
   std::optional<analysis::NominalNetwork> model;
   double inertia_kg_m2 = 0.0;
+  // The design's tolerances when the simulation states them (a motor JSON's "tolerances").
+  std::optional<analysis::NominalTolerances> tolerances;
 };
 
 // `lines_hz`: where a model is evaluated (the measurement's lines); FRF files keep theirs.

@@ -92,6 +92,17 @@ void ParseFixture(const JsonObject& root, analysis::RotorChainParams* p) {
   p->fixture = s;
 }
 
+// "tolerances": each field optional over analysis::NominalTolerances' defaults.
+analysis::NominalTolerances ParseTolerances(const JsonObject& o) {
+  analysis::NominalTolerances t;
+  for (const char* name : analysis::kToleranceNames)
+    if (const auto v = o.OptionalNumber(name)) t.Set(name, *v);
+  std::string why;
+  if (!t.IsValid(&why)) throw ConfigError("/tolerances: " + why);
+  o.RejectUnknown();
+  return t;
+}
+
 }  // namespace
 
 double MotorSpec::TransmissionNmPerA(std::optional<double> position_deg) const {
@@ -133,6 +144,7 @@ MotorSpec ParseMotorJson(const nlohmann::json& j, const std::string& source) {
       m.effects = root.Raw("effects");
       if (!m.effects.is_array()) throw ConfigError(root.PathOf("effects") + ": must be an array");
     }
+    if (const auto t = root.OptionalObject("tolerances")) m.tolerances = ParseTolerances(*t);
     root.RejectUnknown();
     return m;
   } catch (const ConfigError& e) {
@@ -140,11 +152,22 @@ MotorSpec ParseMotorJson(const nlohmann::json& j, const std::string& source) {
   }
 }
 
+nlohmann::json ToleranceJson(const analysis::NominalTolerances& t) {
+  return {{"r", t.r},
+          {"l", t.l},
+          {"torque_constant", t.torque_constant},
+          {"inertia", t.inertia},
+          {"stiffness", t.stiffness},
+          {"damping", t.damping_factor},
+          {"daq_gain", t.daq_gain}};
+}
+
 MotorSpec LoadMotorJson(const std::string& path) {
   return ParseMotorJson(io::ReadJsonFile(path), path);
 }
 
-nlohmann::json ToJson(const MotorSpec& m) {
+namespace {
+nlohmann::json ToJsonWithoutTolerances(const MotorSpec& m) {
   nlohmann::json transducer;
   if (m.transmission_nm_per_a)
     transducer = {{"transmission_nm_per_a", *m.transmission_nm_per_a}};
@@ -174,6 +197,14 @@ nlohmann::json ToJson(const MotorSpec& m) {
             {"soft_magnets", r.soft_magnets}}},
           {"fixture", fixture},
           {"effects", m.effects}};
+}
+
+}  // namespace
+
+nlohmann::json ToJson(const MotorSpec& m) {
+  nlohmann::json j = ToJsonWithoutTolerances(m);
+  if (m.tolerances) j["tolerances"] = ToleranceJson(*m.tolerances);
+  return j;
 }
 
 }  // namespace eol::io

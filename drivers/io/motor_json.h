@@ -18,8 +18,15 @@
 //   "fixture": {"stiffness_nm_per_rad": 887.9, "damping_nms_per_rad": 8.052e-3,
 //               "clamp_inertia_kg_m2": 5e-6},           optional (default as shown);
 //              null: a rigid fixture (the shaft end is ground)
-//   "effects": [ ... ]                      optional, unmodelled effects: kept as raw JSON here
+//   "effects": [ ... ],                     optional, unmodelled effects: kept as raw JSON here
 //                                           (analysis/model/effects.h reads them)
+//   "tolerances": {"r": 0.10, "l": 0.08, "torque_constant": 0.06, "inertia": 0.06,
+//                  "stiffness": 0.15, "damping": 3, "daq_gain": 0.01}
+//                                           optional, each field optional (defaults shown):
+//                                           the design's tolerances, one sd of each relative
+//                                           offset (damping: a factor, log-normal), the prior
+//                                           `eol gap` calibrates the nominal under
+//                                           (analysis/gap/tolerance.h; --tolerances overrides)
 // }
 // The chain these numbers build is analysis/model/rotor_chain.h (the defaults are its
 // ten-pole calibration: 706 Hz rigid, 529 Hz with every bond poor, 390 Hz in the default
@@ -33,6 +40,7 @@
 #include <optional>
 #include <string>
 
+#include "analysis/gap/tolerance.h"
 #include "analysis/model/rotor_chain.h"
 #include "analysis/model/torsional_chain.h"
 
@@ -50,6 +58,7 @@ struct MotorSpec {
   double rotor_position_deg = 0.0;
   analysis::RotorChainParams rotor;  // fixture (nullopt: rigid) and soft magnets included
   nlohmann::json effects = nlohmann::json::array();
+  std::optional<analysis::NominalTolerances> tolerances;  // "tolerances" when given
 
   // T at the file's rotor position, or at `rotor_position_deg` when given (which needs the
   // t_hat form; throws io::ConfigError naming the motor otherwise).
@@ -61,6 +70,8 @@ struct MotorSpec {
 // Throws io::ConfigError "motor <source>: <json path>: <rule>".
 MotorSpec ParseMotorJson(const nlohmann::json& j, const std::string& source);
 MotorSpec LoadMotorJson(const std::string& path);
+// The "tolerances" object of a motor JSON.
+nlohmann::json ToleranceJson(const analysis::NominalTolerances& t);
 // The canonical JSON of a spec (every field written); ParseMotorJson(ToJson(s)) == s.
 nlohmann::json ToJson(const MotorSpec& spec);
 

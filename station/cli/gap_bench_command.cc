@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/bench/gap_bench.h"
+#include "station/bench/gap_independent_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/progress.h"
@@ -22,6 +23,7 @@ struct GapBenchArgs {
   std::uint64_t seed = 1;
   bool json = false;
   bool quiet = false;
+  std::vector<std::string> independent;
 };
 
 std::string Pct(double x) {
@@ -53,7 +55,58 @@ void PrintMatrix(std::ostream& out, const analysis::GapBenchSummary& s) {
   }
 }
 
+void PrintClass(std::ostream& out, const char* what, const IndependentGapClass& k) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%-34s %3d / %3d separable, %3d / %3d all; a pair answered %d\n",
+                what, k.separable_right, k.separable, k.right, k.cases, k.pair_answered);
+  out << buf;
+}
+
+// The independent generator's cases in DIR (station/bench/gap_independent_bench.h).
+int RunIndependent(const std::string& dir, const GapBenchArgs& a) {
+  std::ostream& out = a.json ? std::cerr : std::cout;
+  const IndependentGapSummary s = RunIndependentGapCases(dir, [&](const IndependentGapCase& c) {
+    if (a.quiet) return;
+    char line[320];
+    std::snprintf(line, sizeof line, "%s %-6s %-44s S %7.1f -> %-44s %s%s\n", c.name.c_str(),
+                  c.cls.c_str(), c.hidden.c_str(), c.strength, c.answer.c_str(),
+                  c.right ? "ok " : "MISS", c.separable ? "" : " (not separable)");
+    out << line << std::flush;
+  });
+  out << "\nindependent cases " << dir << " (" << s.cases.size() << " cases, "
+      << static_cast<int>(s.seconds + 0.5) << " s)\n";
+  PrintClass(out, "none (calibration only): `none`", s.none);
+  PrintClass(out, "one effect: named alone", s.single);
+  PrintClass(out, "two effects: named exactly", s.pair);
+  if (a.json) {
+    nlohmann::json cases = nlohmann::json::array();
+    for (const auto& c : s.cases)
+      cases.push_back({{"case", c.name},
+                       {"class", c.cls},
+                       {"hidden", c.hidden},
+                       {"separable", c.separable},
+                       {"strength", c.strength},
+                       {"answer", c.answer},
+                       {"right", c.right}});
+    auto cls = [](const IndependentGapClass& k) {
+      return nlohmann::json{{"cases", k.cases},
+                            {"right", k.right},
+                            {"separable", k.separable},
+                            {"separable_right", k.separable_right},
+                            {"pair_answered", k.pair_answered}};
+    };
+    std::cout << nlohmann::json{{"independent", dir},  {"seconds", s.seconds},
+                                {"none", cls(s.none)}, {"single", cls(s.single)},
+                                {"pair", cls(s.pair)}, {"per_case", cases}}
+                     .dump()
+              << std::endl;
+  }
+  return 0;
+}
+
 int RunGapBenchCommand(const GapBenchArgs& a) {
+  for (const std::string& dir : a.independent) RunIndependent(dir, a);
+  if (a.cases == 0) return 0;
   analysis::GapBenchOptions o;
   o.cases = a.cases;
   o.seed = a.seed;
@@ -161,9 +214,14 @@ void AddGapBenchCommand(CLI::App& app) {
       "label; prints the confusion matrix, top-1 accuracy (overall and on cases an oracle with\n"
       "the true model families can separate), band coverage, held-out shrink of g, and how\n"
       "often a strong effect was called 'none' (analysis/bench/gap_bench.h defines each).");
-  cmd->add_option("--cases", a->cases, "Number of cases")
+  cmd->add_option("--cases", a->cases, "Number of cases (0: only the --independent ones)")
       ->capture_default_str()
-      ->check(Between(1, 100000));
+      ->check(Between(0, 100000));
+  cmd->add_option("--independent", a->independent,
+                  "Also diagnose the blind cases an independent generator wrote into DIR "
+                  "(truth.json: tests/peers/independent_gap_cases.py, "
+                  "independent_tolerance_cases.py); repeatable")
+      ->check(CLI::ExistingDirectory);
   cmd->add_option("--seed", a->seed, "Seed (the same seed gives the same cases)")
       ->capture_default_str();
   cmd->add_flag("--json", a->json,

@@ -52,6 +52,8 @@ struct GapArgs {
   std::string input_column, output_column, lines_file;
   std::vector<std::string> effects;
   bool no_pairs = false;
+  std::string tolerances;
+  bool fixed_nominal = false;
 };
 
 double RecipeInertia(const std::string& path) {
@@ -80,6 +82,8 @@ int RunGap(const GapArgs& a) {
   o.sigma_exact = a.sigma_exact;
   o.inertia_kg_m2 = a.inertia_kg_m2;
   o.try_pairs = !a.no_pairs;
+  o.tolerances = a.tolerances;
+  o.calibrate = !a.fixed_nominal;
   for (const std::string& name : a.effects) {
     const auto kind = analysis::ParseEffectKind(name);
     if (!kind)
@@ -114,7 +118,7 @@ int RunGap(const GapArgs& a) {
     }
     analysis::RankedEffect none;
     const analysis::RankedEffect* w = Winner(r.gap);
-    p.prediction = analysis::PredictWithEffects(r.calibration.nominal, w ? *w : none,
+    p.prediction = analysis::PredictWithEffects(r.gap.nominal_after, w ? *w : none,
                                                 p.calibration.nominal, lines);
     r.prediction = std::move(p);
   }
@@ -210,6 +214,16 @@ void AddGapCommand(CLI::App& app) {
                   "report)")
       ->delimiter(',');
   cmd->add_flag("--no-pairs", a->no_pairs, "Do not try pairs of effects");
+  auto* tol = cmd->add_option(
+      "--tolerances", a->tolerances,
+      "The design's tolerances the nominal is calibrated under in every fit, one sd each: "
+      "name=value,... over the motor JSON's \"tolerances\", else the defaults r=0.1, l=0.08, "
+      "torque_constant=0.06, inertia=0.06, stiffness=0.15, damping=3 (a factor), "
+      "daq_gain=0.01");
+  cmd->add_flag("--fixed-nominal", a->fixed_nominal,
+                "Keep the nominal at the simulation's values in every fit (no calibration; the "
+                "diagnosis before issue 38)")
+      ->excludes(tol);
   cmd->callback([a] { RunGuarded("gap", [&] { return RunGap(*a); }); });
 }
 

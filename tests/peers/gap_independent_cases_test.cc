@@ -38,8 +38,10 @@ TEST(GapIndependentCases, NamesCoupledInertiaAndNeverInventsAnEffect) {
   ChildProcess gen({kPython, Script(), "--out", dir, "--cases", "20", "--seed", "7", "--plan",
                     "coupled_inertia,none,coupled_inertia,fixture_spring"});
   ASSERT_EQ(gen.Wait(std::chrono::seconds(120)).value_or(-1), 0) << gen.output();
+  // The exact simulation: the nominal kept at the simulation's values (issue 38's calibration
+  // takes the weak second inertias into J's tolerance; the tolerance cases below test it).
   ChildProcess score({kPython, Script(), "--out", dir, "--score", "--eol", EOL_BINARY, "--",
-                      "--sigma-periods", "8"});
+                      "--sigma-periods", "8", "--fixed-nominal"});
   ASSERT_EQ(score.Wait(std::chrono::seconds(600)).value_or(-1), 0) << score.output();
   std::ifstream in(dir + "/score.json");
   ASSERT_TRUE(in) << dir << "/score.json: " << score.output();
@@ -66,6 +68,38 @@ TEST(GapIndependentCases, NamesCoupledInertiaAndNeverInventsAnEffect) {
   EXPECT_GE(coupled_named_all, 8) << score.output();
   const double named = s["separable_named"], separable = s["separable"];
   EXPECT_GE(named, 0.9 * separable) << score.output();
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+}
+
+// Issue 38: the simulation is not the unit. tests/peers/independent_tolerance_cases.py (written
+// apart from analysis/, the physics of independent_gap_cases.py) puts every design parameter of
+// the unit off its simulation by its tolerance (R, L, torque constant, J, k by 5-12 %, damping
+// x0.5-2, a DAQ gain error of 0.2-1.5 %), motors 250 Hz - 2 kHz, and none, one or two hidden
+// effects; its oracle marks a case separable when the truth beats the tolerance-calibrated
+// nominal without each effect by the decision rule's margin. Nine cases (seed 2: three of each
+// class) keep the run short; `eol gap-bench --independent DIR` runs the 48-case figures
+// (analysis/gap/README.md). Contract: a calibration-only case is always `none`, never a pair;
+// every separable single effect is named alone.
+TEST(GapIndependentCases, ACalibrationIsNoneAndASingleEffectIsNamedAlone) {
+  std::string tmpl = (std::filesystem::temp_directory_path() / "eol_gap_tol_XXXXXX").string();
+  ASSERT_NE(mkdtemp(tmpl.data()), nullptr);
+  const std::string dir = tmpl;
+  const std::string script =
+      std::string(EOL_SOURCE_DIR) + "/tests/peers/independent_tolerance_cases.py";
+  ChildProcess gen({kPython, script, "--out", dir, "--cases", "9", "--seed", "2"});
+  ASSERT_EQ(gen.Wait(std::chrono::seconds(300)).value_or(-1), 0) << gen.output();
+  ChildProcess score({kPython, script, "--out", dir, "--score", "--eol", EOL_BINARY, "--",
+                      "--sigma-periods", "8"});
+  ASSERT_EQ(score.Wait(std::chrono::seconds(1200)).value_or(-1), 0) << score.output();
+  std::ifstream in(dir + "/score.json");
+  ASSERT_TRUE(in) << dir << "/score.json: " << score.output();
+  const nlohmann::json s = nlohmann::json::parse(in)["summary"];
+  EXPECT_EQ(s["none"]["cases"], 3);
+  EXPECT_EQ(s["none"]["ok"], 3) << score.output();
+  EXPECT_EQ(s["none"]["pair_answered"], 0) << score.output();
+  EXPECT_GE(s["single"]["separable"], 2) << score.output();
+  EXPECT_EQ(s["single"]["separable_ok"], s["single"]["separable"]) << score.output();
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);
 }

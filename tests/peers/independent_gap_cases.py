@@ -119,33 +119,43 @@ def branch(s, j2, k2, c2):
 
 
 def impedance(m, f, effect=None, p=None):
+    """The unit's impedance with one hidden effect (or none); impedance_with for several."""
+    return impedance_with(m, f, [(effect, p or {})] if effect else [])
+
+
+def impedance_with(m, f, effects):
+    """The unit's impedance with every (kind, params) of `effects` at its place."""
     s = 2j * math.pi * f
-    p = p or {}
+    kinds = {kind: p for kind, p in effects}
     shaft = m["k_f"] / s + m["c_f"]
     rotor_node = s * m["J"]
-    if effect == "coupled_inertia":
+    if "coupled_inertia" in kinds:
+        p = kinds["coupled_inertia"]
         b = branch(s, p["J2"], p["k2"], p["c2"])
         if p["at"] == "rotor":
             rotor_node = rotor_node + b
         else:
             shaft = shaft + b
-    if effect == "fixture_spring":
+    if "fixture_spring" in kinds:
+        p = kinds["fixture_spring"]
         shaft = 1.0 / (1.0 / shaft + 1.0 / (p["k_x"] * (1 + 1j * p["eta"]) / s))
     zm = rotor_node + 1.0 / (1.0 / (m["k_r"] / s + m["c_r"]) + 1.0 / shaft)
-    r = m["R"] + (p["dR"] if effect == "series_resistance" else 0.0)
-    if effect == "fractional_inductance":
+    r = m["R"] + (kinds["series_resistance"]["dR"] if "series_resistance" in kinds else 0.0)
+    if "fractional_inductance" in kinds:
+        p = kinds["fractional_inductance"]
         a, n, w_ref = p["a"], p["n"], p["w_ref"]
         zl = s * m["L"] * (1 - a) + a * m["L"] * w_ref ** (1 - n) * (1j * np.abs(s.imag)) ** n
-    elif effect == "eddy_branch":
+    elif "eddy_branch" in kinds:
+        p = kinds["eddy_branch"]
         l2, r2 = p["L2"], p["R2"]
         zl = s * (m["L"] - l2) + s * l2 * r2 / (s * l2 + r2)
     else:
         zl = s * m["L"]
     z = r + zl + m["T"] ** 2 / zm
-    if effect == "stray_capacitance":
-        z = z / (1 + s * p["C"] * z)
-    if effect == "channel_delay":
-        z = z * np.exp(-s * p["tau"])
+    if "stray_capacitance" in kinds:
+        z = z / (1 + s * kinds["stray_capacitance"]["C"] * z)
+    if "channel_delay" in kinds:
+        z = z * np.exp(-s * kinds["channel_delay"]["tau"])
     return z
 
 

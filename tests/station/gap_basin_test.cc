@@ -8,6 +8,10 @@
 // And a winding whose whole inductance is a semi-inductance
 // (tests/data/gap-independent-semi-inductance): the fractional inductance's share sits at its
 // bound of 1, a plausible answer.
+// These cases are exact simulations plus one effect, near the information limit; the nominal is
+// kept at the simulation's values here (GapOptions::calibrate = false): with it calibrated
+// within the design's tolerances (issue 38) the weak coupled inertias and the eddy corner below
+// the band are within J's and L's tolerances and answered `none`.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -56,6 +60,7 @@ analysis::GapSummary Diagnose(const BlindCase& c,
                               analysis::ResidualForm form = analysis::ResidualForm::kAuto) {
   analysis::GapOptions o;
   o.heldout = false;
+  o.calibrate = false;  // the exact simulation's basins (kept fixed: see the top)
   o.residual_form = form;
   return analysis::DiagnoseGap(c.nominal, {c.unit}, o);
 }
@@ -98,6 +103,7 @@ TEST(GapBasin, CoupledInertiaIsScoredInItsBasinOfBestEvidence) {
 
   analysis::GapOptions o;
   o.heldout = false;
+  o.calibrate = false;  // the exact simulation's basins (kept fixed: see the top)
   const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
   ASSERT_TRUE(s.usable) << s.message;
   EXPECT_EQ(s.effect, "coupled_inertia") << s.message;
@@ -113,6 +119,7 @@ TEST(GapBasin, AnEqualRivalIsNamed) {
   const BlindCase c = Load("case-056");
   analysis::GapOptions o;
   o.heldout = false;
+  o.calibrate = false;  // the exact simulation's basins (kept fixed: see the top)
   o.prior_odds.clear();
   const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
   ASSERT_TRUE(s.usable) << s.message;
@@ -142,6 +149,7 @@ TEST(GapBasin, PriorOddsWeighTheEvidenceByTwiceTheirLog) {
   const BlindCase c = Load("seed7-case-011");
   analysis::GapOptions o;
   o.heldout = false;
+  o.calibrate = false;  // the exact simulation's basins (kept fixed: see the top)
   ASSERT_EQ(o.prior_odds.size(), 1u);
   ASSERT_EQ(o.prior_odds[0].first, analysis::EffectKind::kCoupledInertia);
   const double default_odds = o.prior_odds[0].second;
@@ -296,6 +304,7 @@ TEST(GapBasin, AWholeSemiInductanceSitsAtTheShareBoundOfOne) {
 
   analysis::GapOptions o;
   o.heldout = false;
+  o.calibrate = false;  // the exact simulation's basins (kept fixed: see the top)
   const analysis::GapSummary s = analysis::DiagnoseGap(c.nominal, {c.unit}, o);
   ASSERT_TRUE(s.usable) << s.message;
   EXPECT_EQ(s.effect, "fractional_inductance") << s.message;

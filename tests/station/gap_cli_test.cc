@@ -150,7 +150,7 @@ TEST_F(GapCli, MissingSigmaIsEstimatedAndSaid) {
 
 TEST_F(GapCli, SeveralUnitsAndAPlot) {
   const std::vector<analysis::AppliedEffect> truth = {
-      {analysis::EffectKind::kSeriesResistance, {0.015}}};
+      {analysis::EffectKind::kSeriesResistance, {0.5}}};
   std::vector<std::string> args = {"gap",           "--sim",           dir_ / "sim.csv",
                                    "--json-out",    dir_ / "out.json", "--plot",
                                    dir_ / "gap.svg"};
@@ -166,7 +166,9 @@ TEST_F(GapCli, SeveralUnitsAndAPlot) {
   EXPECT_EQ(j["effect"], "series_resistance") << r.output;
   EXPECT_EQ(j["heldout"]["method"], "leave-one-unit-out");
   EXPECT_EQ(j["measurements"].size(), 3u);
-  EXPECT_NEAR(j["params"]["resistance_ohm"].get<double>(), 0.015, 0.002);
+  // The nominal is calibrated within the design's tolerances (R 10 %): a series resistance is
+  // an effect beyond them (R 0.5 ohm: +100 %).
+  EXPECT_NEAR(j["params"]["resistance_ohm"].get<double>(), 0.5, 0.03);
   std::ifstream svg(dir_ / "gap.svg");
   const std::string s((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
   EXPECT_EQ(s.rfind("<?xml", 0), 0u);
@@ -187,7 +189,7 @@ TEST_F(GapCli, PureNoiseIsNoneAndJsonToStdout) {
 TEST_F(GapCli, RawRecordingPeriodAndLinesAreDetected) {
   const analysis::NominalNetwork n = testing::GapNominal();
   const std::vector<analysis::AppliedEffect> truth = {
-      {analysis::EffectKind::kSeriesResistance, {0.02}}};
+      {analysis::EffectKind::kSeriesResistance, {0.5}}};  // beyond R's tolerance (10 %)
   const analysis::Excitation ex = analysis::DesignMultisine(analysis::MultisineOptions{});
   analysis::SimulatedMeasurementOptions o;
   o.seed = 12;
