@@ -14,7 +14,10 @@ mapfile -t subs < <("$eol" --help | sed -n '/^Subcommands:/,/^$/p' | sed -n 's/^
 for s in "${subs[@]}"; do
   grep -q "^\.SS \"eol $s\"" "$page" || missing+=("subcommand $s")
   # Its own usage line must be in the page.
-  usage=$("$eol" "$s" --help | grep -m1 '^Usage:')
+  # Whole help first: `eol ... | grep -m1` would let grep close the pipe early, and under
+  # pipefail eol's SIGPIPE failed the check now and then.
+  help=$("$eol" "$s" --help)
+  usage=$(grep -m1 '^Usage:' <<<"$help")
   grep -qF -- "$usage" "$page" || missing+=("the help text of $s ('$usage')")
 done
 if ((${#missing[@]} > 0)); then
