@@ -36,13 +36,20 @@ using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
-// Routes spdlog's default logger into a ring buffer for the life of the object.
+// Adds a ring buffer to what spdlog's default logger writes, for the life of the object.
+// spdlog's default logger must not be swapped while another thread logs through it (the
+// emulator's thread does: a swap mid-call freed the logger under it and corrupted the heap),
+// so the fixture makes one before the emulator starts and drops it after the emulator stops.
 class LogCapture {
  public:
   LogCapture()
-      : ring_(std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(64)),
+      : ring_(std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(256)),
         previous_(spdlog::default_logger()) {
-    spdlog::set_default_logger(std::make_shared<spdlog::logger>("capture", ring_));
+    std::vector<spdlog::sink_ptr> sinks = previous_->sinks();
+    sinks.push_back(ring_);
+    auto capture = std::make_shared<spdlog::logger>("capture", sinks.begin(), sinks.end());
+    capture->set_level(previous_->level());
+    spdlog::set_default_logger(capture);
   }
   ~LogCapture() { spdlog::set_default_logger(previous_); }
   LogCapture(const LogCapture&) = delete;
@@ -63,6 +70,7 @@ class LogCapture {
 class ModbusFixtureTest : public ::testing::Test {
  protected:
   void SetUp() override {
+    log_ = std::make_unique<LogCapture>();  // before any thread logs; see LogCapture
     bench_ = std::make_shared<SimBench>(bench_settings_, ManualClock::Of(clock_));
     bench_->LoadPart("T-0001");
     StartServer(0);
@@ -70,6 +78,8 @@ class ModbusFixtureTest : public ::testing::Test {
   void TearDown() override {
     if (fixture_) fixture_->Disconnect();
     if (server_) server_->Stop();
+    server_.reset();
+    log_.reset();  // no thread of the emulator is left to log
   }
 
   // (Re)starts the emulator; port 0 picks a free one.
@@ -116,6 +126,7 @@ class ModbusFixtureTest : public ::testing::Test {
   std::shared_ptr<SimBench> bench_;
   std::unique_ptr<ModbusFixtureServer> server_;
   std::unique_ptr<ModbusFixture> fixture_;
+  std::unique_ptr<LogCapture> log_;
 };
 
 TEST_F(ModbusFixtureTest, PressureCountsBecomeBarWithTheClientsScale) {
@@ -147,7 +158,6 @@ TEST_F(ModbusFixtureTest, FinePressureScaleOnBothEnds) {
 
 TEST_F(ModbusFixtureTest, StopsAnsweringGivesANamedErrorAndRecoversAfterClearFaults) {
   ModbusFixture& f = Connected();
-  auto log = std::make_unique<LogCapture>();  // retries are never silent
   ASSERT_TRUE(f.Activate().ok());
   ASSERT_TRUE(f.WriteAlive(1).ok());
   ASSERT_TRUE(f.Write(FixtureOutput::kExcitationEnable, true).ok());
@@ -156,8 +166,7 @@ TEST_F(ModbusFixtureTest, StopsAnsweringGivesANamedErrorAndRecoversAfterClearFau
   const auto t0 = Clock::now();
   const auto in = f.ReadInputs();
   const double took_s = Seconds(Clock::now() - t0);
-  const std::vector<std::string> retries = log->LinesWith("retrying");
-  log.reset();
+  const std::vector<std::string> retries = log_->LinesWith("retrying");  // never silent
   ASSERT_FALSE(in.ok());
   const std::string& m = in.status().message();
   EXPECT_CONTAINS(m,
@@ -231,14 +240,13 @@ TEST_F(ModbusFixtureTest, BacksOffExponentiallyAndLogsEveryRetry) {
   c.backoff_initial_ms = 10;
   c.backoff_max_ms = 25;
   ModbusFixture f(c);
-  LogCapture log;
   const Status s = f.Connect();
   ASSERT_FALSE(s.ok());
   EXPECT_CONTAINS(s.message(), "fixture 'modbus-tcp': connect: TCP connection at 127.0.0.1:" +
                                    std::to_string(c.link.port) +
                                    " unit 1: reconnect failed: Connection refused (attempt 4, "
                                    "timeout 100 ms)");
-  const auto retries = log.LinesWith("retrying");
+  const auto retries = log_->LinesWith("retrying");
   ASSERT_EQ(retries.size(), 3u);
   EXPECT_CONTAINS(retries[0],
                   "Connection refused (attempt 1, timeout 100 ms); retrying in 10 ms "
