@@ -24,10 +24,10 @@ nlohmann::json Bench(const std::vector<std::string>& extra, int* code) {
 
 TEST(ProductionBenchCli, TaughtLimitsMeetTheTargetsAtReducedSize) {
   int code = -1;
-  const nlohmann::json j = Bench({"--units", "2000", "--seed", "7"}, &code);
+  const nlohmann::json j = Bench({"--units", "1000", "--seed", "7", "--pod-units", "300"}, &code);
   ASSERT_EQ(code, 0) << j.dump();
   ASSERT_TRUE(j["usable"].get<bool>()) << j.dump();
-  EXPECT_EQ(j["units"], 2000);
+  EXPECT_EQ(j["units"], 1000);
   int total = 0, good = 0, all_soft = 0;
   for (const auto& c : j["classes"]) {
     const int units = c["units"];
@@ -45,12 +45,12 @@ TEST(ProductionBenchCli, TaughtLimitsMeetTheTargetsAtReducedSize) {
                                                  << c.dump();
     }
   }
-  EXPECT_EQ(total, 2000);
-  EXPECT_GT(good, 1600);    // 90 % good at the default rates
-  EXPECT_GT(all_soft, 20);  // 2 % all_soft: the target is exercised
+  EXPECT_EQ(total, 1000);
+  EXPECT_GT(good, 800);     // 90 % good at the default rates
+  EXPECT_GE(all_soft, 10);  // 2 % all_soft (20 expected): the target is exercised
   EXPECT_LE(j["rates"]["taught"]["false_reject_rate"].get<double>(), 0.003) << j.dump();
   EXPECT_EQ(j["teach"]["units_used"].get<int>() <= 50, true);
-  // POD sweeps (400 units each, losses 0.8-0.99): the all-magnets curve is fitted and its
+  // POD sweeps (300 units each, losses 0.8-0.99): the all-magnets curve is fitted and its
   // a90/95 lies where the model puts the rise (eol detectability: a90 0.937, f0 down 15 Hz
   // at 0.94), above its own a90; one magnet is found later than all ten.
   ASSERT_EQ(j["pod"].size(), 2u) << j["pod"].dump();
