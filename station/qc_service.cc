@@ -6,6 +6,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "analysis/model/chain_prediction.h"
 #include "analysis/qc/measurement_names.h"
 #include "analysis/text.h"
 #include "db/clock.h"
@@ -315,7 +316,8 @@ TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe&
   return result;
 }
 
-analysis::DetectabilityOptions DetectabilityOptionsFor(const Recipe& r, double k_fixture_nm_per_rad,
+analysis::DetectabilityOptions DetectabilityOptionsFor(const Recipe& r, const io::MotorSpec* motor,
+                                                       double k_fixture_nm_per_rad,
                                                        double limit_sigmas,
                                                        double required_sigmas) {
   analysis::DetectabilityOptions o;
@@ -324,11 +326,58 @@ analysis::DetectabilityOptions DetectabilityOptionsFor(const Recipe& r, double k
   o.transient_periods = r.transient_periods;
   o.fit = r.analysis.fit;
   o.required_sigmas = required_sigmas;
-  if (k_fixture_nm_per_rad > 0.0) o.rotor.fixture->stiffness_nm_per_rad = k_fixture_nm_per_rad;
+  if (motor) {
+    o.rotor = motor->rotor;
+    o.rotor.soft_magnets.clear();  // the model's good rotor; its classes soften the bonds
+    o.r_ohm = motor->r_ohm;
+    o.l_h = motor->l_h;
+    o.transmission_nm_per_a = motor->TransmissionNmPerA();
+  }
+  if (k_fixture_nm_per_rad > 0.0) {
+    if (!o.rotor.fixture) o.rotor.fixture = analysis::RotorChainParams{}.fixture;
+    o.rotor.fixture->stiffness_nm_per_rad = k_fixture_nm_per_rad;
+  }
   for (const auto& l : r.limits)
     if (l.limit.lo && l.limit.hi)
       o.unit_spread[l.name] = (*l.limit.hi - *l.limit.lo) / (2.0 * limit_sigmas);
   return o;
+}
+
+namespace {
+
+// The f0 the recipe expects (0 when it states none) and where it comes from.
+double RecipeF0Hz(const Recipe& r, std::string* source) {
+  if (r.excitation_design && r.excitation_design->nominal.f0_hz > 0.0) {
+    *source = "its excitation_design nominal";
+    return r.excitation_design->nominal.f0_hz;
+  }
+  for (const auto& l : r.limits)
+    if (l.name == analysis::names::kResonanceFHz && l.limit.lo && l.limit.hi) {
+      *source = "the middle of its resonance_f_hz limits";
+      return 0.5 * (*l.limit.lo + *l.limit.hi);
+    }
+  return 0.0;
+}
+
+}  // namespace
+
+std::string DetectabilityModelMismatch(const Recipe& r, const io::MotorSpec* motor) {
+  std::string source;
+  const double expected = RecipeF0Hz(r, &source);
+  const analysis::DetectabilityOptions o = DetectabilityOptionsFor(r, motor, 0.0, 3.0, 3.0);
+  if (!(expected > 0.0) || !o.rotor.fixture) return "";  // IsValid names a missing fixture
+  double model = 0.0;
+  try {
+    model = analysis::PredictGoodMode(o.r_ohm, o.l_h, o.transmission_nm_per_a, o.rotor).f0_hz;
+  } catch (const std::exception& e) {
+    return std::string("the motor model has no usable mode: ") + e.what();
+  }
+  if (std::abs(model / expected - 1.0) <= kDetectabilityF0Tolerance) return "";
+  return "the motor model's good rotor rings at " + analysis::Significant(model, 4) +
+         " Hz in its fixture, but recipe " + r.id + " expects " +
+         analysis::Significant(expected, 4) + " Hz (" + source +
+         "): the model is another motor (the built-in chain is the ten-pole motor's); give the "
+         "recipe's motor JSON (eol detectability --motor recipes/motors/<motor>.json)";
 }
 
 json DetectabilityJson(const analysis::DetectabilitySummary& s, const std::string& source,

@@ -12,6 +12,7 @@
 #include "analysis/qc/teach.h"
 #include "db/store.h"
 #include "db/test_record.h"
+#include "drivers/io/motor_json.h"
 #include "station/recipe.h"
 
 namespace eol::station {
@@ -96,12 +97,30 @@ TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe&
                            const std::vector<std::string>& serials,
                            const analysis::TeachOptions& options, bool force_foreign = false);
 
-// Detectability options for the recipe's excitation and fit; `k_fixture_nm_per_rad` > 0
-// replaces the chain's fixture spring; the good-unit spread is the recipe's two-sided limits
-// taken as +-limit_sigmas (override unit_spread afterwards for a measured spread).
+// Detectability options for the recipe's excitation and fit on a motor's model: `motor`'s
+// winding (R, L), torque transmission and rotor chain with its fixture when given (a motor JSON,
+// drivers/io/motor_json.h), else the built-in chain (analysis/model/rotor_chain.h: the ten-pole
+// motor, 390 Hz in its fixture) with DetectabilityOptions' winding. `k_fixture_nm_per_rad` > 0
+// replaces the fixture spring (and stands one in for a motor JSON's rigid fixture); the
+// good-unit spread is the recipe's two-sided limits taken as +-limit_sigmas (override
+// unit_spread afterwards for a measured spread).
 analysis::DetectabilityOptions DetectabilityOptionsFor(const Recipe& recipe,
+                                                       const io::MotorSpec* motor,
                                                        double k_fixture_nm_per_rad,
                                                        double limit_sigmas, double required_sigmas);
+
+// The model is another motor than the recipe's when its good rotor's mode (PredictChain) lies
+// more than this share away from the f0 the recipe expects.
+inline constexpr double kDetectabilityF0Tolerance = 0.15;
+
+// Why the motor model (`motor`, or the built-in chain when null) cannot stand for the recipe's
+// motor, or "" when it can (or when the recipe states no f0: no excitation_design nominal and
+// no two-sided resonance_f_hz limit). The model's good rotor is taken in the model's own
+// fixture (a what-if fixture stiffness changes f0 on purpose, not the motor); the f0 the
+// recipe expects is its excitation_design nominal's, else the middle of its resonance_f_hz
+// limits. A prediction made on the ten-pole chain for a recipe of another motor is silently
+// wrong, so `eol detectability` and GET /api/detectability refuse it with this text.
+std::string DetectabilityModelMismatch(const Recipe& recipe, const io::MotorSpec* motor);
 
 nlohmann::json DetectabilityJson(const analysis::DetectabilitySummary& summary,
                                  const std::string& k_fixture_source,

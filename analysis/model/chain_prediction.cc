@@ -57,6 +57,15 @@ double LossForDrop(const Electrical& e, const RotorChainParams& rotor, double f_
 
 }  // namespace
 
+MotionalImpedance PredictGoodMode(double r_ohm, double l_h, double transmission_nm_per_a,
+                                  const RotorChainParams& rotor) {
+  std::string why;
+  if (!rotor.IsValid(&why)) throw std::invalid_argument("rotor: " + why);
+  RotorChainParams good = rotor;
+  good.soft_magnets.clear();
+  return FittedMode(Electrical{r_ohm, l_h, transmission_nm_per_a}, good);
+}
+
 ChainPrediction PredictChain(double r_ohm, double l_h, double transmission_nm_per_a,
                              const RotorChainParams& rotor) {
   std::string why;

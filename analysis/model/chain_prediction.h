@@ -30,6 +30,11 @@ struct ChainPrediction {
   double total_inertia_kg_m2 = 0.0;  // magnets, poles and hub (the rotor's J)
 };
 
+// The good rotor's mode alone (ChainPrediction::good). Throws std::invalid_argument naming the
+// cause: an invalid chain, or no mode the torque excites.
+MotionalImpedance PredictGoodMode(double r_ohm, double l_h, double transmission_nm_per_a,
+                                  const RotorChainParams& rotor);
+
 // Throws std::invalid_argument naming the cause: an invalid chain, no mode the torque excites,
 // or a softening that never lowers f0 by kDirectionF0Drop (the bonds do not carry the mode).
 ChainPrediction PredictChain(double r_ohm, double l_h, double transmission_nm_per_a,

@@ -1,7 +1,11 @@
-// `eol detectability --recipe R [--gap gap.json | --k-fixture K] [--golden FILES...] [--json]`:
+// `eol detectability --recipe R [--motor M.json] [--gap gap.json | --k-fixture K]
+//                    [--golden FILES...] [--json]`:
 // where each defect class shows in the real fixture and whether the recipe's measurement can
-// tell it from good units (analysis/qc/detectability.h). The fixture stiffness comes from the
-// gap diagnosis (`eol gap --json`: params.k_fixture_nm_per_rad of fixture_compliance) or
+// tell it from good units (analysis/qc/detectability.h), on the recipe's motor (--motor: its
+// motor JSON) or the built-in ten-pole chain; a model whose good rotor misses the recipe's f0
+// by more than 15 % is refused (DetectabilityModelMismatch), never predicted silently. The fixture
+// stiffness comes from the gap diagnosis (`eol gap --json`: params.k_fixture_nm_per_rad of
+// fixture_compliance) or
 // --k-fixture, and is applied as the chain's fixture spring; without either the chain's
 // default fixture is used. The good units' spread comes from --golden (standard deviation of
 // each measurement), else from the recipe's two-sided limits taken as +-limit_sigmas.
@@ -11,6 +15,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "analysis/qc/detectability.h"
 #include "station/cli/commands.h"
@@ -27,6 +32,7 @@ using nlohmann::json;
 
 struct DetectArgs {
   std::string recipe = DefaultRecipePath();
+  std::string motor;
   std::string gap;
   double k_fixture = 0.0;
   std::vector<std::string> golden;
@@ -91,8 +97,16 @@ int RunDetect(const DetectArgs& a) {
     k_fixture = a.k_fixture;
     source = "--k-fixture";
   }
-  analysis::DetectabilityOptions o =
-      DetectabilityOptionsFor(r, k_fixture, a.limit_sigmas, a.required_sigmas);
+  std::optional<io::MotorSpec> motor;
+  if (!a.motor.empty()) motor = io::LoadMotorJson(a.motor);
+  analysis::DetectabilityOptions o = DetectabilityOptionsFor(
+      r, motor ? &*motor : nullptr, k_fixture, a.limit_sigmas, a.required_sigmas);
+  if (const std::string why = DetectabilityModelMismatch(r, motor ? &*motor : nullptr);
+      !why.empty()) {
+    std::cerr << "eol detectability: " << why << std::endl;
+    if (a.json) std::cout << json{{"usable", false}, {"error", why}}.dump() << std::endl;
+    return 1;
+  }
   std::string spread_source = "the recipe's limits as +-" + G(a.limit_sigmas) + " sigma";
   if (!a.golden.empty()) {
     std::vector<std::string> skipped;
@@ -178,6 +192,11 @@ void AddDetectabilityCommand(CLI::App& app) {
       "cannot be told apart. Exit: 0 analysed, 1 not analysable, 2 usage or file error.");
   cmd->add_option("--recipe", args->recipe, "Recipe: excitation, analysis, limits")
       ->capture_default_str()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--motor", args->motor,
+                  "The recipe's motor JSON (recipes/motors/): its winding, transmission and "
+                  "rotor chain; default: the built-in ten-pole chain, refused for a recipe whose "
+                  "f0 it misses by more than 15 %")
       ->check(CLI::ExistingFile);
   cmd->add_option("--gap", args->gap, "`eol gap --json` output with fixture_compliance")
       ->check(CLI::ExistingFile);

@@ -115,8 +115,11 @@ void GetDetectability(ApiContext& c, const httplib::Request& req, httplib::Respo
                         NumberParam(req, "required_sigmas", 0.5, 20.0, &required_sigmas)})
     if (e) return Send(res, *e);
   const auto recipe = c.handlers.current_recipe();
-  const analysis::DetectabilitySummary summary = analysis::PredictDetectability(
-      DetectabilityOptionsFor(*recipe, k_fixture, limit_sigmas, required_sigmas));
+  const analysis::DetectabilityOptions options =
+      DetectabilityOptionsFor(*recipe, nullptr, k_fixture, limit_sigmas, required_sigmas);
+  if (const std::string why = DetectabilityModelMismatch(*recipe, nullptr); !why.empty())
+    return Send(res, ApiError{ApiErrorKind::kUnprocessable, "model_mismatch", why});
+  const analysis::DetectabilitySummary summary = analysis::PredictDetectability(options);
   const std::string source =
       k_fixture > 0.0 ? "k_fixture parameter" : "the chain's default fixture";
   nlohmann::json body = DetectabilityJson(

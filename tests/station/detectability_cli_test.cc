@@ -111,5 +111,31 @@ TEST(DetectabilityCli, ErrorsNameTheFile) {
   EXPECT_NE(r.out.find("either --gap or --k-fixture"), std::string::npos) << r.out;
 }
 
+// A recipe of another motor: the built-in chain (the ten-pole motor, 390 Hz) is refused for
+// the eight-pole recipe (589 Hz), never predicted silently; with the recipe's own motor JSON
+// the model's good rotor rings where the recipe expects it and the classes are predicted.
+TEST(DetectabilityCli, AnotherMotorsRecipeNeedsItsMotorJson) {
+  const std::string recipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-8pole-heavy.json";
+  CliRun r = Eol({"detectability", "--recipe", recipe});
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("rings at 390"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("expects 588.8 Hz"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--motor"), std::string::npos) << r.out;
+
+  r = Eol(
+      {"detectability", "--recipe", recipe, "--motor", kMotors + "pmsm-8pole-heavy.json", "--json"},
+      false);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j["f0_good_hz"].get<double>(), 588.8, 0.05 * 588.8) << r.out;
+  const nlohmann::json* all = Class(j, "all_soft");
+  ASSERT_NE(all, nullptr) << r.out;
+  EXPECT_LT((*all)["f0_hz"].get<double>(), j["f0_good_hz"].get<double>()) << all->dump();
+
+  // The ten-pole recipe on the ten-pole chain is unchanged (no refusal).
+  r = Eol({"detectability", "--json"}, false);
+  EXPECT_EQ(r.code, 0) << r.out;
+}
+
 }  // namespace
 }  // namespace eol

@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "analysis/qc/measurement_names.h"
+#include "station/qc_service.h"
 
 namespace eol::station {
 namespace {
@@ -137,6 +138,22 @@ TEST(RecipeDesign, BadInputsAreRefusedNamingTheCause) {
   flat.f0_half_soft_hz = flat.nominal.f0_hz;
   EXPECT_NE(Refusal([&] { ProposeRecipe(flat, {}, "x"); }).find("does not ring lower"),
             std::string::npos);
+}
+
+// The detectability model must be the recipe's motor (station/qc_service.h): the built-in
+// chain is refused for the eight-pole recipe (what GET /api/detectability answers 422
+// model_mismatch with), the recipe's own motor JSON is accepted, and so is the ten-pole
+// recipe on the built-in chain.
+TEST(RecipeDesign, DetectabilityRefusesAModelOfAnotherMotor) {
+  const Recipe eight = LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-8pole-heavy.json");
+  const Recipe ten = LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json");
+  const std::string why = DetectabilityModelMismatch(eight, nullptr);
+  EXPECT_NE(why.find("recipe pmsm-8pole-heavy expects 588.8 Hz"), std::string::npos) << why;
+  const io::MotorSpec motor = Motor("pmsm-8pole-heavy");
+  EXPECT_EQ(DetectabilityModelMismatch(eight, &motor), "");
+  EXPECT_EQ(DetectabilityModelMismatch(ten, nullptr), "");
+  // The ten-pole recipe on the eight-pole motor is refused the other way round.
+  EXPECT_NE(DetectabilityModelMismatch(ten, &motor), "");
 }
 
 }  // namespace
