@@ -42,6 +42,8 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
     if (spec.name == analysis::names::kResonanceFRefPressureHz) taught.limits.push_back(spec);
   const WindingReference winding = RelearnWindingReference(r, s);
   if (winding.relearned) taught.conditions.r_ref_ohm = winding.r_ref_ohm;
+  const NominalRelearned nominal = RelearnNominal(taught, s);
+  if (nominal.relearned) taught.excitation_design->nominal = nominal.nominal;
   std::string note = " Limits v" + std::to_string(r.version + 1) + " taught from " +
                      std::to_string(s.units_used) + " golden units (" +
                      analysis::ToString(o.method) + ", allocation " + o.allocation +
@@ -53,6 +55,7 @@ json TaughtRecipeJson(const Recipe& r, const analysis::TeachSummary& s,
     note += " FORCED: " + std::to_string(s.units_used) + " golden units where " +
             std::to_string(s.units_needed) + " are needed.";
   note += " " + winding.note;
+  if (!nominal.note.empty()) note += " " + nominal.note;
   std::string approval_note;
   if (!forced_foreign.empty()) {
     note += " FORCED (--force-foreign): golden units of another motor than the recipe expects:";
@@ -97,6 +100,48 @@ WindingReference RelearnWindingReference(const Recipe& r, const analysis::TeachS
                 " degC): it was another motor's reference; the taught recipe has " +
                 Fixed(w.r_ref_ohm, 4) + " ohm";
   return w;
+}
+
+std::string ExcitationShortOfDesign(const json& taught, const std::string& source) {
+  try {
+    ParseRecipe(taught, source);
+    return "";
+  } catch (const std::exception& e) {
+    return std::string("the proposal cannot be loaded or approved yet: ") + e.what() +
+           "; redesign its excitation for the relearned nominal (eol design-excitation "
+           "--recipe <proposal> --out <next>) or state the sigma_f0_hz this motor needs";
+  }
+}
+
+NominalRelearned RelearnNominal(const Recipe& r, const analysis::TeachSummary& s) {
+  NominalRelearned n;
+  if (!r.excitation_design) return n;
+  n.nominal = r.excitation_design->nominal;
+  const std::string disagreement = NominalDisagreement(r, n.nominal);
+  if (disagreement.empty()) return n;  // the design's nominal is within the taught limits
+  namespace names = analysis::names;
+  const std::pair<std::string_view, double*> fields[] = {
+      {names::kResonanceFHz, &n.nominal.f0_hz},
+      {names::kResonanceQ, &n.nominal.q},
+      {names::kWindingROhm, &n.nominal.r_ohm},
+      {names::kWindingLH, &n.nominal.l_h},
+      {names::kMotionalRpOhm, &n.nominal.rp_ohm}};
+  std::string changed;
+  for (const auto& [name, value] : fields) {
+    const auto it = std::find_if(s.statistics.begin(), s.statistics.end(),
+                                 [&](const auto& t) { return t.name == name; });
+    if (it == s.statistics.end() || !(it->centre > 0.0) || !std::isfinite(it->centre)) continue;
+    changed += std::string(changed.empty() ? "" : ", ") + std::string(name) + " " +
+               analysis::Significant(*value, 4) + " -> " + analysis::Significant(it->centre, 4);
+    *value = it->centre;
+    n.relearned = true;
+  }
+  if (n.relearned)
+    n.note =
+        "Excitation-design nominal relearned from the golden units' centres (the design's "
+        "disagreed with the taught limits: " +
+        disagreement + "): " + changed + ".";
+  return n;
 }
 
 namespace {
@@ -305,9 +350,12 @@ TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe&
   }
   const json proposed = TaughtRecipeJson(recipe, summary, options, foreign);
   try {
-    const Recipe checked = ParseRecipe(proposed, "taught recipe");
+    const Recipe checked =
+        ParseRecipe(proposed, "taught recipe", {.check_excitation_design = false});
     result.report["recipe"] = proposed;
     result.report["recipe_hash"] = checked.hash;
+    result.report["excitation_short_of_design"] =
+        ExcitationShortOfDesign(proposed, "taught recipe");
   } catch (const std::exception& e) {
     result.kind = TeachResult::Kind::kInvalidRecipe;
     result.message = e.what();

@@ -38,6 +38,31 @@ struct WindingReference {
 WindingReference RelearnWindingReference(const Recipe& recipe,
                                          const analysis::TeachSummary& summary);
 
+// The excitation design's nominal motor (recipe "excitation_design.nominal": the good motor the
+// recipe expects, which must pass the recipe's own limits) relearned from the golden units when
+// the taught recipe `taught` (limits and winding reference already taught) disagrees with it
+// (NominalDisagreement, station/recipe.h), so limits taught from real units are not refused
+// against a design value they have moved away from (Q 50 of the design against taught limits
+// up to 43.5); a design nominal inside the taught limits is kept (the engineer's statement, and
+// the excitation was designed at it). Relearned, each of f0, Q, R, L and Rp becomes the golden
+// units' taught centre of its measurement (resonance_f_hz, resonance_q, winding_r_ohm,
+// winding_l_h, motional_rp_ohm) where one was taught; the others are kept. The excitation is
+// not redesigned: a proposal whose excitation no longer reaches its sigma_f0 at the relearned
+// nominal is written but not loadable (ExcitationShortOfDesign) until eol design-excitation.
+struct NominalRelearned {
+  bool relearned = false;  // the recipe has an excitation_design and at least one was taught
+  analysis::MotionalImpedance nominal;
+  std::string note;  // one sentence: each value old -> new, for the description and report
+};
+NominalRelearned RelearnNominal(const Recipe& taught, const analysis::TeachSummary& summary);
+
+// "" when the taught recipe `taught` loads; else why not, with the fix. Called on a proposal
+// that validates except for its excitation requirement (RecipeParseOptions
+// check_excitation_design false): units unlike the design (a lower Q) can leave the excitation
+// short of its sigma_f0_hz at the relearned nominal. Teach still writes that proposal, saying
+// so, and nothing loads or approves it until `eol design-excitation` has redesigned it.
+std::string ExcitationShortOfDesign(const nlohmann::json& taught, const std::string& source);
+
 // Golden units of another motor: the medians of the golden units' resonance_f_hz,
 // winding_r_ohm, winding_l_h and motional_residue_ohm_per_s against what the recipe expects:
 // the centre of its two-sided limit on each (else its excitation_design nominal motor), and
@@ -54,10 +79,10 @@ std::vector<std::string> ForeignGoldenUnits(const Recipe& recipe,
 std::string ForeignGoldenRefusal(const Recipe& recipe, const std::vector<std::string>& foreign,
                                  const std::string& how_to_force);
 
-// The recipe's JSON with the taught limits and masks, the winding reference relearned
-// (RelearnWindingReference), version + 1, a note in the description. `forced_foreign` holds
-// ForeignGoldenUnits' sentences when teaching from them was forced: the description and the
-// approval note record it (the audit of the proposal).
+// The recipe's JSON with the taught limits and masks, the winding reference and the excitation
+// design's nominal relearned (RelearnWindingReference, RelearnNominal), version + 1, a note in the
+// description. `forced_foreign` holds ForeignGoldenUnits' sentences when teaching from them was
+// forced: the description and the approval note record it (the audit of the proposal).
 nlohmann::json TaughtRecipeJson(const Recipe& recipe, const analysis::TeachSummary& summary,
                                 const analysis::TeachOptions& options,
                                 const std::vector<std::string>& forced_foreign = {});

@@ -336,11 +336,15 @@ std::string HowToChooseSigmaF0(const Recipe& r) {
   return text;
 }
 
-// The nominal motor is the good motor the recipe expects: it must pass the recipe's own
-// limits (those the nominal determines: f0, Q, R, L, Rp, residue, bond index) and lie inside
-// its winding-temperature window; otherwise limits and nominal describe different motors.
 void RequireNominalPasses(const JsonObject& o, const Recipe& r,
                           const analysis::MotionalImpedance& n) {
+  const std::string why = NominalDisagreement(r, n);
+  o.Require(why.empty(), "nominal", why);
+}
+
+}  // namespace
+
+std::string NominalDisagreement(const Recipe& r, const analysis::MotionalImpedance& n) {
   namespace names = analysis::names;
   std::map<std::string, analysis::Estimate> values = {
       {std::string(names::kResonanceFHz), {n.f0_hz, 0.0}},
@@ -357,27 +361,26 @@ void RequireNominalPasses(const JsonObject& o, const Recipe& r,
   const analysis::Verdict v = analysis::Judge(judged, values);
   std::string why;
   for (const analysis::Reason& reason : v.reasons) why += (why.empty() ? "" : "; ") + reason.text;
-  o.Require(v.outcome == analysis::Outcome::kPass, "nominal",
-            "the recipe's own nominal motor (the good motor it expects) fails its limits: " + why +
-                ". The limits and the nominal describe different motors: teach the limits from "
-                "this motor's golden units (eol teach) or correct the nominal (`eol recipe-new "
-                "--golden` calibrates it to measured good units)");
+  if (v.outcome != analysis::Outcome::kPass)
+    return "the recipe's own nominal motor (the good motor it expects) fails its limits: " + why +
+           ". The limits and the nominal describe different motors: teach the limits from "
+           "this motor's golden units (eol teach) or correct the nominal (`eol recipe-new "
+           "--golden` calibrates it to measured good units)";
   const ConditionWindows& w = r.conditions;
-  if (w.r_ref_ohm <= 0.0) return;
+  if (w.r_ref_ohm <= 0.0) return "";
   const double t = WindingTemperatureC(n.r_ohm, w.r_ref_ohm, w.t_ref_c);
   const bool inside = (!w.winding_temperature_c.lo || t >= *w.winding_temperature_c.lo) &&
                       (!w.winding_temperature_c.hi || t <= *w.winding_temperature_c.hi);
-  o.Require(inside, "nominal",
-            "the nominal winding r_ohm " + Fixed(n.r_ohm, 4) +
-                " ohm reads as a winding "
-                "temperature of " +
-                Fixed(t, 1) +
-                " degC against /conditions/winding_temperature_c "
-                "(r_ref_ohm " +
-                Fixed(w.r_ref_ohm, 4) + " ohm at " + Fixed(w.t_ref_c, 1) +
-                " degC), outside its window: r_ref_ohm is another motor's; set it to this motor's "
-                "winding R at t_ref_c (eol teach relearns it from golden units)");
+  if (inside) return "";
+  return "the nominal winding r_ohm " + Fixed(n.r_ohm, 4) +
+         " ohm reads as a winding temperature of " + Fixed(t, 1) +
+         " degC against /conditions/winding_temperature_c (r_ref_ohm " + Fixed(w.r_ref_ohm, 4) +
+         " ohm at " + Fixed(w.t_ref_c, 1) +
+         " degC), outside its window: r_ref_ohm is another motor's; set it to this motor's "
+         "winding R at t_ref_c (eol teach relearns it from golden units)";
 }
+
+namespace {
 
 // After the excitation and the analysis: the recipe's own excitation must meet the requirement
 // it states.

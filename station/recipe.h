@@ -192,6 +192,13 @@ struct Recipe {
   nlohmann::json source;  // the recipe as loaded
 };
 
+// Why the nominal motor `n` (the excitation design's "good motor the recipe expects") and the
+// recipe's limits describe different motors, or "" when they agree: `n` must pass the limits
+// it determines (f0, Q, R, L, Rp, residue, bond index) and read inside the winding-temperature
+// window. ParseRecipe refuses a recipe whose own nominal disagrees; eol teach relearns the
+// nominal when the taught limits disagree with it (station/qc_service.h RelearnNominal).
+std::string NominalDisagreement(const Recipe& recipe, const analysis::MotionalImpedance& n);
+
 struct RecipeParseOptions {
   // false only for `eol design-excitation`, which reads a recipe whose excitation does not yet
   // meet its stated requirement in order to design one that does.
