@@ -1,9 +1,10 @@
-// `eol report --db DB --serial S --out S.pdf [--test-id N] [--recipe FILE]`: the printable
+// `eol report --db DB --serial S --out S.pdf [--test-id N] [--recipe FILE] [--json]`: the printable
 // report of one unit's test (station/unit_report.h), its newest finished test or test N.
 // Exit: 0 written, 1 the serial has no such test, 2 usage or a file that cannot be written.
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 
 #include "db/clock.h"
@@ -24,6 +25,7 @@ struct ReportArgs {
   std::string out;
   long long test_id = 0;
   std::string recipe;
+  bool json = false;
 };
 
 int RunReport(const ReportArgs& a) {
@@ -58,6 +60,16 @@ int RunReport(const ReportArgs& a) {
     std::remove(tmp.c_str());
     throw std::runtime_error(a.out + ": cannot be written (rename)");
   }
+  if (a.json) {
+    std::cout << nlohmann::json{{"path", a.out},
+                                {"serial", a.serial},
+                                {"test_id", report.test.id},
+                                {"outcome", analysis::ToString(report.test.outcome)},
+                                {"bytes", pdf.size()}}
+                     .dump()
+              << std::endl;
+    return 0;
+  }
   std::cout << "wrote " << a.out << ": " << a.serial << " test #" << report.test.id << " "
             << analysis::ToString(report.test.outcome) << ", " << pdf.size() << " bytes\n";
   return 0;
@@ -85,6 +97,7 @@ void AddReportCommand(CLI::App& app) {
                   "The test's recipe file: its masks are drawn on the curve when its hash is\n"
                   "the test's")
       ->check(CLI::ExistingFile);
+  cmd->add_flag("--json", args->json, "Print one JSON object on stdout");
   cmd->callback([args] { RunGuarded("report", [&] { return RunReport(*args); }); });
 }
 

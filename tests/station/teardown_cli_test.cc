@@ -266,8 +266,12 @@ TEST_F(TeardownCli, ReportIsAPdfWithTheSerialVerdictMeasurementsAndFindings) {
   EXPECT_TRUE(Has(text, "|Z| measured and fitted")) << text;  // the curve page's chart
 
   // A unit without a curve says so; PASS is printed as such.
-  r = Eol({"report", "--db", Db(), "--serial", "GOOD-1", "--out", dir_ / "g.pdf"});
+  r = Eol({"report", "--db", Db(), "--serial", "GOOD-1", "--out", dir_ / "g.pdf", "--json"}, false);
   ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json written = nlohmann::json::parse(r.out);
+  EXPECT_EQ(written["outcome"], "PASS");
+  EXPECT_EQ(written["test_id"], 6);
+  EXPECT_EQ(written["bytes"], std::filesystem::file_size(dir_ / "g.pdf"));
   const std::string good = PdfText(dir_ / "g.pdf");
   EXPECT_TRUE(Has(good, "Verdict: PASS")) << good;
   EXPECT_TRUE(Has(good, "stored no impedance curve")) << good;
