@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/support/child_process.h"
+#include "tests/support/eol_cli.h"
 #include "tests/support/station_ready.h"
 #include "tests/support/stored_test.h"
 #include "tests/support/token_station.h"
@@ -100,10 +101,17 @@ TEST_F(TeardownApi, EngineersRecordFindingsAndTheReportIsAPdf) {
   ASSERT_EQ(res->status, 201) << res->body;
   EXPECT_EQ(nlohmann::json::parse(res->body)["corrects"], first["id"]);
 
+  // `eol teardown` records beside the running station (which holds the store's writer lock).
+  const testing::CliRun cli =
+      testing::RunEol({"teardown", "--db", dir_ / "s.sqlite", "--serial", "TD-1", "--found",
+                       "not-defective", "--by", "Bea", "--note", "second opinion"},
+                      true, 60s);
+  ASSERT_EQ(cli.code, 0) << cli.out;
   list = nlohmann::json::parse(http_->Get("/api/units/TD-1/teardown")->body);
-  ASSERT_EQ(list["teardowns"].size(), 2u) << list.dump();
+  ASSERT_EQ(list["teardowns"].size(), 3u) << list.dump();
   EXPECT_EQ(list["teardowns"][0]["note"], "cracked magnet");
   EXPECT_EQ(list["current"]["found"], "not-defective");
+  EXPECT_EQ(list["current"]["by"], "Bea");
   const auto review = nlohmann::json::parse(http_->Get("/api/teardown/review")->body);
   EXPECT_EQ(review[verdict == "PASS" ? "confirmed_good" : "false_rejects"].size(), 1u)
       << review.dump();
