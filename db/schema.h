@@ -157,4 +157,31 @@ ALTER TABLE curves ADD COLUMN encoding TEXT NOT NULL DEFAULT 'json-zlib'
   CHECK (encoding IN ('json-zlib', 'binary-v1'));
 )sql";
 
+// Version 6 -> 7: what teardown of a unit found (db/store.h TeardownEntry).
+//
+// teardowns: one row per finding an engineer records for a serial: found ('defective': the
+//   defect is confirmed; 'not_defective': nothing wrong was found), a note, who (the
+//   engineer's name, never empty) and when (ISO 8601 UTC). Append-only: the triggers refuse
+//   every UPDATE and DELETE, so a correction is a new row and the history stays; the newest
+//   row of a serial (highest id) is its current finding, and `corrects` names the row it
+//   replaced. test_id is the serial's newest finished test when the finding was recorded
+//   (the verdict the teardown judges: a FAIL found not defective is a false reject).
+inline constexpr const char kSchemaV7[] = R"sql(
+CREATE TABLE teardowns (
+  id       INTEGER PRIMARY KEY,
+  serial   TEXT    NOT NULL CHECK (length(serial) > 0),
+  found    TEXT    NOT NULL CHECK (found IN ('defective', 'not_defective')),
+  note     TEXT    NOT NULL DEFAULT '',
+  by       TEXT    NOT NULL CHECK (length(trim(by)) > 0),
+  at       TEXT    NOT NULL CHECK (length(at) > 0),
+  test_id  INTEGER REFERENCES tests(id),
+  corrects INTEGER REFERENCES teardowns(id)
+);
+CREATE INDEX teardowns_serial ON teardowns(serial, id);
+CREATE TRIGGER teardowns_append_only_update BEFORE UPDATE ON teardowns
+BEGIN SELECT RAISE(ABORT, 'teardown findings are append-only: record a correction'); END;
+CREATE TRIGGER teardowns_append_only_delete BEFORE DELETE ON teardowns
+BEGIN SELECT RAISE(ABORT, 'teardown findings are append-only: record a correction'); END;
+)sql";
+
 }  // namespace eol::db::schema

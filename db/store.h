@@ -26,6 +26,11 @@
 // - Outbox (schema v5): every finished record, and every test recovered as ABORTED, gets an
 //   outbox row in the same transaction; publishers read the rows after their own cursor, in
 //   order, and advance it only once delivered: an outage of any length loses nothing.
+// - Teardown findings (schema v7): append-only (the schema's triggers refuse UPDATE and
+//   DELETE); a correction is a new entry that names the one it corrects, so the history of a
+//   serial is every entry ever recorded, each with the engineer's name and time; the newest
+//   entry of a serial is its current finding. An entry is accepted only for a serial with a
+//   finished test in this store, and records which test (the newest) it judges.
 // - All SQL is parameterised. Errors throw StoreError naming the file and the operation.
 // Not thread-safe: one Store per thread (SQLite connections are cheap).
 #pragma once
@@ -35,6 +40,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -120,6 +126,28 @@ struct SelfCheckEntry {
   std::string detail;
 };
 
+// What teardown of a unit found (schema v7).
+enum class TeardownFinding { kDefective, kNotDefective };
+// "defective", "not-defective" (the CLI's and the API's words; the table stores
+// 'defective' and 'not_defective').
+const char* ToString(TeardownFinding f);
+// Accepts "defective", "not-defective" and "not_defective"; empty for anything else.
+std::optional<TeardownFinding> ParseTeardownFinding(std::string_view text);
+
+// One finding an engineer recorded for a serial.
+struct TeardownEntry {
+  std::int64_t id = 0;  // set by AppendTeardown
+  std::string serial;
+  TeardownFinding found = TeardownFinding::kDefective;
+  std::string note;
+  std::string by;  // the engineer's name (token name through the API), never empty
+  std::string at;  // ISO 8601 UTC, when it was recorded
+  // Set by AppendTeardown: the serial's newest finished test then (the verdict judged) and
+  // the serial's previous newest entry, which this one corrects (empty for the first).
+  std::optional<std::int64_t> test_id;
+  std::optional<std::int64_t> corrects;
+};
+
 // Measurement rows of finished tests for statistics, oldest first.
 struct MeasurementQuery {
   std::optional<std::string> from;  // ISO 8601, inclusive, on started_at
@@ -153,7 +181,7 @@ struct OutboxEntry {
 
 class Store {
  public:
-  static constexpr int kSchemaVersion = 6;
+  static constexpr int kSchemaVersion = 7;
 
   // kWriter: the station's one connection; recovers unfinished tests as ABORTED. It holds an
   // exclusive flock on "<path>.lock" (created 0600 beside the file) for as long as it is open:
@@ -224,6 +252,16 @@ class Store {
   // Every measurement row of finished PASS/FAIL/ERROR tests matching the query, in test order
   // (started_at, id), at most 1,000,000 rows.
   std::vector<MeasurementRow> MeasurementRows(const MeasurementQuery& query);
+
+  // Records a teardown finding (`entry.id`, `test_id` and `corrects` are set here and in the
+  // returned copy) in one transaction. Throws std::invalid_argument naming the cause, before
+  // writing, for an empty serial, name or time, and for a serial without a finished test in
+  // this store; StoreError when the write fails.
+  TeardownEntry AppendTeardown(const TeardownEntry& entry);
+  // Every finding recorded for `serial`, oldest first (the last one is current).
+  std::vector<TeardownEntry> TeardownsOfSerial(const std::string& serial);
+  // The current finding of every serial that has one, by serial.
+  std::vector<TeardownEntry> CurrentTeardowns();
 
   // The outbox rows after `consumer`'s cursor, oldest first, at most `limit` (1..10000).
   std::vector<OutboxEntry> OutboxAfterCursor(const std::string& consumer, int limit);

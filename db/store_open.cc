@@ -64,8 +64,12 @@ void MigrateTo6(sqlite3* db, const std::string& path) {
   Exec(db, path, schema::kSchemaV6, "migrate the schema to version 6");
 }
 
+void MigrateTo7(sqlite3* db, const std::string& path) {
+  Exec(db, path, schema::kSchemaV7, "migrate the schema to version 7");
+}
+
 constexpr std::array<Migration, Store::kSchemaVersion> kMigrations = {
-    &MigrateTo1, &MigrateTo2, &MigrateTo3, &MigrateTo4, &MigrateTo5, &MigrateTo6};
+    &MigrateTo1, &MigrateTo2, &MigrateTo3, &MigrateTo4, &MigrateTo5, &MigrateTo6, &MigrateTo7};
 
 void Configure(sqlite3* db, const std::string& path) {
   sqlite3_extended_result_codes(db, 1);

@@ -15,7 +15,7 @@ test_pkgs=(
   python3 python3-numpy python3-scipy python3-pymodbus python3-serial-asyncio python3-can
   can-utils socat sqlite3 mosquitto python3-paho-mqtt postgresql-15 openssl
   chromium dpkg-dev pulseaudio libasound2-plugins clang-format systemd
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev poppler-utils
 )
 
 pkgs=("${build_pkgs[@]}")

@@ -30,6 +30,7 @@ void HttpApi::Start() {
   http::AddTestRoutes(*server_, *context_);
   http::AddQcRoutes(*server_, *context_);
   http::AddFigureRoutes(*server_, *context_);
+  http::AddTeardownRoutes(*server_, *context_);
   server_->set_exception_handler(
       [](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
         std::string what = "unknown";

@@ -35,6 +35,17 @@
 //   POST /api/gap.svg           {"simulation": {"name", "text"}, "measured": [...], ...}: the
 //                               plot of `eol gap` (both station/http/figure_routes.cc;
 //                               engineer token when tokens are configured)
+//   GET  /api/units/{serial}/teardown   the serial's teardown findings, oldest first, each
+//                               with who, when and the verdict it judged; "current": the newest
+//   POST /api/units/{serial}/teardown   {"found": "defective" | "not-defective", "note"}: an
+//                               engineer records a finding under the token's name (201;
+//                               append-only, a correction is a new finding; 404
+//                               "unknown_serial" for a serial this store never tested)
+//   GET  /api/teardown/review?confidence=   hits, misses, false rejects of the current
+//                               findings and the share caught (station/teardown_review.h)
+//   GET  /api/units/{serial}/report.pdf?test_id=   the unit's printable report as
+//                               application/pdf (station/unit_report.h); masks drawn when the
+//                               recipe in use is the test's
 //   GET  /metrics               Prometheus text: tests by outcome, state, last resonance
 //   GET  /                      the operator page (station/web)
 //   GET  /engineer              the engineer page (station/web/engineer.html)

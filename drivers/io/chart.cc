@@ -525,6 +525,20 @@ ChartBars Histogram(const std::vector<double>& values, double lo, double hi, int
   return out;
 }
 
+std::vector<std::string> DrawChart(cairo_t* cr, const Chart& c) {
+  Check(c);
+  cairo_save(cr);
+  cairo_rectangle(cr, 0.0, 0.0, c.width_px, Height(c));
+  cairo_clip(cr);
+  std::vector<std::string> texts = Draw(cr, c);
+  cairo_restore(cr);
+  ThrowIf(cairo_status(cr), "drawing");
+  return texts;
+}
+
+double ChartWidth(const Chart& c) { return c.width_px; }
+double ChartHeight(const Chart& c) { return Height(c); }
+
 std::string RenderChartSvg(const Chart& c) {
   Check(c);
   std::string svg;

@@ -17,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+struct _cairo;  // cairo_t, as <cairo.h> names it
+
 namespace eol::io {
 
 struct Colour {
@@ -106,6 +108,14 @@ std::vector<double> SpreadLabels(const std::vector<double>& desired, double gap,
 // std::runtime_error when cairo fails.
 std::string RenderChartSvg(const Chart& chart);
 std::string RenderChartPng(const Chart& chart);
+// Draws the chart on a cairo context the caller owns (a page of a PDF report,
+// station/unit_report.h) with its top-left corner at the context's origin, within
+// ChartWidth x ChartHeight units (clipped there, its white background included); returns the
+// strings drawn. Throws as the renderers do.
+std::vector<std::string> DrawChart(_cairo* cr, const Chart& chart);
+double ChartWidth(const Chart& chart);
+double ChartHeight(const Chart& chart);
+
 // SVG, or PNG for a path ending in ".png"; throws FileError (file_error.h) when the file
 // cannot be written.
 void WriteChart(const std::string& path, const Chart& chart);

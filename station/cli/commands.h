@@ -31,5 +31,7 @@ void AddPlantBenchCommand(CLI::App& app);
 void AddDesignExcitationCommand(CLI::App& app);
 void AddRecipeNewCommand(CLI::App& app);
 void AddDbBenchCommand(CLI::App& app);
+void AddTeardownCommand(CLI::App& app);
+void AddReportCommand(CLI::App& app);
 
 }  // namespace eol::station::cli

@@ -8,6 +8,7 @@
 #include "analysis/impedance_analysis.h"
 #include "analysis/qc/measurement_names.h"
 #include "analysis/signal/waveform.h"
+#include "db/store.h"
 #include "db/test_record.h"
 #include "drivers/io/measured_input.h"
 #include "station/qc_service.h"
@@ -165,6 +166,43 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
   if (units.empty())
     throw std::runtime_error(known_bad ? "no known-bad unit could be read"
                                        : "no golden unit could be read");
+  return units;
+}
+
+std::vector<analysis::GoldenUnit> ReadKnownBadFromStore(const std::string& db_path,
+                                                        const Recipe& recipe,
+                                                        std::vector<std::string>* skipped) {
+  if (skipped) skipped->clear();
+  auto store = db::Store::Open(db_path, db::Store::Role::kReadOnly);
+  std::vector<analysis::GoldenUnit> units;
+  int defective = 0;
+  for (const db::TeardownEntry& e : store->CurrentTeardowns()) {
+    if (e.found != db::TeardownFinding::kDefective) continue;
+    ++defective;
+    const std::string label = db_path + " " + e.serial + " test #" +
+                              (e.test_id ? std::to_string(*e.test_id) : std::string("-"));
+    const auto t = e.test_id ? store->Test(*e.test_id, true) : std::nullopt;
+    std::string why;
+    if (!t)
+      why = "its judged test is not in the store";
+    else if (t->outcome != analysis::Outcome::kPass && t->outcome != analysis::Outcome::kFail)
+      why = std::string("its judged test is ") + analysis::ToString(t->outcome) +
+            " (no measurement to place limits against)";
+    else if (t->recipe_hash != recipe.hash)
+      why = "tested with recipe " + t->recipe_id + " v" + std::to_string(t->recipe_version) + " (" +
+            t->recipe_hash.substr(0, 12) + "), not " + recipe.id + " v" +
+            std::to_string(recipe.version) + " (" + recipe.hash.substr(0, 12) + ")";
+    if (!why.empty()) {
+      if (skipped) skipped->push_back(label + ": " + why);
+      continue;
+    }
+    units.push_back(GoldenFromRecord(*t, label));
+  }
+  if (units.empty())
+    throw std::runtime_error(db_path + ": no confirmed-defective unit tested with " + recipe.id +
+                             " v" + std::to_string(recipe.version) + " (" +
+                             std::to_string(defective) +
+                             " confirmed defective in all; record findings with `eol teardown`)");
   return units;
 }
 

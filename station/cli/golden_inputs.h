@@ -33,4 +33,13 @@ std::vector<analysis::GoldenUnit> ReadGoldenUnits(const std::vector<std::string>
                                                   bool known_bad = false,
                                                   const analysis::ProgressCallback& progress = {});
 
+// Known-bad units from a store's teardown findings (`eol teach --known-bad-from-db`): every
+// serial whose current finding is "defective", as measured by the test the finding judged.
+// Units whose judged test is ERROR or ABORTED, or of another recipe hash than `recipe`'s, are
+// left out and named in *skipped with the reason. Throws std::runtime_error naming the file
+// when none is left (or the store cannot be read).
+std::vector<analysis::GoldenUnit> ReadKnownBadFromStore(const std::string& db_path,
+                                                        const Recipe& recipe,
+                                                        std::vector<std::string>* skipped);
+
 }  // namespace eol::station::cli

@@ -46,6 +46,8 @@ int main(int argc, char** argv) {
   eol::station::cli::AddPodCommand(app);
   eol::station::cli::AddRecipeApproveCommand(app);
   eol::station::cli::AddPlantBenchCommand(app);
+  eol::station::cli::AddTeardownCommand(app);
+  eol::station::cli::AddReportCommand(app);
   // Default files (recipe, operator page, SciPy peer) come from the working directory or the
   // installed program's prefix, never from the machine the program was built on.
   const std::string defaults =

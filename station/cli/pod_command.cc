@@ -3,7 +3,12 @@
 // (analysis/qc/pod.h, MIL-HDBK-1823A), e.g. the per-unit table of
 // tests/peers/population_rejects.py; the hits CSV and the figure: station/pod_chart.h (shared
 // with POST /api/pod.svg).
-// Exit: 0 every class fitted, 1 a class could not be fitted (the reason is printed), 2 usage.
+// `eol pod --from-db DB [--confidence 0.95] [--json]`: instead of a hits table, the store's
+// teardown findings (station/teardown_review.h): confirmed-defective units the station failed
+// (hits) and passed (misses), the share caught with its exact lower bound, and the false
+// rejects (failed units teardown found not defective).
+// Exit: 0 every class fitted, 1 a class could not be fitted (the reason is printed) or the
+// store has no confirmed-defective unit with a PASS/FAIL verdict, 2 usage.
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -17,6 +22,7 @@
 #include "station/cli/common.h"
 #include "station/cli/progress.h"
 #include "station/pod_chart.h"
+#include "station/teardown_review.h"
 
 namespace eol::station::cli {
 namespace {
@@ -25,6 +31,7 @@ using nlohmann::json;
 
 struct PodArgs {
   std::string hits;
+  std::string from_db;
   analysis::PodOptions options;
   std::string svg;
   std::vector<double> f0_limits;
@@ -35,7 +42,41 @@ std::string Bound(double v) {
   return std::isfinite(v) ? std::to_string(v) : std::string("none (not bounded by the data)");
 }
 
+void PrintUnits(const char* what, const std::vector<ReviewedUnit>& units) {
+  for (const ReviewedUnit& u : units)
+    std::cout << "  " << what << ": " << u.finding.serial << " (test #"
+              << (u.finding.test_id ? std::to_string(*u.finding.test_id) : "-") << " "
+              << analysis::ToString(u.verdict) << ", teardown " << u.finding.at << " by "
+              << u.finding.by << (u.finding.note.empty() ? "" : ": " + u.finding.note) << ")\n";
+}
+
+int RunPodFromStore(const PodArgs& a) {
+  auto store = db::Store::Open(a.from_db, db::Store::Role::kReadOnly);
+  const TeardownReview r = ReviewTeardowns(*store, a.options.confidence);
+  const std::size_t n = r.hits.size() + r.misses.size();
+  if (a.json) {
+    std::cout << json{{"from_db", a.from_db}, {"teardown", ReviewJson(r)}}.dump() << std::endl;
+    return n > 0 ? 0 : 1;
+  }
+  std::cout << "teardown findings in " << a.from_db << ": " << n
+            << " confirmed defective with a verdict: " << r.hits.size() << " hit(s) (FAIL), "
+            << r.misses.size() << " miss(es) (PASS)\n";
+  if (n > 0)
+    std::cout << "  share caught " << r.pod << ", " << 100.0 * r.confidence << " % lower bound "
+              << r.pod_lower << " (exact binomial; no defect sizes, so no "
+              << "POD curve)\n";
+  PrintUnits("miss", r.misses);
+  std::cout << "false rejects (FAIL, teardown found not defective): " << r.false_rejects.size()
+            << "; confirmed good (PASS, not defective): " << r.confirmed_good.size()
+            << "; without a PASS/FAIL verdict: " << r.no_verdict.size() << "\n";
+  PrintUnits("false reject", r.false_rejects);
+  PrintUnits("no verdict", r.no_verdict);
+  if (n == 0) std::cout << "no confirmed-defective unit: record findings with `eol teardown`\n";
+  return n > 0 ? 0 : 1;
+}
+
 int RunPod(const PodArgs& a) {
+  if (!a.from_db.empty()) return RunPodFromStore(a);
   const HitsTable h = ReadHitsFile(a.hits);
   json fits = json::object();
   std::vector<PodCurve> curves;
@@ -81,9 +122,16 @@ void AddPodCommand(CLI::App& app) {
       "pod",
       "Probability of detection from hit/miss data (MIL-HDBK-1823A): POD(a) by maximum\n"
       "likelihood, a50, a90 and a90/95 (likelihood ratio and Wald), per class of the hits CSV\n"
-      "(columns size, hit; optional class, f0_hz). Exit: 0 fitted, 1 a class could not be\n"
-      "fitted, 2 usage error.");
-  cmd->add_option("--hits", args->hits, "Hits CSV")->required()->check(CLI::ExistingFile);
+      "(columns size, hit; optional class, f0_hz), or hits and misses of the store's teardown\n"
+      "findings (--from-db). Exit: 0 fitted, 1 a class could not be fitted (or no\n"
+      "confirmed-defective unit in the store), 2 usage error.");
+  CLI::Option* hits = cmd->add_option("--hits", args->hits, "Hits CSV")->check(CLI::ExistingFile);
+  cmd->add_option("--from-db", args->from_db,
+                  "Instead of --hits: the station store's teardown findings (`eol teardown`):\n"
+                  "confirmed-defective units failed (hits) and passed (misses), the share\n"
+                  "caught with its exact lower bound at --confidence, and the false rejects")
+      ->check(CLI::ExistingFile)
+      ->excludes(hits);
   cmd->add_option_function<std::string>(
          "--link", [args](const std::string& n) { args->options.link = analysis::ParsePodLink(n); },
          "logit (default) or probit")
@@ -103,6 +151,8 @@ void AddPodCommand(CLI::App& app) {
   cmd->callback([args] {
     std::string why;
     if (!args->options.IsValid(&why)) throw CLI::ValidationError("--confidence/--pod-level", why);
+    if (args->hits.empty() && args->from_db.empty())
+      throw CLI::RequiredError("--hits or --from-db");
     RunGuarded("pod", [&] { return RunPod(*args); });
   });
 }

@@ -1,5 +1,5 @@
-// `eol teach --recipe R --golden FILES... [--bad FILES...] --out R2`: limits learned from good
-// units, and placed against confirmed-defective ones when given
+// `eol teach --recipe R --golden FILES... [--bad FILES...] [--known-bad-from-db DB] --out R2`:
+// limits learned from good units, and placed against confirmed-defective ones when given
 // (analysis/qc/teach.h). The new recipe is R with every declared scalar limit's bounds and
 // marginal band replaced by the learned ones, its masks replaced by the learned Re Z mask
 // (kept when no curve was given), version + 1 and a note in the description. It is validated
@@ -31,6 +31,7 @@ struct TeachArgs {
   std::string recipe;
   std::vector<std::string> golden;
   std::vector<std::string> bad;
+  std::string bad_db;  // --known-bad-from-db
   std::string out;
   analysis::TeachOptions options;
   bool force = false;
@@ -60,10 +61,14 @@ int RunTeach(const TeachArgs& a) {
   auto progress = std::make_unique<Progress>("teach");
   const std::vector<analysis::GoldenUnit> golden =
       ReadGoldenUnits(a.golden, recipe, &skipped, false, progress->Callback());
-  const std::vector<analysis::GoldenUnit> bad =
+  std::vector<analysis::GoldenUnit> bad =
       a.bad.empty()
           ? std::vector<analysis::GoldenUnit>{}
           : ReadGoldenUnits(a.bad, recipe, nullptr, /*known_bad=*/true, progress->Callback());
+  std::vector<std::string> bad_skipped;
+  if (!a.bad_db.empty())
+    for (analysis::GoldenUnit& u : ReadKnownBadFromStore(a.bad_db, recipe, &bad_skipped))
+      bad.push_back(std::move(u));
   progress.reset();  // ends the line before the results
   const std::vector<std::string> foreign = ForeignGoldenUnits(recipe, golden);
   if (!foreign.empty()) {
@@ -79,6 +84,8 @@ int RunTeach(const TeachArgs& a) {
   }
   const analysis::TeachSummary s = analysis::TeachLimits(recipe.limits, golden, options, bad);
   for (const std::string& k : skipped) std::cerr << "eol teach: skipped " << k << "\n";
+  for (const std::string& k : bad_skipped)
+    std::cerr << "eol teach: known-bad unit left out: " << k << "\n";
   if (!s.usable) {
     std::cerr << "eol teach: nothing learned: " << s.message << std::endl;
     if (a.json) std::cout << json{{"usable", false}, {"error", s.message}}.dump() << std::endl;
@@ -100,6 +107,7 @@ int RunTeach(const TeachArgs& a) {
         {"path", a.out}, {"id", next.id}, {"version", next.version}, {"hash", next.hash}};
     out["previous"] = {{"path", a.recipe}, {"version", recipe.version}, {"hash", recipe.hash}};
     out["skipped"] = skipped;
+    out["known_bad_skipped"] = bad_skipped;
     out["foreign_forced"] = foreign;
     out["excitation_short_of_design"] = short_of_design;
     out["winding_reference"] = {
@@ -184,6 +192,12 @@ void AddTeachCommand(CLI::App& app) {
                   "FAIL): the f0 lower bound takes budget from bounds that catch none of them "
                   "until it catches those it can; teach reports the escapes before and after")
       ->expected(1, -1);
+  cmd->add_option("--known-bad-from-db", args->bad_db,
+                  "Also take as known-bad units every serial this store's teardown findings\n"
+                  "confirm defective (`eol teardown`), as measured by the test each finding\n"
+                  "judged; units of another recipe or without a PASS/FAIL test are left out\n"
+                  "and named")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--bad-max-donation", args->options.known_bad_max_donation,
                   "With --bad: share of each other bound's budget (above plausibility) that may "
                   "move to the f0 lower bound")

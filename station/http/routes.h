@@ -20,6 +20,9 @@ void AddTestRoutes(httplib::Server& s, ApiContext& c);
 // GET /api/stats, GET /api/charts/{measurement}.svg, GET /api/detectability, POST /api/teach
 // (station/http/qc_routes.cc)
 void AddQcRoutes(httplib::Server& s, ApiContext& c);
+// GET and POST /api/units/{serial}/teardown, GET /api/teardown/review,
+// GET /api/units/{serial}/report.pdf (station/http/teardown_routes.cc)
+void AddTeardownRoutes(httplib::Server& s, ApiContext& c);
 // POST /api/pod.svg, POST /api/gap.svg (station/http/figure_routes.cc)
 void AddFigureRoutes(httplib::Server& s, ApiContext& c);
 

@@ -186,7 +186,8 @@ TEST_F(StoreTest, OpenCreatesTheSchemaWithWalAndVersion) {
             std::vector<std::string>{std::to_string(Store::kSchemaVersion)});
   EXPECT_EQ(raw.Column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
             (std::vector<std::string>{"curves", "measurements", "outbox", "outbox_cursors",
-                                      "recipe_audit", "self_checks", "sqlite_sequence", "tests"}));
+                                      "recipe_audit", "self_checks", "sqlite_sequence", "teardowns",
+                                      "tests"}));
   const auto indexes = raw.Column("SELECT name FROM sqlite_schema WHERE type = 'index'");
   for (const char* name : {"tests_serial_started", "tests_started", "measurements_name"})
     EXPECT_NE(std::find(indexes.begin(), indexes.end(), name), indexes.end()) << name;
