@@ -374,7 +374,7 @@ std::string ParetoLine(const nlohmann::json& g) {
   if (g["pareto"].empty()) return out + " no non-PASS test\n";
   for (const auto& e : g["pareto"])
     out += " " + e["code"].get<std::string>() + " " + std::to_string(e["tests"].get<int>()) +
-           " tests/" + std::to_string(e["units"].get<int>()) + " units (" + Percent(e["share"]) +
+           " tests of " + std::to_string(e["units"].get<int>()) + " units (" + Percent(e["share"]) +
            ", cum. " + Percent(e["cumulative"]) + ");";
   out.back() = '\n';
   return out;
@@ -392,14 +392,15 @@ std::string YieldText(const nlohmann::json& r) {
                     "last test PASSed; open: the last test was ERROR or ABORTED\n";
   char head[256];
   std::snprintf(head, sizeof head, "%-30s %6s %9s %9s %9s %5s %5s %8s %9s %6s\n", "group", "units",
-                "1st pass", "1st verd", "final", "fail", "open", "retested", "tests/unit", "tests");
+                "1st pass", "1st verd", "final", "fail", "open", "retested", "per unit", "tests");
   out += head;
   for (const auto& g : r["groups"]) out += Row(g);
   out += Row(r["total"]);
   if (r["total"]["carried_over_tests"].get<std::size_t>() > 0)
     out += std::to_string(r["total"]["carried_over_tests"].get<std::size_t>()) +
            " tests of serials first tested before the window count as tests, not units\n";
-  out += "Pareto of the decisive reason of each non-PASS test (tests/units, share, cumulative):\n";
+  out +=
+      "Pareto of the decisive reason of each non-PASS test (tests of units, share, cumulative):\n";
   for (const auto& g : r["groups"]) out += ParetoLine(g);
   out += ParetoLine(r["total"]);
   return out;

@@ -366,7 +366,7 @@ TEST_F(YieldStore, StatsYieldCommand) {
   const testing::CliRun text = Eol(args);
   ASSERT_EQ(text.code, 0) << text.out;
   for (const std::string line :
-       {"yield by day (UTC+00:00", "2026-11-21", "limit 3 tests/2 units (37.5 %, cum. 37.5 %)",
+       {"yield by day (UTC+00:00", "2026-11-21", "limit 3 tests of 2 units (37.5 %, cum. 37.5 %)",
         "1 tests of serials first tested before the window", "Pareto chart written to"})
     EXPECT_NE(text.out.find(line), std::string::npos) << line << "\n" << text.out;
   // The total row: 8 units, 25 % first pass, 60 % first verdict, 50 % final, 1 FAIL, 3 open.
