@@ -181,7 +181,7 @@ function yieldRow(g, isTotal) {
                    pct(g.final_yield), g.final_fail, g.final_open, g.retested_units,
                    g.tests_per_unit === null ? "—" : g.tests_per_unit.toFixed(2), g.tests, top || "—"])
     row.appendChild(el("td", {}, String(v)));
-  row.addEventListener("click", () => showPareto(isTotal ? "all" : g.key));
+  row.addEventListener("click", () => showPareto(g, isTotal));
   return row;
 }
 
@@ -201,10 +201,19 @@ function renderYield(report) {
       "ABORTED; click a row for its Pareto)";
 }
 
-function showPareto(group) {
+// The Pareto of one group (or the total); none is asked for a group without a non-PASS test.
+async function showPareto(g, isTotal) {
+  const img = $("chart-pareto"), caption = img.parentElement.querySelector("figcaption");
+  caption.dataset.base = caption.dataset.base || caption.textContent;
+  if (!(g.pareto || []).length) {
+    img.hidden = true;
+    img.removeAttribute("src");
+    caption.textContent = `${caption.dataset.base}: no non-PASS test in ${isTotal ? "the window" : g.key}`;
+    return;
+  }
   const by = $("yield-by").value;
-  showChart($("chart-pareto"), "/api/yield/pareto.svg?" +
-            queryString({...yieldWindow, by, shifts: $("yield-shifts").value, group}));
+  await showChart(img, "/api/yield/pareto.svg?" +
+                  queryString({...yieldWindow, by, shifts: $("yield-shifts").value, group: isTotal ? "all" : g.key}));
 }
 
 async function showYield() {
@@ -213,7 +222,7 @@ async function showYield() {
     const by = $("yield-by").value;
     const report = await getJson("/api/yield?" + queryString({...yieldWindow, by, shifts: $("yield-shifts").value}));
     renderYield(report);
-    await showPareto("all");
+    await showPareto(report.total, true);
     status("yield-status", `${report.total.units} units, ${report.total.tests} tests`);
   } catch (e) {
     status("yield-status", e.message, true);

@@ -333,6 +333,13 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
       << states["pass"]["tested"];
   EXPECT_EQ(stored("SCAN-BAD-1")["outcome"], "FAIL");
   EXPECT_EQ(states["fail"]["verdict"], "FAIL");
+  // Retest marking: nothing on a first test; the serial's second test reads "retest 2 of 3",
+  // as its stored record says.
+  EXPECT_EQ(states["fail"]["attempt"], "");
+  EXPECT_EQ(j["retest"]["attempt"], "retest 2 of 3");
+  EXPECT_EQ(j["retest"]["verdict"], "FAIL");
+  EXPECT_EQ(stored("SCAN-BAD-1")["attempt"], 2);
+  EXPECT_EQ(stored("SCAN-BAD-1")["max_tests"], 3);
   EXPECT_TRUE(stored("SCAN-LOCKED-1").is_null()) << "a refused serial is not stored";
 
   // Lockout: a banner; the refused serial is ERROR with the recipe's instruction above the
@@ -715,7 +722,7 @@ TEST(EngineerPage, ShowsChartsCapabilityDetectabilityAndFiguresFromFiles) {
     for (const std::string& w : words) EXPECT_NE(all.find(w), std::string::npos) << id << ": " << w;
   }
   // Yield per day, as GET /api/yield says: 12 units, all PASS at the first test, so no Pareto
-  // (the caption says why).
+  // is asked for (the caption says why).
   const auto yield = nlohmann::json::parse(http.Get("/api/yield?by=day")->body);
   const nlohmann::json& rows = j["yield"]["rows"];
   ASSERT_EQ(rows.size(), yield["groups"].size() + 1) << j["yield"];
@@ -724,7 +731,7 @@ TEST(EngineerPage, ShowsChartsCapabilityDetectabilityAndFiguresFromFiles) {
   EXPECT_EQ(rows.back()["units"], kTests);
   EXPECT_EQ(rows.back()["first_pass"], "100.0 %");
   EXPECT_EQ(rows.back()["final"], "100.0 %");
-  EXPECT_NE(j["yield"]["pareto_caption"].get<std::string>().find("no non-PASS test in all"),
+  EXPECT_NE(j["yield"]["pareto_caption"].get<std::string>().find("no non-PASS test in the window"),
             std::string::npos)
       << j["yield"];
   EXPECT_EQ(j["yield"]["status"], "12 units, 12 tests");

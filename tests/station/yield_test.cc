@@ -395,6 +395,17 @@ TEST_F(YieldStore, StatsYieldCommand) {
   }
 }
 
+// `eol query` marks each test with its attempt of the recipe's allowed tests.
+TEST_F(YieldStore, QueryShowsTheAttempt) {
+  const testing::CliRun q = Eol({"query", "--db", db_, "--serial", "U2"});
+  ASSERT_EQ(q.code, 0) << q.out;
+  EXPECT_NE(q.out.find("test 2 of 3 retest of #"), std::string::npos) << q.out;
+  EXPECT_NE(q.out.find("test 1 of 3\n"), std::string::npos) << q.out;
+  const testing::CliRun json = Eol({"query", "--db", db_, "--serial", "U2", "--json"});
+  ASSERT_EQ(json.code, 0) << json.out;
+  EXPECT_EQ(nlohmann::json::parse(json.out)["latest"]["attempt"], 2);
+}
+
 TEST_F(YieldStore, YieldApiAndParetoChart) {
   station::StatusBoard board("api");
   station::HttpOptions o;
