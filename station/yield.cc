@@ -438,7 +438,8 @@ io::Chart ParetoChart(const nlohmann::json& group, const std::string& title) {
   }
   p.series.push_back(std::move(cumulative));
   p.hlines.push_back({"80 %", 80.0, io::kChartGrey, io::LineStyle::kDotted, 1.0});
-  p.x_range = {0.5, static_cast<double>(pareto.size()) + 0.5};
+  // At least five ranks wide: whole-number ticks, and one bar is not drawn across the panel.
+  p.x_range = {0.5, static_cast<double>(std::max<std::size_t>(pareto.size(), 5)) + 0.5};
   p.y_range = {0.0, 105.0};
   p.notes.push_back(std::to_string(non_pass) + " non-PASS of " +
                     std::to_string(group.at("tests").get<std::size_t>()) +
