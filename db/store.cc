@@ -29,7 +29,9 @@ constexpr sqlite3_int64 kMaxCurveJsonBytes = sqlite3_int64{1} << 30;
 constexpr std::string_view kSelectTests =
     "SELECT id, serial, station_id, recipe_id, recipe_version, recipe_hash, software_version, "
     "started_at, finished_at, outcome, retest_of, reasons, record, kind, operator_id, shift, "
-    "order_number FROM tests ";
+    "order_number, "
+    "(SELECT count(*) FROM tests p WHERE p.serial = tests.serial AND p.id <= tests.id) "
+    "FROM tests ";
 
 TestRecord RowToRecord(const Statement& s, const std::string& path) {
   const std::int64_t id = s.Int(0);
@@ -66,6 +68,7 @@ TestRecord RowToRecord(const Statement& s, const std::string& path) {
   r.work.operator_id = s.Text(14);
   r.work.shift = s.Text(15);
   r.work.order_number = s.Text(16);
+  r.attempt = static_cast<int>(s.Int(17));
   r.curves.clear();
   return r;
 }
@@ -251,6 +254,48 @@ int Store::CountTestsSince(RecordKind kind, const std::string& since) {
   s.BindText(2, since);
   if (!s.Step()) throw StoreError(Message(path_, "count tests", "no result"));
   return static_cast<int>(s.Int(0));
+}
+
+std::vector<OutcomeRow> Store::OutcomeRows(const OutcomeQuery& q) {
+  // Only fixed clauses are appended; every value is a bound parameter.
+  std::string sql =
+      "SELECT id, serial, started_at, outcome, retest_of, recipe_id, recipe_version, "
+      "recipe_hash, reasons FROM tests WHERE outcome <> 'RUNNING' AND kind = ?1";
+  int n = 1;
+  const int from_i = q.from ? ++n : 0;
+  if (from_i) sql += " AND started_at >= ?" + std::to_string(from_i);
+  const int to_i = q.to ? ++n : 0;
+  if (to_i) sql += " AND started_at < ?" + std::to_string(to_i);
+  const int hash_i = q.recipe_hash ? ++n : 0;
+  if (hash_i) sql += " AND recipe_hash = ?" + std::to_string(hash_i);
+  sql += " ORDER BY started_at, id LIMIT 1000000";
+  Statement s(db_, path_, sql, "read outcomes for yield");
+  s.BindText(1, ToString(q.kind));
+  if (from_i) s.BindText(from_i, *q.from);
+  if (to_i) s.BindText(to_i, *q.to);
+  if (hash_i) s.BindText(hash_i, *q.recipe_hash);
+  std::vector<OutcomeRow> out;
+  while (s.Step()) {
+    OutcomeRow r;
+    r.test_id = s.Int(0);
+    const std::string op = "read the outcome of test " + std::to_string(r.test_id);
+    r.serial = s.Text(1);
+    r.started_at = s.Text(2);
+    const std::optional<analysis::Outcome> o = analysis::ParseOutcome(s.Text(3));
+    if (!o) throw StoreError(Message(path_, op, "unknown outcome '" + s.Text(3) + "'"));
+    r.outcome = *o;
+    r.retest_of = s.OptInt(4);
+    r.recipe_id = s.Text(5);
+    r.recipe_version = static_cast<int>(s.Int(6));
+    r.recipe_hash = s.Text(7);
+    try {
+      r.reasons = nlohmann::json::parse(s.Text(8)).get<std::vector<analysis::Reason>>();
+    } catch (const nlohmann::json::exception& e) {
+      throw StoreError(Message(path_, op, std::string("stored reasons: ") + e.what()));
+    }
+    out.push_back(std::move(r));
+  }
+  return out;
 }
 
 std::vector<MeasurementRow> Store::MeasurementRows(const MeasurementQuery& q) {

@@ -172,6 +172,28 @@ struct MeasurementRow {
   std::optional<double> hi;
 };
 
+// What yield counts of each finished (or aborted) test (station/yield.h), without the record
+// JSON: identity, outcome, reasons, the first test's link and the recipe.
+struct OutcomeQuery {
+  std::optional<std::string> from;  // ISO 8601, inclusive, on started_at
+  std::optional<std::string> to;    // exclusive
+  std::optional<std::string> recipe_hash;
+  RecordKind kind = RecordKind::kProduction;
+};
+
+struct OutcomeRow {
+  std::int64_t test_id = 0;
+  std::string serial;
+  std::string started_at;
+  analysis::Outcome outcome = analysis::Outcome::kError;
+  // Empty for the serial's first stored test (of any kind, in or before the window).
+  std::optional<std::int64_t> retest_of;
+  std::string recipe_id;
+  int recipe_version = 0;
+  std::string recipe_hash;
+  std::vector<analysis::Reason> reasons;  // the decisive first
+};
+
 // One row of the outbox: the record of test `test_id`, to be delivered in `id` order.
 struct OutboxEntry {
   std::int64_t id = 0;
@@ -252,6 +274,9 @@ class Store {
   // Every measurement row of finished PASS/FAIL/ERROR tests matching the query, in test order
   // (started_at, id), at most 1,000,000 rows.
   std::vector<MeasurementRow> MeasurementRows(const MeasurementQuery& query);
+  // Every finished or aborted test matching the query, in test order (started_at, id), at
+  // most 1,000,000 rows.
+  std::vector<OutcomeRow> OutcomeRows(const OutcomeQuery& query);
 
   // Records a teardown finding (`entry.id`, `test_id` and `corrects` are set here and in the
   // returned copy) in one transaction. Throws std::invalid_argument naming the cause, before

@@ -60,8 +60,13 @@ void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record,
   const std::int64_t id = s.Int(0);
   const std::optional<std::int64_t> retest_of = s.OptInt(1);
   s.Run();  // completes the statement (and, outside a transaction, commits it)
+  Statement count(db, path, "SELECT count(*) FROM tests WHERE serial = ?1 AND id <= ?2", op);
+  count.BindText(1, record.serial);
+  count.BindInt(2, id);
+  if (!count.Step()) throw StoreError(Message(path, op, "counting the serial's tests failed"));
   record.id = id;
   record.retest_of = retest_of;
+  record.attempt = static_cast<int>(count.Int(0));
 }
 
 // The caller holds the transaction.
@@ -260,6 +265,7 @@ void Store::FinishTest(const TestRecord& record) {
 void Store::Insert(TestRecord& record) {
   const std::int64_t id = record.id;
   const std::optional<std::int64_t> retest_of = record.retest_of;
+  const int attempt = record.attempt;
   try {
     FinishFailedWrites();
     // One transaction: an import is either fully there or not at all (never left RUNNING).
@@ -271,6 +277,7 @@ void Store::Insert(TestRecord& record) {
     // Rolled back: the record must not carry an id that is not in the file.
     record.id = id;
     record.retest_of = retest_of;
+    record.attempt = attempt;
     Failed(e);
     throw;
   }

@@ -74,6 +74,8 @@ void to_json(nlohmann::json& j, const TestRecord& r) {
        {"started_at", r.started_at},
        {"finished_at", r.finished_at},
        {"retest_of", r.retest_of ? nlohmann::json(*r.retest_of) : nlohmann::json()},
+       {"attempt", r.attempt},
+       {"max_tests", r.max_tests},
        {"outcome", r.outcome},
        {"reasons", r.reasons},
        {"measurements", r.measurements},
@@ -104,6 +106,8 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   r.retest_of.reset();
   if (j.contains("retest_of") && !j.at("retest_of").is_null())
     r.retest_of = j.at("retest_of").get<std::int64_t>();
+  r.attempt = j.value("attempt", 0);
+  r.max_tests = j.value("max_tests", 0);
   r.outcome = j.at("outcome").get<analysis::Outcome>();
   r.reasons = j.value("reasons", std::vector<analysis::Reason>{});
   r.measurements = j.value("measurements", std::vector<analysis::Measurement>{});

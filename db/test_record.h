@@ -68,6 +68,15 @@ struct TestRecord {
   std::string started_at;                 // ISO 8601 UTC, millisecond precision
   std::string finished_at;                // empty while the test runs
   std::optional<std::int64_t> retest_of;  // id of the first test of this serial, if any
+  // Which test of its serial this is (1: the first, 2: the first retest, ...), counting every
+  // stored test of the serial up to this one in id order, whatever its outcome or kind, as the
+  // retest limit counts them: set by Store::BeginTest and on every read from the store (the
+  // columns decide, not the stored JSON); 0 where unknown (a record from elsewhere).
+  int attempt = 0;
+  // The tests the recipe allowed this serial in all (recipe "retest.max_tests_per_serial") when
+  // it was tested, as the sequencer applied it: "retest 2 of 3" is attempt 2 of max_tests 3.
+  // 0: no limit (a master part, a recipe without one) or not recorded (records before it).
+  int max_tests = 0;
 
   analysis::Outcome outcome = analysis::Outcome::kError;
   // Why the outcome is what it is, the decisive first: [{"code", "text"}] in JSON

@@ -629,6 +629,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
       }
     }
     const int max_tests = master ? 0 : recipe_->max_tests_per_serial;  // masters: no limit
+    record.max_tests = max_tests;  // "retest 2 of 3": BeginTest sets the attempt
     if (max_tests > 0) {
       const std::size_t earlier = store_.TestsOfSerial(serial).size();
       if (earlier >= static_cast<std::size_t>(max_tests)) {

@@ -16,6 +16,10 @@ nlohmann::json RecordSummary(const db::TestRecord& r) {
       {"started_at", r.started_at},
       {"finished_at", r.finished_at},
       {"kind", r.kind},  // a master part's self-check is no production unit
+      // "retest 2 of 3": which test of its serial (1: the first; 0: not stored) of how many
+      // the recipe allows (0: no limit).
+      {"attempt", r.attempt},
+      {"max_tests", r.max_tests},
       {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}}};
 }
 

@@ -74,7 +74,8 @@ class StatusBoard {
   //  "counts": {"pass", "fail", "error", "aborted", "day"} (the local day's verdicts, stored
   //  ones rebuilt from the store at start),
   //  "last": {serial, outcome, reasons [{code, text}], measurements, finished_at, id,
-  //           kind: "production" | "self_check"} | null,
+  //           kind: "production" | "self_check", attempt, max_tests (db/test_record.h: the
+  //           retest "attempt of max_tests")} | null,
   //  "recent": [...], "lockout": {...} | null}
   nlohmann::json Snapshot() const;
 

@@ -103,6 +103,14 @@ void WritePlot(const QueryArgs& a, const std::vector<db::TestRecord>& tests) {
   io::WriteChart(a.plot, CurveChart(p));
 }
 
+// " test 2 of 3" (the serial's attempt of the recipe's allowed tests), " test 2" without a
+// limit, "" where the attempt is unknown (the central record keeps none).
+std::string AttemptText(const db::TestRecord& t) {
+  if (t.attempt <= 0) return "";
+  return " test " + std::to_string(t.attempt) +
+         (t.max_tests > 0 ? " of " + std::to_string(t.max_tests) : "");
+}
+
 int RunQuery(const QueryArgs& a) {
   std::string why;
   if (!ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
@@ -135,10 +143,10 @@ int RunQuery(const QueryArgs& a) {
   std::cout << a.serial << ": " << tests.size() << " test(s), latest "
             << analysis::ToString(tests.front().outcome) << "\n";
   for (const auto& t : tests) {
-    std::printf("  %s#%-6lld %s  %-7s recipe %s v%d (%s)%s\n",
+    std::printf("  %s#%-6lld %s  %-7s recipe %s v%d (%s)%s%s\n",
                 a.central.empty() ? "" : (t.station_id + " ").c_str(), static_cast<long long>(t.id),
                 t.started_at.c_str(), analysis::ToString(t.outcome), t.recipe_id.c_str(),
-                t.recipe_version, t.recipe_hash.substr(0, 12).c_str(),
+                t.recipe_version, t.recipe_hash.substr(0, 12).c_str(), AttemptText(t).c_str(),
                 t.retest_of ? (" retest of #" + std::to_string(*t.retest_of)).c_str() : "");
     if (t.work != db::WorkContext{})  // who and for which order (schema v4), when given
       std::printf("          operator %s, shift %s, order %s\n",

@@ -4,6 +4,10 @@
 // capability (Cp/Cpk within, Pp/Ppk overall), control-chart run-rule alarms, drift alarms and
 // the type-1 gauge study (station/stats_report.h); --plot draws the control charts and
 // histograms of the resonance and its Q (station/spc_charts.h).
+// `eol stats --db FILE --yield [--by all|shift|day|recipe] [--shifts A=06:00,...]
+//  [--utc-offset-min M] [--recipe-hash H] [--from T] [--to T] [--plot FILE] [--json]`:
+// first-pass and final yield, retests and the Pareto of reasons (station/yield.h); --plot
+// draws the Pareto of the whole window. Exit 0, 2 on usage or file errors.
 // Exit 0 when no drift (trend) alarm fired, 1 when one did, 2 on usage or file errors; run-rule
 // alarms are printed and listed under "spc_alarms" but leave the exit code alone.
 #include <algorithm>
@@ -19,6 +23,7 @@
 #include "station/cli/common.h"
 #include "station/spc_charts.h"
 #include "station/stats_report.h"
+#include "station/yield.h"
 
 namespace eol::station::cli {
 namespace {
@@ -37,6 +42,12 @@ struct StatsArgs {
   std::size_t baseline = kDefaultBaselineUnits;
   std::string plot;
   bool json = false;
+  bool yield = false;
+  std::string by = "all";
+  std::string shifts = kDefaultShifts;
+  std::optional<int> utc_offset_min;
+  // Options given on the command line, by name ("--gauge"): what --yield refuses.
+  std::vector<std::string> given;
 };
 
 std::string Num(const nlohmann::json& v, const char* fmt = "%.4g") {
@@ -164,7 +175,45 @@ void CheckGauge(db::Store& store, const StatsRequest& req, const nlohmann::json&
   }
 }
 
+bool Given(const StatsArgs& a, const std::string& name) {
+  return std::find(a.given.begin(), a.given.end(), name) != a.given.end();
+}
+
+// `--yield`: the yield report (station/yield.h); the capability options do not apply.
+int RunYield(const StatsArgs& a) {
+  for (const char* other : {"--gauge", "--reference", "--gauge-sigma-span", "--drift-t",
+                            "--population", "--baseline", "--subgroup"})
+    if (Given(a, other))
+      throw std::runtime_error(std::string(other) +
+                               " is a capability option and does not apply to --yield");
+  YieldRequest req;
+  if (!a.recipe_hash.empty()) req.recipe_hash = a.recipe_hash;
+  if (!a.from.empty()) req.from = IsoOption("--from", a.from);
+  if (!a.to.empty()) req.to = IsoOption("--to", a.to);
+  if (req.from && req.to && *req.from >= *req.to)
+    throw std::runtime_error("--from must be before --to");
+  if (!ParseYieldGrouping(a.by, &req.options.by))
+    throw std::runtime_error("--by must be all, shift, day or recipe (have '" + a.by + "')");
+  std::string why;
+  if (!ParseShifts(a.shifts, &req.options.shifts, &why))
+    throw std::runtime_error("--shifts: " + why);
+  req.options.utc_offset_min = a.utc_offset_min;
+  auto store = db::Store::Open(a.db, db::Store::Role::kReadOnly);
+  const nlohmann::json report = YieldReport(*store, req);
+  if (!a.plot.empty())
+    io::WriteChart(a.plot, ParetoChart(report["total"], "eol stats --yield: " + a.db));
+  if (a.json)
+    std::cout << report.dump(2) << std::endl;
+  else
+    std::cout << YieldText(report);
+  if (!a.plot.empty() && !a.json) std::printf("Pareto chart written to %s\n", a.plot.c_str());
+  return 0;
+}
+
 int RunStats(const StatsArgs& a) {
+  if (a.yield) return RunYield(a);
+  for (const char* yield_only : {"--by", "--shifts", "--utc-offset-min"})
+    if (Given(a, yield_only)) throw std::runtime_error(std::string(yield_only) + " needs --yield");
   StatsRequest req;
   if (!a.recipe_hash.empty()) req.recipe_hash = a.recipe_hash;
   if (!a.from.empty()) req.from = IsoOption("--from", a.from);
@@ -207,7 +256,10 @@ void AddStatsCommand(CLI::App& app) {
       "serial tested repeatedly. Self-check (master) tests are excluded. --plot draws the\n"
       "control charts and histograms of resonance_f_hz and resonance_q.\n"
       "Exit code 1 when a drift (trend) alarm fired; 2 when --gauge names a serial without\n"
-      "tests in the window or --reference a measurement its study lacks.");
+      "tests in the window or --reference a measurement its study lacks.\n"
+      "With --yield: first-pass and final yield, retests and the Pareto of reasons, in total\n"
+      "and --by shift, day or recipe (station/yield.h defines each figure); --plot draws\n"
+      "the Pareto.");
   cmd->add_option("--db", args->db, "SQLite file of the station")
       ->required()
       ->check(CLI::ExistingFile);
@@ -231,8 +283,26 @@ void AddStatsCommand(CLI::App& app) {
                   "consecutive units, sigma within = Rbar/d2");
   cmd->add_option("--plot", args->plot,
                   "Write the control charts and histograms with the limits (SVG, or PNG for .png)");
-  cmd->add_flag("--json", args->json, "One JSON object (station/stats_report.h)");
-  cmd->callback([args] { RunGuarded("stats", [&] { return RunStats(*args); }); });
+  cmd->add_flag("--json", args->json,
+                "One JSON object (station/stats_report.h; with --yield station/yield.h)");
+  cmd->add_flag("--yield", args->yield,
+                "Yield instead of capability: first-pass, first-verdict and final yield,\n"
+                "retested units, tests per unit and the Pareto of reason codes");
+  cmd->add_option("--by", args->by, "--yield per: all (default), shift, day or recipe")
+      ->capture_default_str();
+  cmd->add_option("--shifts", args->shifts,
+                  "--yield --by shift: NAME=HH:MM start times in local time, each shift\n"
+                  "running until the next")
+      ->capture_default_str();
+  cmd->add_option("--utc-offset-min", args->utc_offset_min,
+                  "--yield: local time = UTC + this many minutes (default: the time zone\n"
+                  "of this machine, with its daylight saving rules)")
+      ->check(Between(-840, 840));
+  cmd->callback([args, cmd] {
+    for (const CLI::Option* o : cmd->get_options())
+      if (o->count() > 0) args->given.push_back(o->get_name());
+    RunGuarded("stats", [&] { return RunStats(*args); });
+  });
 }
 
 }  // namespace eol::station::cli

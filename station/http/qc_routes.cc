@@ -9,6 +9,7 @@
 #include "station/http/routes.h"
 #include "station/spc_charts.h"
 #include "station/stats_report.h"
+#include "station/yield.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -106,6 +107,78 @@ void GetChart(ApiContext& c, const httplib::Request& req, httplib::Response& res
   res.set_content(io::RenderChartSvg(MeasurementChart(*series, q)), "image/svg+xml");
 }
 
+// The yield request of GET /api/yield and /api/yield/pareto.svg: from, to, recipe_hash, by,
+// shifts, utc_offset_min (station/yield.h), and for the chart `group` (a group's key).
+// Unknown parameters are refused (a misspelt "by" would otherwise give the total).
+std::optional<ApiError> ParseYieldRequest(const httplib::Request& req, bool chart,
+                                          YieldRequest* q) {
+  static const std::set<std::string> kKnown = {"from", "to",     "recipe_hash",
+                                               "by",   "shifts", "utc_offset_min"};
+  for (const auto& [name, value] : req.params)
+    if (!kKnown.count(name) && !(chart && name == "group"))
+      return BadRequest("unknown_parameter", "unknown parameter '" + name +
+                                                 "' (from, to, recipe_hash, by, shifts, "
+                                                 "utc_offset_min" +
+                                                 (chart ? ", group)" : ")"));
+  for (const auto& e : {TimeParam(req, "from", &q->from), TimeParam(req, "to", &q->to)})
+    if (e) return e;
+  if (q->from && q->to && *q->from >= *q->to)
+    return BadRequest("bad_request", "from must be before to");
+  if (req.has_param("recipe_hash")) q->recipe_hash = req.get_param_value("recipe_hash");
+  if (req.has_param("by") && !ParseYieldGrouping(req.get_param_value("by"), &q->options.by))
+    return BadRequest("bad_by", "by must be all, shift, day or recipe (have '" +
+                                    req.get_param_value("by") + "')");
+  std::string why;
+  if (!ParseShifts(req.has_param("shifts") ? req.get_param_value("shifts") : kDefaultShifts,
+                   &q->options.shifts, &why))
+    return BadRequest("bad_shifts", "shifts: " + why);
+  long long offset = 0;
+  if (const auto e = IntegerParam(req, "utc_offset_min", -840, 840, &offset)) return e;
+  if (req.has_param("utc_offset_min")) q->options.utc_offset_min = static_cast<int>(offset);
+  return std::nullopt;
+}
+
+// GET /api/yield: station/yield.h's JSON.
+void GetYield(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
+  YieldRequest q;
+  if (const auto e = ParseYieldRequest(req, false, &q)) return Send(res, *e);
+  nlohmann::json report;
+  {
+    std::lock_guard<std::mutex> lock(c.db_mu);
+    report = YieldReport(*c.db, q);
+  }
+  Send(res, HttpReply{200, report});
+}
+
+// GET /api/yield/pareto.svg: the Pareto of the window's total, or of the group `group` (by
+// `by`), as image/svg+xml; 404 "no_group" for a key the report lacks, 404 "no_failures"
+// when the group has no non-PASS test.
+void GetParetoSvg(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
+  YieldRequest q;
+  if (const auto e = ParseYieldRequest(req, true, &q)) return Send(res, *e);
+  nlohmann::json report;
+  {
+    std::lock_guard<std::mutex> lock(c.db_mu);
+    report = YieldReport(*c.db, q);
+  }
+  const nlohmann::json* group = &report["total"];
+  if (req.has_param("group") && req.get_param_value("group") != "all") {
+    group = nullptr;
+    for (const auto& g : report["groups"])
+      if (g["key"] == req.get_param_value("group")) group = &g;
+    if (!group)
+      return Send(res, ApiError{ApiErrorKind::kNotFound, "no_group",
+                                "no group '" + req.get_param_value("group") + "' by " +
+                                    report["window"]["by"].get<std::string>() + " in the window"});
+  }
+  if ((*group)["pareto"].empty())
+    return Send(res, ApiError{ApiErrorKind::kNotFound, "no_failures",
+                              "no non-PASS test in " + (*group)["key"].get<std::string>() +
+                                  ": nothing to chart"});
+  res.status = 200;
+  res.set_content(io::RenderChartSvg(ParetoChart(*group, "Pareto of reasons")), "image/svg+xml");
+}
+
 void GetDetectability(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   // Fixtures measured so far are near 1e3 N m/rad; the range allows four decades each way
   // and keeps the model's arithmetic finite (k_fixture=1e308 used to give a 500).
@@ -188,6 +261,8 @@ void AddQcRoutes(httplib::Server& s, ApiContext& c) {
   Route(s, c, "GET", "/api/stats", GetStats);
   Route(s, c, "GET", R"(/api/charts/([^/]+)\.svg)", GetChart);
   Route(s, c, "GET", "/api/detectability", GetDetectability);
+  Route(s, c, "GET", "/api/yield", GetYield);
+  Route(s, c, "GET", R"(/api/yield/pareto\.svg)", GetParetoSvg);
   Route(s, c, "POST", "/api/teach", PostTeach);
 }
 

@@ -349,10 +349,19 @@ async function showTest(id) {
   }
 }
 
+// Retest marking (GET /api/status "last".attempt, max_tests): "retest 2 of 3" for a serial's
+// second test of the three its recipe allows, nothing for a first test or an unstored refusal.
+function renderAttempt(summary) {
+  const a = (summary && summary.attempt) || 0, of = (summary && summary.max_tests) || 0;
+  $("attempt").textContent = a > 1 ? `retest ${a}` + (of ? ` of ${of}` : "") +
+      (of && a >= of ? " (last allowed test)" : "") : "";
+}
+
 // A finished result: its record when it was stored (id > 0); a refusal before anything moved
 // (lockout, retest limit) is not stored and has no curve.
 function showResult(summary) {
   renderOutcome(summary.outcome, summary.serial, summary.reasons, summary.kind);
+  renderAttempt(summary);
   if (summary.id > 0) {
     showTest(summary.id);
   } else {
@@ -365,6 +374,7 @@ function showResult(summary) {
 
 function showRunning(serial) {
   renderOutcome("RUNNING", serial, []);
+  renderAttempt(null);
   shownTestId = null;  // the last unit's curve is not this one's
   clearPlot("test running");
   renderMeasurements([]);

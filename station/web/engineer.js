@@ -1,6 +1,7 @@
 // Engineer page: control charts, histogram and capability of one measurement over a window of
-// stored tests, detectability of defect classes, and POD and gap figures from files. Every
-// figure is the station's own SVG (GET /api/charts/..., POST /api/pod.svg, /api/gap.svg), the
+// stored tests, yield with the Pareto of reasons over the same window, detectability of defect
+// classes, and POD and gap figures from files. Every figure is the station's own SVG
+// (GET /api/charts/..., /api/yield/pareto.svg, POST /api/pod.svg, /api/gap.svg), the
 // same drawing the `eol` command writes; this page only asks and shows. No libraries, no
 // network beyond this station.
 "use strict";
@@ -157,9 +158,74 @@ async function refresh() {
       showChart($("chart-xbar"), base + queryString({...query, population, chart: "xbar_r", subgroup})),
       showChart($("chart-hist"), base + queryString({...query, population, chart: "histogram"})),
     ]);
+    yieldWindow = query;
+    await showYield();
     status("window-status", `${picked}: ${words}`);
   } catch (e) {
     status("window-status", e.message, true);
+  }
+}
+
+// --- Yield over the same window (GET /api/yield, station/yield.h defines each figure). ---
+
+let yieldWindow = {};  // the window of the last refresh
+
+function pct(v) {
+  return v === null || v === undefined ? "—" : (100 * v).toFixed(1) + " %";
+}
+
+function yieldRow(g, isTotal) {
+  const row = el("tr", {"data-key": g.key, class: isTotal ? "total" : "group"});
+  const top = (g.pareto || []).slice(0, 3).map(p => `${p.code} ${p.tests}`).join(", ");
+  for (const v of [isTotal ? "total" : g.key, g.units, pct(g.first_pass_yield), pct(g.first_verdict_yield),
+                   pct(g.final_yield), g.final_fail, g.final_open, g.retested_units,
+                   g.tests_per_unit === null ? "—" : g.tests_per_unit.toFixed(2), g.tests, top || "—"])
+    row.appendChild(el("td", {}, String(v)));
+  row.addEventListener("click", () => showPareto(g, isTotal));
+  return row;
+}
+
+function renderYield(report) {
+  const t = $("yield");
+  t.replaceChildren();
+  const head = el("tr");
+  for (const h of ["group", "units", "first pass", "first verdict", "final", "FAIL", "open", "retested",
+                   "tests per unit", "tests", "top reasons (tests)"])
+    head.appendChild(el("th", {scope: "col"}, h));
+  t.appendChild(head);
+  for (const g of report.groups || []) t.appendChild(yieldRow(g, false));
+  t.appendChild(yieldRow(report.total, true));
+  const w = report.window || {};
+  $("yield-note").textContent = `(production units; ${w.time_zone || ""}; first pass: the first test PASSed, ` +
+      "an ERROR first is not; first verdict: the first PASS/FAIL was PASS; open: the last test was ERROR or " +
+      "ABORTED; click a row for its Pareto)";
+}
+
+// The Pareto of one group (or the total); none is asked for a group without a non-PASS test.
+async function showPareto(g, isTotal) {
+  const img = $("chart-pareto"), caption = img.parentElement.querySelector("figcaption");
+  caption.dataset.base = caption.dataset.base || caption.textContent;
+  if (!(g.pareto || []).length) {
+    img.hidden = true;
+    img.removeAttribute("src");
+    caption.textContent = `${caption.dataset.base}: no non-PASS test in ${isTotal ? "the window" : g.key}`;
+    return;
+  }
+  const by = $("yield-by").value;
+  await showChart(img, "/api/yield/pareto.svg?" +
+                  queryString({...yieldWindow, by, shifts: $("yield-shifts").value, group: isTotal ? "all" : g.key}));
+}
+
+async function showYield() {
+  status("yield-status", "loading…");
+  try {
+    const by = $("yield-by").value;
+    const report = await getJson("/api/yield?" + queryString({...yieldWindow, by, shifts: $("yield-shifts").value}));
+    renderYield(report);
+    await showPareto(report.total, true);
+    status("yield-status", `${report.total.units} units, ${report.total.tests} tests`);
+  } catch (e) {
+    status("yield-status", e.message, true);
   }
 }
 
@@ -255,6 +321,7 @@ async function main() {
   $("token").addEventListener("change", () => sessionStorage.setItem("eol.engineer_token", $("token").value));
   $("window-form").addEventListener("submit", e => { e.preventDefault(); refresh(); });
   $("measurement").addEventListener("change", refresh);
+  $("yield-form").addEventListener("submit", e => { e.preventDefault(); showYield(); });
   $("detect-form").addEventListener("submit", e => { e.preventDefault(); detectability(); });
   $("pod-form").addEventListener("submit", drawPod);
   $("gap-form").addEventListener("submit", drawGap);

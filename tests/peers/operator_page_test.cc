@@ -333,6 +333,13 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
       << states["pass"]["tested"];
   EXPECT_EQ(stored("SCAN-BAD-1")["outcome"], "FAIL");
   EXPECT_EQ(states["fail"]["verdict"], "FAIL");
+  // Retest marking: nothing on a first test; the serial's second test reads "retest 2 of 3",
+  // as its stored record says.
+  EXPECT_EQ(states["fail"]["attempt"], "");
+  EXPECT_EQ(j["retest"]["attempt"], "retest 2 of 3");
+  EXPECT_EQ(j["retest"]["verdict"], "FAIL");
+  EXPECT_EQ(stored("SCAN-BAD-1")["attempt"], 2);
+  EXPECT_EQ(stored("SCAN-BAD-1")["max_tests"], 3);
   EXPECT_TRUE(stored("SCAN-LOCKED-1").is_null()) << "a refused serial is not stored";
 
   // Lockout: a banner; the refused serial is ERROR with the recipe's instruction above the
@@ -621,7 +628,8 @@ TEST(OperatorPage, FollowsTheFixtureControllerAndShowsALostStationWithin2s) {
 // Issue 17: the engineer page (GET /engineer, linked from the operator page) against a
 // station with stored tests: its capability table is the API's, its charts are the API's
 // SVGs with their series, the window and the measurement picker change what is drawn, the
-// detectability table lists every class, uploads give the POD and gap figures; axe-core finds
+// yield table is GET /api/yield's, the detectability table lists every class, uploads give the
+// POD and gap figures; axe-core finds
 // nothing serious at 1920x1080 and 1280x800. Screenshots are kept in build/artifacts/.
 TEST(EngineerPage, ShowsChartsCapabilityDetectabilityAndFiguresFromFiles) {
   const std::string node = BrowserCheckNode();
@@ -713,6 +721,20 @@ TEST(EngineerPage, ShowsChartsCapabilityDetectabilityAndFiguresFromFiles) {
     const std::string all = c["title"].get<std::string>() + "\n" + c["desc"].get<std::string>();
     for (const std::string& w : words) EXPECT_NE(all.find(w), std::string::npos) << id << ": " << w;
   }
+  // Yield per day, as GET /api/yield says: 12 units, all PASS at the first test, so no Pareto
+  // is asked for (the caption says why).
+  const auto yield = nlohmann::json::parse(http.Get("/api/yield?by=day")->body);
+  const nlohmann::json& rows = j["yield"]["rows"];
+  ASSERT_EQ(rows.size(), yield["groups"].size() + 1) << j["yield"];
+  EXPECT_EQ(rows[0]["key"], yield["groups"][0]["key"]);
+  EXPECT_TRUE(rows.back()["total"].get<bool>());
+  EXPECT_EQ(rows.back()["units"], kTests);
+  EXPECT_EQ(rows.back()["first_pass"], "100.0 %");
+  EXPECT_EQ(rows.back()["final"], "100.0 %");
+  EXPECT_NE(j["yield"]["pareto_caption"].get<std::string>().find("no non-PASS test in the window"),
+            std::string::npos)
+      << j["yield"];
+  EXPECT_EQ(j["yield"]["status"], "12 units, 12 tests");
   // The window: the last 5 tests (all PASS) are 5 units, in the table and on the charts.
   ASSERT_EQ(j["last"]["capability"].size(), 1u);
   EXPECT_EQ(j["last"]["capability"][0]["n"], 5);

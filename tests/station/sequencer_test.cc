@@ -210,6 +210,13 @@ TEST_F(SequencerTest, RetestLimitRefusesASerialBeforeClamping) {
   for (int i = 0; i < recipe_.max_tests_per_serial; ++i) {
     const db::TestRecord r = Test("RETEST-1", true);
     EXPECT_EQ(r.outcome, Outcome::kFail);
+    // Retest marking: "test i+1 of 3", on the record published and on the stored one.
+    EXPECT_EQ(r.attempt, i + 1);
+    EXPECT_EQ(r.max_tests, recipe_.max_tests_per_serial);
+    const std::optional<db::TestRecord> stored = store_->Test(r.id, false);
+    ASSERT_TRUE(stored);
+    EXPECT_EQ(stored->attempt, i + 1);
+    EXPECT_EQ(stored->max_tests, recipe_.max_tests_per_serial);
     if (i > 0) {
       EXPECT_TRUE(r.retest_of.has_value());
     }

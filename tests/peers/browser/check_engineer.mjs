@@ -1,7 +1,7 @@
 // Drives Debian's chromium (headless, through playwright-core) against the engineer page of a
 // station with stored tests: reads back the capability table and the words of every chart the
 // page shows (the SVG it loaded), narrows the window to the last N tests, picks another
-// measurement, reads the detectability table, uploads a hits CSV and gap inputs and reads the
+// measurement, reads the yield table and the Pareto's caption, the detectability table, uploads a hits CSV and gap inputs and reads the
 // figures back; axe-core at 1920x1080 and 1280x800, screenshots kept.
 // Usage: node check_engineer.mjs BASE_URL ARTIFACT_DIR LAST_N HITS_CSV SIM_FILE MEASURED_FILE
 // Prints one JSON object; exit code 1 with {"error": ...} when a step does not happen.
@@ -62,6 +62,13 @@ await runCheck(out, async browser => {
   await page.waitForSelector("body[data-ready=true]", { timeout: 60000 });
   out.url = page.url();
   out.initial = await shown(page);
+  // The yield table (per day by default) and the Pareto's caption.
+  out.yield = await page.evaluate(() => ({
+    rows: [...document.querySelectorAll("#yield tr[data-key]")].map(r => ({
+      key: r.dataset.key, total: r.classList.contains("total"), units: Number(r.cells[1].textContent),
+      first_pass: r.cells[2].textContent, final: r.cells[4].textContent })),
+    pareto_caption: document.querySelector("#chart-pareto").parentElement.querySelector("figcaption").textContent,
+    status: document.getElementById("yield-status").textContent }));
   out.detectability = await page.$$eval("#detectability tr[data-defect]", rows => rows.map(r => ({
     defect: r.dataset.defect, detectable: r.cells[5].textContent })));
   out.axe_1920 = await seriousViolations(page);

@@ -158,6 +158,12 @@ await runCheck(out, async browser => {
   await waitForStored(page, badSerial);
   const fail = await capture(page, "fail");
   fail.verdict = await text(page, "#verdict");
+  fail.attempt = await text(page, "#attempt");
+  // Retest marking: the same serial again is "retest 2 of 3" (the recipe allows 3 tests).
+  await scan(page, badSerial);
+  await page.waitForFunction(() => document.getElementById("attempt").textContent.startsWith("retest 2"),
+                             null, { timeout: 30000 });
+  out.retest = { attempt: await text(page, "#attempt"), verdict: await text(page, "#verdict") };
 
   for (const [w, h] of SIZES) {
     await page.setViewportSize({ width: w, height: h });
