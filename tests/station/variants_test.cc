@@ -194,6 +194,7 @@ class TwoRecipeStation : public ::testing::Test {
   void SetUp() override {
     db::Store::Open(db_path_);  // recipe-approve audits into an existing store
     std::filesystem::copy_file(kEightPole, eight_pole_);
+    std::filesystem::copy_file(kTenPole, ten_pole_);  // ChangeRecipe writes over it
     const auto run = eol::testing::RunEol({"recipe-approve", "--recipe", eight_pole_, "--by",
                                            "qe-test", "--note", "variants test", "--db", db_path_},
                                           true, 120s);
@@ -209,7 +210,7 @@ class TwoRecipeStation : public ::testing::Test {
   nlohmann::json Config(const std::string& eight_pole) const {
     return {{"station_id", "variants"},
             {"variants",
-             {{{"name", "P10"}, {"recipe", kTenPole}, {"plc_code", 1}, {"prefixes", {"P10-"}}},
+             {{{"name", "P10"}, {"recipe", ten_pole_}, {"plc_code", 1}, {"prefixes", {"P10-"}}},
               {{"name", "P8H"}, {"recipe", eight_pole}, {"plc_code", 2}, {"prefixes", {"P8H-"}}}}},
             {"db", db_path_},
             {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
@@ -258,6 +259,7 @@ class TwoRecipeStation : public ::testing::Test {
   eol::testing::TempDir dir_;
   const std::string db_path_ = dir_ / "variants.sqlite";
   const std::string eight_pole_ = dir_ / "pmsm-8pole-heavy.json";
+  const std::string ten_pole_ = dir_ / "pmsm-10pole.json";
   std::unique_ptr<Station> station_;
   std::thread serve_;
 };
@@ -277,7 +279,7 @@ TEST_F(TwoRecipeStation, AProposalIsRefusedAtStartNamingTheVariantAndTheFile) {
     EXPECT_NE(what.find("the station does not start with it"), std::string::npos) << what;
   }
   nlohmann::json twice = Config(eight_pole_);
-  twice["variants"][1]["recipe"] = kTenPole;
+  twice["variants"][1]["recipe"] = ten_pole_;
   try {
     Station s(ParseStationConfig(twice, "test", ""));
     FAIL() << "two variants of one recipe";
@@ -436,6 +438,43 @@ TEST(OneRecipeStation, RefusesAnotherVariantAndKeepsItsRecipe) {
   EXPECT_EQ(r.recipe_id, "pmsm-10pole");
   EXPECT_FALSE(r.conditions.contains("variant")) << "no variant keys on a one-recipe station";
   EXPECT_EQ(station.VariantsJson()["variants"], nlohmann::json::array());
+}
+
+}  // namespace
+}  // namespace eol::station
+
+namespace eol::station {
+namespace {
+
+// PUT /api/recipe on a station of variants: the new recipe's id picks the variant it replaces;
+// the next unit of that variant is tested with it, the other variant keeps its own.
+TEST_F(TwoRecipeStation, ANewVersionReplacesTheRecipeOfItsVariantOnly) {
+  Start();
+  const ApiToken engineer{"qe-test", Role::kEngineer, "engineer-token-0123456789"};
+  nlohmann::json next = io::ReadJsonFile(ten_pole_);
+  next["version"] = 2;
+  const RecipeChange changed = station_->ChangeRecipe(next, engineer);
+  ASSERT_EQ(changed.kind, RecipeChange::Kind::kChanged) << changed.message;
+  EXPECT_EQ(changed.path, ten_pole_);
+  EXPECT_EQ(changed.kept_as, dir_ / "pmsm-10pole.v1.json");
+  nlohmann::json other =
+      io::ReadJsonFile(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json");
+  const RecipeChange refused = station_->ChangeRecipe(other, engineer);
+  EXPECT_EQ(refused.kind, RecipeChange::Kind::kWrongRecipe);
+  EXPECT_EQ(refused.message,
+            "recipe id 'pmsm-10pole-fast' is none of this station's variants' (P10: "
+            "pmsm-10pole, P8H: pmsm-8pole-heavy); a new variant needs a new station config");
+
+  ASSERT_EQ(Post({{"serial", "P10-1"}})->status, 202);
+  ASSERT_EQ(Post({{"serial", "P8H-1"}})->status, 202);
+  const std::vector<db::TestRecord> stored = Stored(2);
+  ASSERT_EQ(stored.size(), 2u);
+  EXPECT_EQ(stored[1].serial, "P10-1");
+  EXPECT_EQ(stored[1].recipe_version, 2);
+  EXPECT_EQ(stored[1].recipe_hash, changed.hash);
+  EXPECT_EQ(stored[0].recipe_hash, LoadRecipe(eight_pole_).hash);
+  const nlohmann::json v = station_->VariantsJson();
+  EXPECT_EQ(v["variants"][0]["recipe"]["version"], 2);
 }
 
 }  // namespace
