@@ -5,8 +5,50 @@
 
 #include "drivers/io/json_config.h"
 
+#define PCRE2_CODE_UNIT_WIDTH 8
+#include <pcre2.h>
+
 namespace eol::station {
+
+struct CompiledPattern {
+  pcre2_code* code = nullptr;
+  ~CompiledPattern() { pcre2_code_free(code); }
+};
+
 namespace {
+
+// The pattern compiled to match whole serials; throws io::ConfigError at `at` when it is none.
+std::shared_ptr<const CompiledPattern> Compile(const std::string& pattern, const std::string& at) {
+  int error = 0;
+  PCRE2_SIZE offset = 0;
+  auto p = std::make_shared<CompiledPattern>();
+  p->code = pcre2_compile(reinterpret_cast<PCRE2_SPTR>(pattern.data()), pattern.size(),
+                          PCRE2_ANCHORED | PCRE2_ENDANCHORED, &error, &offset, nullptr);
+  if (p->code == nullptr) {
+    PCRE2_UCHAR text[256];
+    pcre2_get_error_message(error, text, sizeof text);
+    throw io::ConfigError(at + ": not a regular expression (" +
+                          std::string(reinterpret_cast<const char*>(text)) + " at offset " +
+                          std::to_string(offset) + ")");
+  }
+  return p;
+}
+
+enum class Match { kNo, kYes, kTooCostly };
+
+Match MatchWhole(const CompiledPattern& p, const std::string& serial) {
+  const std::unique_ptr<pcre2_match_data, decltype(&pcre2_match_data_free)> data(
+      pcre2_match_data_create_from_pattern(p.code, nullptr), pcre2_match_data_free);
+  const std::unique_ptr<pcre2_match_context, decltype(&pcre2_match_context_free)> context(
+      pcre2_match_context_create(nullptr), pcre2_match_context_free);
+  if (!data || !context) return Match::kTooCostly;
+  pcre2_set_match_limit(context.get(), kPatternMatchLimit);
+  pcre2_set_depth_limit(context.get(), kPatternMatchLimit);
+  const int rc = pcre2_match(p.code, reinterpret_cast<PCRE2_SPTR>(serial.data()), serial.size(), 0,
+                             0, data.get(), context.get());
+  if (rc >= 0) return Match::kYes;
+  return rc == PCRE2_ERROR_NOMATCH ? Match::kNo : Match::kTooCostly;
+}
 
 bool ValidName(const std::string& s) {
   return !s.empty() && s.size() <= kMaxVariantNameChars &&
@@ -46,14 +88,8 @@ VariantConfig ParseOne(const io::JsonObject& o,
   }
   v.prefixes = Strings(o, "prefixes", 64);  // a serial is at most 64 characters
   v.patterns = Strings(o, "patterns", kMaxVariantPatternChars);
-  for (std::size_t i = 0; i < v.patterns.size(); ++i) {
-    try {
-      v.compiled.emplace_back(v.patterns[i], std::regex::ECMAScript);
-    } catch (const std::regex_error& e) {
-      throw io::ConfigError(o.PathOf("patterns") + "/" + std::to_string(i) +
-                            ": not a regular expression (" + e.what() + ")");
-    }
-  }
+  for (std::size_t i = 0; i < v.patterns.size(); ++i)
+    v.compiled.push_back(Compile(v.patterns[i], o.PathOf("patterns") + "/" + std::to_string(i)));
   o.RejectUnknown();
   return v;
 }
@@ -78,12 +114,17 @@ void CheckDistinct(const std::vector<VariantConfig>& vs, std::size_t k, const st
   }
 }
 
-// The rule of `v` that claims `serial`, or "" when none does.
-std::string MatchingRule(const VariantConfig& v, const std::string& serial) {
+// The rule of `v` that claims `serial`, or "" when none does; `costly` gets a pattern that
+// exceeded its match limit.
+std::string MatchingRule(const VariantConfig& v, const std::string& serial, std::string* costly) {
   for (const std::string& p : v.prefixes)
     if (serial.rfind(p, 0) == 0) return "prefix '" + p + "'";
-  for (std::size_t i = 0; i < v.compiled.size(); ++i)
-    if (std::regex_match(serial, v.compiled[i])) return "pattern '" + v.patterns[i] + "'";
+  for (std::size_t i = 0; i < v.compiled.size(); ++i) {
+    const Match m = MatchWhole(*v.compiled[i], serial);
+    if (m == Match::kYes) return "pattern '" + v.patterns[i] + "'";
+    if (m == Match::kTooCostly && costly->empty())
+      *costly = "variant '" + v.name + "''s pattern '" + v.patterns[i] + "'";
+  }
   return "";
 }
 
@@ -165,9 +206,15 @@ VariantSelection SelectVariant(const std::vector<VariantConfig>& variants,
     by = "plc code " + std::to_string(choice.plc_code);
   }
   std::vector<std::pair<std::size_t, std::string>> claims;  // variant, rule
+  std::string costly;
   for (std::size_t i = 0; i < variants.size(); ++i)
-    if (std::string rule = MatchingRule(variants[i], serial); !rule.empty())
+    if (std::string rule = MatchingRule(variants[i], serial, &costly); !rule.empty())
       claims.emplace_back(i, std::move(rule));
+  // Whether it would have matched is unknown: neither a choice nor another rule may stand.
+  if (!costly.empty())
+    return Refused(VariantRefusal::kNoRule, costly + " exceeded its match limit on serial '" +
+                                                serial +
+                                                "' (it backtracks too much); simplify the pattern");
   std::string claimed;
   for (const auto& [i, rule] : claims)
     claimed += (claimed.empty() ? "" : ", ") + variants[i].name + " by its " + rule;

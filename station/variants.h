@@ -17,8 +17,10 @@
 //             unique
 //   prefixes  part-number prefixes of the serial (the scanned code): "P10-" picks this variant
 //             for "P10-000123". A prefix may not begin another variant's prefix (ambiguous).
-//   patterns  ECMAScript regular expressions the WHOLE serial must match (std::regex_match);
-//             each at most 200 characters
+//   patterns  regular expressions (PCRE2, Perl syntax) the WHOLE serial must match (anchored
+//             at both ends); each at most 200 characters. A match is bounded (kPatternMatchLimit
+//             steps): a pattern that backtracks beyond it ("(a+)+b") refuses the unit naming
+//             the pattern, it never hangs the station nor counts as "no match"
 //
 // Selection per unit (SelectVariant), from what the request names and the serial:
 //   - the request names a variant: the operator's choice by name (POST /api/tests "variant"),
@@ -34,9 +36,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -44,14 +46,17 @@ namespace eol::station {
 
 inline constexpr std::size_t kMaxVariantNameChars = 32;
 inline constexpr std::size_t kMaxVariantPatternChars = 200;
+inline constexpr std::uint32_t kPatternMatchLimit = 100000;  // PCRE2 match limit per serial
+
+struct CompiledPattern;  // PCRE2 code, private to variants.cc
 
 struct VariantConfig {
   std::string name;
   std::string recipe_path;     // resolved against the config's folder
   std::uint16_t plc_code = 0;  // 0: the PLC cannot pick it
   std::vector<std::string> prefixes;
-  std::vector<std::string> patterns;  // as written
-  std::vector<std::regex> compiled;   // the patterns, compiled once
+  std::vector<std::string> patterns;                             // as written
+  std::vector<std::shared_ptr<const CompiledPattern>> compiled;  // the patterns, compiled once
 };
 
 // The "variants" array at JSON pointer `path`; recipe paths resolved by `resolve`. Throws
@@ -68,7 +73,8 @@ struct VariantChoice {
 enum class VariantRefusal {
   kNone,
   kUnknown,   // the name or the PLC code names no variant of this station
-  kNoRule,    // nothing named, and no variant's rule (or more than one's) matches the serial
+  kNoRule,    // nothing named, and no variant's rule (or more than one's) matches the serial,
+              // or a pattern exceeded its match limit on it
   kConflict,  // the named variant is not the one the serial's rule gives
 };
 // "unknown_variant", "no_variant", "variant_conflict": the HTTP error code.

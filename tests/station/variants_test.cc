@@ -154,6 +154,25 @@ TEST(VariantSelection, TheSerialsPrefixOrWholePatternPicks) {
             "its pattern '[0-9]{4}-8.*'); choose the variant");
 }
 
+// A pattern that backtracks beyond its match limit refuses the unit at once, naming the
+// pattern: it neither hangs the station nor counts as "no match" (which would let another
+// variant's rule or the operator's choice stand).
+TEST(VariantSelection, APatternThatBacktracksTooMuchRefusesTheUnitQuickly) {
+  const auto v = ParseVariants({{{"name", "A"}, {"recipe", "a.json"}, {"patterns", {"(a+)+[bc]"}}},
+                                {{"name", "B"}, {"recipe", "b.json"}, {"prefixes", {"aaa"}}}},
+                               "/variants", [](const std::string& p) { return p; });
+  const std::string serial(60, 'a');
+  const auto t0 = std::chrono::steady_clock::now();
+  VariantSelection s = SelectVariant(v, serial, {"B", 0});
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 2s);
+  EXPECT_EQ(s.refusal, VariantRefusal::kNoRule);
+  EXPECT_EQ(s.why, "variant 'A''s pattern '(a+)+[bc]' exceeded its match limit on serial '" +
+                       serial + "' (it backtracks too much); simplify the pattern");
+  s = SelectVariant(v, "aaab", {});  // matched within the limit: A's pattern and B's prefix
+  EXPECT_EQ(s.refusal, VariantRefusal::kNoRule);
+  EXPECT_NE(s.why.find("matches several variants"), std::string::npos) << s.why;
+}
+
 TEST(VariantSelection, TheOperatorOrThePlcNamesItAndAContradictingRuleRefuses) {
   const auto v = TwoVariants();
   VariantSelection s = SelectVariant(v, "ANY-1", {"P8H", 0});
