@@ -11,6 +11,7 @@ find_package(prometheus-cpp CONFIG REQUIRED)  # /metrics (core registry and text
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 pkg_check_modules(MODBUS REQUIRED IMPORTED_TARGET libmodbus)
+pkg_check_modules(PCRE2 REQUIRED IMPORTED_TARGET libpcre2-8)  # variants' serial patterns, bounded
 pkg_check_modules(MOSQUITTO REQUIRED IMPORTED_TARGET libmosquitto)  # results to the MES (MQTT)
 pkg_check_modules(PQ REQUIRED IMPORTED_TARGET libpq)  # the plant's central PostgreSQL record
 pkg_check_modules(SNDFILE REQUIRED IMPORTED_TARGET sndfile)  # WAV recordings (drivers/io)

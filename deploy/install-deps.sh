@@ -9,6 +9,7 @@ build_pkgs=(
   libeigen3-dev libfftw3-dev libmodbus-dev libsqlite3-dev libspdlog-dev nlohmann-json3-dev
   libcpp-httplib-dev libcli11-dev libgtest-dev libssl-dev zlib1g-dev libasound2-dev
   libsndfile1-dev libsystemd-dev prometheus-cpp-dev libcairo2-dev libmosquitto-dev libpq-dev
+  libpcre2-dev
   help2man
 )
 test_pkgs=(

@@ -10,6 +10,7 @@
 #include "drivers/io/json_config.h"
 #include "station/plant_urls.h"
 #include "station/serial_number.h"
+#include "station/variants.h"
 
 namespace eol::station {
 namespace {
@@ -64,7 +65,17 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
     const JsonObject root(j, "");
     StationConfig c;
     c.station_id = root.String("station_id", c.station_id);
-    c.recipe_path = Resolve(base_dir, root.RequiredString("recipe"));
+    if (root.Has("variants")) {
+      if (root.Has("recipe"))
+        throw io::ConfigError(root.PathOf("recipe") +
+                              ": give either \"recipe\" (one recipe) or \"variants\" (several, "
+                              "one picked per unit), not both");
+      c.variants = ParseVariants(root.Raw("variants"), root.PathOf("variants"),
+                                 [&](const std::string& p) { return Resolve(base_dir, p); });
+      c.recipe_path = c.variants.front().recipe_path;  // shown until the first unit
+    } else {
+      c.recipe_path = Resolve(base_dir, root.RequiredString("recipe"));
+    }
     c.db_path = Resolve(base_dir, root.RequiredString("db"));
     c.init_store = root.Bool("init_store", false);
     if (auto http = root.OptionalObject("http")) {

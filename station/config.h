@@ -3,6 +3,9 @@
 // {
 //   "station_id": "eol-1",
 //   "recipe": "../recipes/pmsm-10pole.json",     relative paths are relative to this file
+//   "variants": [{"name": "P10", "recipe": "...", "plc_code": 1, "prefixes": ["P10-"],
+//                 "patterns": ["..."]}, ...]     instead of "recipe": several approved recipes,
+//                                                one picked per unit (station/variants.h)
 //   "db": "/var/lib/eol/eol.sqlite",
 //   "http": {"listen": "127.0.0.1", "port": 8080,
 //            "tokens": [{"name": "line1-operator", "role": "operator", "token": "..."},
@@ -57,6 +60,7 @@
 #include "station/central/central_replicator.h"
 #include "station/mqtt_publisher.h"
 #include "station/plc/plc_server.h"
+#include "station/variants.h"
 
 namespace eol::station {
 
@@ -105,7 +109,10 @@ struct SelfCheckConfig {
 
 struct StationConfig {
   std::string station_id = "eol-1";
+  // The one recipe; with variants, the first variant's (shown until the first unit).
   std::string recipe_path;
+  // Several recipes, one picked per unit (station/variants.h); empty: the one recipe.
+  std::vector<VariantConfig> variants;
   std::string db_path;
   // Make an existing empty file at db_path a new store (db::OpenOptions::create_if_empty;
   // config "init_store", `--init-store`). Without it such a file is refused; a missing file

@@ -9,9 +9,13 @@
 //   GET  /api/tests/{id}        one test with its curves
 //   GET  /api/tests?from=&to=&outcome=&serial=&limit=   tests in a time range ("verdict=",
 //                               the older name of outcome=, is still accepted)
-//   POST /api/tests             {"serial": "...", "operator_id", "shift", "order_number"}
-//                               starts a test (bearer token when configured; the three
-//                               optional fields as station/test_request.h accepts them)
+//   POST /api/tests             {"serial": "...", "operator_id", "shift", "order_number",
+//                               "variant"} starts a test (bearer token when configured; the
+//                               optional fields as station/test_request.h accepts them;
+//                               "variant" the operator's choice, station/variants.h: refused
+//                               400 unknown_variant, 400 no_variant, 409 variant_conflict)
+//   GET  /api/variants          the station's variants with their recipes (id, version, hash)
+//                               and the last unit's ("current"); [] with one recipe
 //   PUT  /api/recipe            a new version of the recipe (engineer token; audited)
 //   GET  /api/recipe/audit      who changed the recipe, when, old and new hash
 //   POST /api/recipe/approve    approve a taught proposal and install it (engineer; audited)
@@ -97,8 +101,12 @@ struct HttpOptions {
 
 // What the API asks of the station.
 struct HttpHandlers {
-  // Queues a test; false with the reason when refused (busy, stopping).
-  std::function<bool(const TestRequest& request, std::string* why)> start_test;
+  // Queues a test; false with the reason when refused (busy, stopping, or its variant:
+  // then `variant` says how).
+  std::function<bool(const TestRequest& request, std::string* why, VariantRefusal* variant)>
+      start_test;
+  // GET /api/variants (Station::VariantsJson); unset: {"variants": []}.
+  std::function<nlohmann::json()> variants;
   // The recipe in use as JSON, with its "hash".
   std::function<nlohmann::json()> recipe;
   // The recipe in use, parsed (teaching and detectability work from it).

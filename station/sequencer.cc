@@ -115,6 +115,11 @@ void Sequencer::SetRecipe(std::shared_ptr<const Recipe> recipe, analysis::Excita
   recipe_ = std::move(recipe);
 }
 
+void Sequencer::SetVariant(std::string name, std::string by) {
+  variant_ = std::move(name);
+  variant_by_ = std::move(by);
+}
+
 void Sequencer::RequestAbort(const std::string& why) {
   {
     std::lock_guard<std::mutex> lock(abort_mu_);
@@ -611,6 +616,10 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
   record.started_at = db::UtcNowIso8601();
   record.outcome = analysis::Outcome::kError;
   if (!options_.simulation.empty()) record.conditions["simulation"] = options_.simulation;
+  if (!variant_.empty()) {
+    record.conditions["variant"] = variant_;
+    record.conditions["variant_by"] = variant_by_;
+  }
   Enter(record, SeqState::kWaitSerial, "serial " + serial + " received");
   const std::optional<std::string> master = MasterRole(options_.self_check, serial);
   if (master) record.kind = db::RecordKind::kSelfCheck;

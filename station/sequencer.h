@@ -95,6 +95,10 @@ class Sequencer {
   // validate the recipe before anything was swapped.
   void SetRecipe(std::shared_ptr<const Recipe> recipe, analysis::Excitation designed);
   const Recipe& recipe() const { return *recipe_; }
+  // Between tests only: the variant the next tests are of (station/variants.h), kept in each
+  // record's conditions as "variant" (its name) and "variant_by" (how it was picked: "operator",
+  // "plc code 2", "prefix 'P10-'", ...). Empty (the default): a station of one recipe, no keys.
+  void SetVariant(std::string name, std::string by);
   // Re-reads the self-check state from the store and shows it on the board (GET /api/status).
   // Between tests only; a no-op when self-checks are off.
   void PublishLockout();
@@ -155,6 +159,8 @@ class Sequencer {
   drivers::Daq& daq_;
   db::Store& store_;
   std::shared_ptr<const Recipe> recipe_;
+  std::string variant_;  // SetVariant
+  std::string variant_by_;
   StatusBoard& board_;
   SequencerOptions options_;
   analysis::Excitation excitation_;  // designed from the recipe

@@ -51,10 +51,14 @@ Recipe LoadRecipeOrLastGood(const std::string& path, std::string* problem) {
 
 Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
     : config_(std::move(config)) {
-  recipe_ =
-      std::make_shared<const Recipe>(LoadRecipeOrLastGood(config_.recipe_path, &recipe_problem_));
-  if (recipe_problem_.empty() && !recipe_->Approved())
-    recipe_problem_ = recipe_->WhyNotApproved() + "; tests are refused until then";
+  if (config_.variants.empty()) {
+    recipe_ =
+        std::make_shared<const Recipe>(LoadRecipeOrLastGood(config_.recipe_path, &recipe_problem_));
+    if (recipe_problem_.empty() && !recipe_->Approved())
+      recipe_problem_ = recipe_->WhyNotApproved() + "; tests are refused until then";
+  } else {
+    LoadVariants();
+  }
   if (!recipe_problem_.empty()) spdlog::error("{}", recipe_problem_);
   spdlog::info("recipe {} v{} ({}), sha256 {}", recipe_->id, recipe_->version, config_.recipe_path,
                recipe_->hash.substr(0, 12));
@@ -104,6 +108,99 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
   sequencer_ = std::make_unique<Sequencer>(*drivers_.fixture, *drivers_.daq, *store_, recipe_,
                                            *board_, opts);
   sequencer_->PublishLockout();  // a lockout survives a restart: it is read from the store
+}
+
+// Every variant's recipe loaded, approved and its excitation designed, or the station does not
+// start: a proposal or a broken file is named with its variant.
+void Station::LoadVariants() {
+  for (const VariantConfig& v : config_.variants) {
+    const std::string where = "variant '" + v.name + "' (" + v.recipe_path + "): ";
+    std::shared_ptr<const Recipe> r;
+    try {
+      r = std::make_shared<const Recipe>(LoadRecipe(v.recipe_path));
+    } catch (const io::ConfigError& e) {
+      throw io::ConfigError(where + e.what());
+    }
+    if (!r->Approved())
+      throw io::ConfigError(where + r->WhyNotApproved() + "; the station does not start with it");
+    for (const LoadedVariant& other : variants_)
+      if (other.recipe->id == r->id)
+        throw io::ConfigError(where + "recipe id '" + r->id + "' is already variant '" +
+                              other.config.name + "''s: one variant per recipe");
+    std::shared_ptr<const analysis::Excitation> designed;
+    try {
+      designed =
+          std::make_shared<const analysis::Excitation>(analysis::DesignMultisine(r->excitation));
+    } catch (const std::exception& e) {
+      throw io::ConfigError(where + "/excitation: cannot be designed: " + e.what());
+    }
+    spdlog::info("variant {}: recipe {} v{} ({}), sha256 {}", v.name, r->id, r->version,
+                 v.recipe_path, r->hash.substr(0, 12));
+    variants_.push_back({v, std::move(r), std::move(designed)});
+  }
+  recipe_ = variants_.front().recipe;
+}
+
+bool Station::PickVariant(const TestRequest& request, std::size_t* index, std::string* by,
+                          std::string* why, VariantRefusal* refusal) const {
+  VariantSelection s;
+  if (variants_.empty()) {  // one recipe: nothing to pick, and no other variant to name
+    const std::string id = recipe()->id;
+    if (!request.variant.name.empty() && request.variant.name != id)
+      s = {VariantRefusal::kUnknown, 0, "",
+           "unknown variant '" + request.variant.name + "': this station runs one recipe (" + id +
+               ") and no variants"};
+    else if (request.variant.plc_code != 0)
+      s = {VariantRefusal::kUnknown, 0, "",
+           "the PLC's variant register holds " + std::to_string(request.variant.plc_code) +
+               ": this station runs one recipe (" + id + ") and no variants; write 0"};
+  } else {
+    s = SelectVariant(config_.variants, request.serial, request.variant);
+  }
+  if (refusal != nullptr) *refusal = s.refusal;
+  if (s.refusal != VariantRefusal::kNone) {
+    *why = s.why;
+    return false;
+  }
+  *index = s.index;
+  *by = s.by;
+  return true;
+}
+
+void Station::UseVariant(std::size_t index, const std::string& by) {
+  if (variants_.empty()) return;
+  std::shared_ptr<const Recipe> r;
+  std::shared_ptr<const analysis::Excitation> designed;
+  {
+    std::lock_guard<std::mutex> lock(queue_mu_);  // ChangeRecipe replaces them under it
+    r = variants_[index].recipe;
+    designed = variants_[index].designed;
+    current_variant_ = index;
+  }
+  sequencer_->SetRecipe(r, *designed);
+  sequencer_->SetVariant(variants_[index].config.name, by);
+  bool changed = false;
+  {
+    std::lock_guard<std::mutex> lock(recipe_mu_);
+    changed = recipe_ != r;
+    recipe_ = r;
+  }
+  if (changed) board_->SetRecipe(r->id, r->hash);
+}
+
+nlohmann::json Station::VariantsJson() const {
+  nlohmann::json list = eol::station::VariantsJson(config_.variants);
+  std::lock_guard<std::mutex> lock(queue_mu_);
+  for (std::size_t i = 0; i < variants_.size(); ++i) {
+    const Recipe& r = *variants_[i].recipe;
+    list[i]["recipe"] = {{"id", r.id},
+                         {"version", r.version},
+                         {"hash", r.hash},
+                         {"path", variants_[i].config.recipe_path}};
+  }
+  return {{"variants", list},
+          {"current", variants_.empty() ? nlohmann::json()
+                                        : nlohmann::json(variants_[current_variant_].config.name)}};
 }
 
 // A fixture or DAQ that does not answer yet is not fatal: the idle look (LookAtDrivers)
@@ -160,7 +257,10 @@ void Station::StartHttp(const std::string& web_root) {
   o.web_root = web_root;
   if (config_.central) o.central_postgres = config_.central->postgres;
   HttpHandlers h;
-  h.start_test = [this](const TestRequest& r, std::string* why) { return Enqueue(r, why); };
+  h.start_test = [this](const TestRequest& r, std::string* why, VariantRefusal* refusal) {
+    return Enqueue(r, why, nullptr, refusal);
+  };
+  h.variants = [this] { return VariantsJson(); };
   h.recipe = [this] {
     const auto r = recipe();
     nlohmann::json j = r->source;
@@ -211,7 +311,23 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   if (running_test_ || !queue_.empty())
     return refused(RecipeChange::Kind::kBusy,
                    "a test is running or waiting; change the recipe between tests");
-  const std::shared_ptr<const Recipe> current = recipe();
+  std::shared_ptr<const Recipe> current = recipe();
+  namespace fs = std::filesystem;
+  fs::path path = config_.recipe_path;
+  std::optional<std::size_t> variant;  // with variants: the one whose recipe is replaced
+  for (std::size_t i = 0; i < variants_.size(); ++i)
+    if (variants_[i].recipe->id == next->id) variant = i;
+  if (variant) {
+    current = variants_[*variant].recipe;
+    path = variants_[*variant].config.recipe_path;
+  } else if (!variants_.empty()) {
+    std::string ids;
+    for (const LoadedVariant& v : variants_)
+      ids += (ids.empty() ? "" : ", ") + v.config.name + ": " + v.recipe->id;
+    return refused(RecipeChange::Kind::kWrongRecipe,
+                   "recipe id '" + next->id + "' is none of this station's variants' (" + ids +
+                       "); a new variant needs a new station config");
+  }
   if (next->id != current->id)
     return refused(RecipeChange::Kind::kWrongRecipe,
                    "recipe id must stay '" + current->id +
@@ -220,8 +336,6 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
     return refused(RecipeChange::Kind::kVersionNotIncreased,
                    "version must increase: the station runs version " +
                        std::to_string(current->version) + ", got " + std::to_string(next->version));
-  namespace fs = std::filesystem;
-  const fs::path path = config_.recipe_path;
   const fs::path kept = path.parent_path() /
                         (path.stem().string() + ".v" + std::to_string(current->version) + ".json");
   try {
@@ -241,7 +355,12 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
   audit.new_hash = next->hash;
   audit.path = path.string();
   store_->AppendAudit(audit);
-  {
+  if (variant) {  // under queue_mu_: the next test of this variant takes it (UseVariant)
+    variants_[*variant].recipe = next;
+    variants_[*variant].designed = std::make_shared<const analysis::Excitation>(designed);
+  }
+  const bool in_use = recipe()->id == next->id;  // with variants: the last unit's recipe
+  if (in_use) {
     std::lock_guard<std::mutex> lock(recipe_mu_);
     recipe_ = next;
   }
@@ -251,8 +370,10 @@ RecipeChange Station::ChangeRecipe(const nlohmann::json& j, const ApiToken& who)
     // Only the recipe's cause: a fixture that never answered keeps its own.
     board_->ClearCause(NotReadyCause::kRecipeInvalid);
   }
-  sequencer_->SetRecipe(next, std::move(designed));
-  board_->SetRecipe(next->id, next->hash);
+  if (in_use) {
+    sequencer_->SetRecipe(next, std::move(designed));
+    board_->SetRecipe(next->id, next->hash);
+  }
   spdlog::warn("recipe {} changed by {} ({}): v{} {} -> v{} {}", next->id, who.name,
                ToString(who.role), current->version, current->hash.substr(0, 12), next->version,
                next->hash.substr(0, 12));
@@ -273,9 +394,14 @@ bool Station::ready() const { return board_->Snapshot().value("ready", false); }
 int Station::http_port() const { return http_ ? http_->port() : 0; }
 
 db::TestRecord Station::RunTest(const std::string& serial) {
+  std::size_t variant = 0;
+  std::string by, why;
+  if (!PickVariant(TestRequest{serial, {}, {}}, &variant, &by, &why, nullptr))
+    throw std::invalid_argument(why);
   db::TestRecord r;
   {
     std::lock_guard<std::mutex> fixture_lock(fixture_use_mu_);
+    UseVariant(variant, by);
     r = sequencer_->RunTest(serial);
   }
   metrics_.OnTest(r);
@@ -359,11 +485,12 @@ LiveMetrics Station::LiveValues() {
 }
 
 bool Station::Enqueue(const std::string& serial, std::string* why) {
-  return Enqueue(TestRequest{serial, {}}, why);
+  return Enqueue(TestRequest{serial, {}, {}}, why);
 }
 
-bool Station::Enqueue(const TestRequest& request, std::string* why,
-                      std::uint64_t* verdicts_before) {
+bool Station::Enqueue(const TestRequest& request, std::string* why, std::uint64_t* verdicts_before,
+                      VariantRefusal* variant_refusal) {
+  if (variant_refusal != nullptr) *variant_refusal = VariantRefusal::kNone;
   std::lock_guard<std::mutex> lock(queue_mu_);
   if (stop_) {
     *why = "station is stopping";
@@ -373,11 +500,16 @@ bool Station::Enqueue(const TestRequest& request, std::string* why,
     *why = recipe_problem_;
     return false;
   }
+  Queued queued{request, 0, ""};
+  if (!PickVariant(request, &queued.variant, &queued.variant_by, why, variant_refusal)) {
+    spdlog::warn("start of serial '{}' refused: {}", request.serial, *why);
+    return false;
+  }
   if (running_test_ || !queue_.empty()) {
     *why = "busy: a test is running or waiting";
     return false;
   }
-  queue_.push_back(request);
+  queue_.push_back(std::move(queued));
   if (verdicts_before != nullptr) *verdicts_before = verdicts_;
   queue_cv_.notify_all();
   return true;
@@ -442,7 +574,7 @@ void Station::HealthLoop(const std::atomic<bool>& serving) {
 
 void Station::ServeQueue() {
   while (true) {
-    TestRequest request;
+    Queued queued;
     {
       std::unique_lock<std::mutex> lock(queue_mu_);
       int idle_s = 0;
@@ -451,16 +583,19 @@ void Station::ServeQueue() {
         if (++idle_s % 60 == 0) sequencer_->PublishLockout();  // a check falls due with time
       }
       if (stop_) return;
-      request = queue_.front();
+      queued = queue_.front();
       queue_.pop_front();
       running_test_ = true;
-      running_serial_ = request.serial;
+      running_serial_ = queued.request.serial;
       test_started_ = std::chrono::steady_clock::now();
-      test_deadline_s_ = TestDeadlineS(*recipe(), config_.safety);
+      test_deadline_s_ = TestDeadlineS(
+          variants_.empty() ? *recipe() : *variants_[queued.variant].recipe, config_.safety);
     }
+    const TestRequest& request = queued.request;
     db::TestRecord r;
     {
       std::lock_guard<std::mutex> fixture_lock(fixture_use_mu_);  // no idle look meanwhile
+      UseVariant(queued.variant, queued.variant_by);
       r = sequencer_->RunTest(request.serial, request.work);
     }
     metrics_.OnTest(r);
@@ -495,9 +630,14 @@ void Station::StartPlc() {
   plc::PlcBackend backend;
   backend.start = [this](const TestRequest& request) {
     plc::PlcStartReply reply;
-    if (Enqueue(request, &reply.message, &reply.verdicts_before)) return reply;
+    VariantRefusal variant = VariantRefusal::kNone;
+    if (Enqueue(request, &reply.message, &reply.verdicts_before, &variant)) return reply;
     std::lock_guard<std::mutex> lock(queue_mu_);
-    reply.refusal = stop_ ? plc::PlcRefusal::kStopping : plc::PlcRefusal::kBusy;
+    reply.refusal = stop_                                  ? plc::PlcRefusal::kStopping
+                    : variant == VariantRefusal::kUnknown  ? plc::PlcRefusal::kUnknownVariant
+                    : variant == VariantRefusal::kNoRule   ? plc::PlcRefusal::kNoVariant
+                    : variant == VariantRefusal::kConflict ? plc::PlcRefusal::kVariantConflict
+                                                           : plc::PlcRefusal::kBusy;
     return reply;
   };
   backend.view = [this] {

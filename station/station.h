@@ -36,6 +36,9 @@ class Station {
   // and connects them. A fixture or DAQ that does not answer yet is not fatal: the station
   // says so (a NotReadyCause) and retries while idle (Serve) and at the next test. A bad recipe,
   // config or database is fatal (throws with the cause).
+  // With "variants" (station/variants.h) every variant's recipe must load and be approved: one
+  // that does not (a proposal) throws io::ConfigError naming the variant and the file, and two
+  // variants of one recipe id are refused; there is no last-good fallback for them.
   // `bench`: a simulated bench shared with a fixture emulator (the demo); normally null.
   explicit Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench = nullptr);
   ~Station();
@@ -50,27 +53,38 @@ class Station {
   // are looked at every health.period_ms when no test runs or waits.
   bool ready() const;
 
-  // Runs one test now, on the calling thread.
+  // Runs one test now, on the calling thread. With variants the serial's rules pick the
+  // recipe; a serial they do not pick one for throws std::invalid_argument with the reason
+  // (nothing moves, nothing is stored).
   db::TestRecord RunTest(const std::string& serial);
 
   // For the daemon: queue a serial (one test at a time; refused while one runs or waits).
   bool Enqueue(const std::string& serial, std::string* why);
   // The same for a whole request; `verdicts_before` (optional) gets the number of tests
-  // ended before this one was accepted (the PLC's done bit waits for the next).
+  // ended before this one was accepted (the PLC's done bit waits for the next). The request's
+  // variant is picked here (station/variants.h SelectVariant; a station of one recipe refuses
+  // a request naming another variant or a PLC code): when it is refused, `variant_refusal`
+  // (optional) says how and `why` names the serial, the choice and the rules.
   bool Enqueue(const TestRequest& request, std::string* why,
-               std::uint64_t* verdicts_before = nullptr);
+               std::uint64_t* verdicts_before = nullptr, VariantRefusal* variant_refusal = nullptr);
   // Runs queued tests until RequestStop(); returns when the test in flight has ended. Feeds
   // systemd's watchdog from a health thread while it runs (see HealthLoop).
   void Serve();
   // Thread-safe: aborts the test in flight and ends Serve().
   void RequestStop(const std::string& why);
 
+  // The recipe in use: with variants, the last unit's (the first variant's before any).
   std::shared_ptr<const Recipe> recipe() const;
+  // GET /api/variants: {"variants": [{"name", "plc_code", "prefixes", "patterns",
+  // "recipe": {"id", "version", "hash", "path"}}], "current": name | null}; "variants" is
+  // empty on a station of one recipe.
+  nlohmann::json VariantsJson() const;
   // PUT /api/recipe: validates a new version of the recipe in use, keeps the old file as
   // <name>.v<old version>.json beside it, replaces the configured file atomically, writes the
   // audit log, and activates it for the next test. Refused while a test runs or waits.
   // Checks run in that order: validation, busy, id, version; then the files, the audit, the
-  // swap. Anything refused before the files leaves everything as it was.
+  // swap. Anything refused before the files leaves everything as it was. With variants the
+  // new recipe's id picks the variant whose recipe it replaces (one of no variant is refused).
   RecipeChange ChangeRecipe(const nlohmann::json& recipe, const ApiToken& who);
   const StationConfig& config() const { return config_; }
   StatusBoard& board() { return *board_; }
@@ -97,6 +111,21 @@ class Station {
   // Non-empty when the configured recipe did not load at start: tests are refused (Enqueue)
   // until ChangeRecipe installs a valid one. Guarded by queue_mu_.
   std::string recipe_problem_;
+  // Variants (station/variants.h): each with its approved recipe and designed excitation;
+  // empty on a station of one recipe. Replaced by ChangeRecipe under queue_mu_ while idle.
+  struct LoadedVariant {
+    VariantConfig config;
+    std::shared_ptr<const Recipe> recipe;
+    std::shared_ptr<const analysis::Excitation> designed;
+  };
+  std::vector<LoadedVariant> variants_;
+  std::size_t current_variant_ = 0;  // of the last unit (under queue_mu_)
+  void LoadVariants();
+  // The variant of `request`; false with the reason when refused.
+  bool PickVariant(const TestRequest& request, std::size_t* index, std::string* by,
+                   std::string* why, VariantRefusal* refusal) const;
+  // Before a test of variant `index` (ServeQueue, RunTest): its recipe into the sequencer.
+  void UseVariant(std::size_t index, const std::string& by);
   std::unique_ptr<db::Store> store_;
   drivers::DriverSet drivers_;
   std::unique_ptr<StatusBoard> board_;
@@ -107,9 +136,14 @@ class Station {
   std::unique_ptr<central::CentralReplicator> central_;
   StationMetrics metrics_;
 
-  std::mutex queue_mu_;
+  mutable std::mutex queue_mu_;
   std::condition_variable queue_cv_;
-  std::deque<TestRequest> queue_;
+  struct Queued {
+    TestRequest request;
+    std::size_t variant = 0;  // with variants: the one picked at Enqueue
+    std::string variant_by;
+  };
+  std::deque<Queued> queue_;
   bool running_test_ = false;
   std::string running_serial_;
   std::chrono::steady_clock::time_point test_started_{};

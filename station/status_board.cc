@@ -7,20 +7,26 @@
 namespace eol::station {
 
 nlohmann::json RecordSummary(const db::TestRecord& r) {
-  return {
-      {"id", r.id},
-      {"serial", r.serial},
-      {"outcome", analysis::ToString(r.outcome)},
-      {"reasons", r.reasons},
-      {"measurements", r.measurements},
-      {"started_at", r.started_at},
-      {"finished_at", r.finished_at},
-      {"kind", r.kind},  // a master part's self-check is no production unit
-      // "retest 2 of 3": which test of its serial (1: the first; 0: not stored) of how many
-      // the recipe allows (0: no limit).
-      {"attempt", r.attempt},
-      {"max_tests", r.max_tests},
-      {"recipe", {{"id", r.recipe_id}, {"version", r.recipe_version}, {"hash", r.recipe_hash}}}};
+  return {{"id", r.id},
+          {"serial", r.serial},
+          {"outcome", analysis::ToString(r.outcome)},
+          {"reasons", r.reasons},
+          {"measurements", r.measurements},
+          {"started_at", r.started_at},
+          {"finished_at", r.finished_at},
+          {"kind", r.kind},  // a master part's self-check is no production unit
+          // "retest 2 of 3": which test of its serial (1: the first; 0: not stored) of how many
+          // the recipe allows (0: no limit).
+          {"attempt", r.attempt},
+          {"max_tests", r.max_tests},
+          // With variants (station/variants.h) the recipe picked for this unit and its variant.
+          {"recipe",
+           {{"id", r.recipe_id},
+            {"version", r.recipe_version},
+            {"hash", r.recipe_hash},
+            {"variant", r.conditions.is_object() && r.conditions.contains("variant")
+                            ? r.conditions["variant"]
+                            : nlohmann::json()}}}};
 }
 
 void VerdictCounts::Add(analysis::Outcome outcome) {

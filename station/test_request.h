@@ -21,12 +21,17 @@
 #include <string>
 
 #include "db/test_record.h"
+#include "station/variants.h"
 
 namespace eol::station {
 
 struct TestRequest {
   std::string serial;
   db::WorkContext work;
+  // The variant the request names (station/variants.h): the operator's choice by name
+  // (POST /api/tests "variant") or the line PLC's variant register. Neither (the scanner's
+  // line names none): the serial's part-number rules pick it.
+  VariantChoice variant;
 };
 
 inline constexpr std::size_t kMaxOperatorIdChars = 32;

@@ -143,7 +143,7 @@ HttpBenchResult RunHttpBench(const HttpBenchOptions& o) {
   options.port = 0;
   options.db_path = db_path;
   HttpHandlers handlers;
-  handlers.start_test = [](const TestRequest&, std::string* why) {
+  handlers.start_test = [](const TestRequest&, std::string* why, VariantRefusal*) {
     *why = "http-bench: tests are not started";
     return false;
   };

@@ -65,6 +65,10 @@ int RunStation(const std::string& config_path, std::string web_root, bool init_s
   std::cout << "eol station: " << station.config().station_id << " " << readiness << ", recipe "
             << station.recipe()->id << " v" << station.recipe()->version << ", http://"
             << station.config().http_listen << ":" << station.http_port() << "/";
+  const nlohmann::json variants = station.VariantsJson()["variants"];  // empty: one recipe
+  for (const auto& v : variants)
+    std::cout << ", variant " << v["name"].get<std::string>() << " = "
+              << v["recipe"]["id"].get<std::string>() << " v" << v["recipe"]["version"].get<int>();
   if (station.config().plc)
     std::cout << ", plc modbus://" << station.config().plc->listen << ":" << station.plc_port();
   std::cout << (simulation.empty() ? "" : ", SIMULATION (" + simulation + ")") << std::endl;

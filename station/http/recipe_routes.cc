@@ -50,6 +50,12 @@ void ApproveRecipe(ApiContext& c, const httplib::Request& req, httplib::Response
   Send(res, RecipeChangeReply(c.handlers.change_recipe(recipe, std::get<ApiToken>(who))));
 }
 
+void GetVariants(ApiContext& c, const httplib::Request&, httplib::Response& res) {
+  Send(res,
+       HttpReply{200, c.handlers.variants ? c.handlers.variants()
+                                          : nlohmann::json{{"variants", nlohmann::json::array()}}});
+}
+
 void GetAudit(ApiContext& c, const httplib::Request&, httplib::Response& res) {
   std::vector<db::RecipeAudit> log;
   {
@@ -107,6 +113,7 @@ void AddRecipeRoutes(httplib::Server& s, ApiContext& c) {
   Route(s, c, "PUT", "/api/recipe", PutRecipe);
   Route(s, c, "GET", "/api/recipe/audit", GetAudit);
   Route(s, c, "POST", "/api/recipe/approve", ApproveRecipe);
+  Route(s, c, "GET", "/api/variants", GetVariants);
 }
 
 }  // namespace eol::station::http

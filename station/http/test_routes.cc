@@ -105,10 +105,23 @@ void PostTest(ApiContext& c, const httplib::Request& req, httplib::Response& res
   const std::string serial = body["serial"].get<std::string>();
   std::string why;
   if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
-  TestRequest request{serial, {}};
+  TestRequest request{serial, {}, {}};
   if (!ReadWorkContext(body, &request.work, &why)) return Send(res, BadRequest("bad_field", why));
-  if (!c.handlers.start_test(request, &why))
-    return Send(res, ApiError{ApiErrorKind::kConflict, "busy", why});
+  if (body.contains("variant") && !body["variant"].is_null()) {
+    if (!body["variant"].is_string() || body["variant"].get<std::string>().empty())
+      return Send(res, BadRequest("bad_field", "variant: must be a non-empty string"));
+    request.variant.name = body["variant"].get<std::string>();
+  }
+  VariantRefusal variant = VariantRefusal::kNone;
+  if (!c.handlers.start_test(request, &why, &variant)) {
+    if (variant == VariantRefusal::kNone)
+      return Send(res, ApiError{ApiErrorKind::kConflict, "busy", why});
+    // Nothing was started: the choice or the serial does not name a variant (400), or the two
+    // name different ones (409: the part in the fixture may not be the one chosen).
+    const ApiErrorKind kind =
+        variant == VariantRefusal::kConflict ? ApiErrorKind::kConflict : ApiErrorKind::kBadRequest;
+    return Send(res, ApiError{kind, ToString(variant), why});
+  }
   Send(res, HttpReply{202, {{"serial", serial}, {"accepted", true}}});
 }
 

@@ -32,11 +32,12 @@ struct SignalSpec {
   int width;  // addresses taken
 };
 
-constexpr std::array<SignalSpec, 13> kSignals = {{
+constexpr std::array<SignalSpec, 14> kSignals = {{
     {"serial", &PlcMap::serial, Table::kHoldingRegister, kSerialRegisters},
     {"operator_id", &PlcMap::operator_id, Table::kHoldingRegister, kOperatorIdRegisters},
     {"shift", &PlcMap::shift, Table::kHoldingRegister, kShiftRegisters},
     {"order_number", &PlcMap::order_number, Table::kHoldingRegister, kOrderNumberRegisters},
+    {"variant", &PlcMap::variant, Table::kHoldingRegister, 1},
     {"start", &PlcMap::start, Table::kCoil, 1},
     {"busy", &PlcMap::busy, Table::kDiscreteInput, 1},
     {"done", &PlcMap::done, Table::kDiscreteInput, 1},
@@ -166,6 +167,12 @@ const char* ToString(PlcRefusal r) {
       return "stopping";
     case PlcRefusal::kBadField:
       return "bad_field";
+    case PlcRefusal::kUnknownVariant:
+      return "unknown_variant";
+    case PlcRefusal::kNoVariant:
+      return "no_variant";
+    case PlcRefusal::kVariantConflict:
+      return "variant_conflict";
   }
   return "?";
 }

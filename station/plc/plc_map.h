@@ -10,6 +10,9 @@
 //   holding register  116-131  operator_id   who tests, the same encoding (at most 32; NUL: none)
 //   holding register  132-139  shift         the shift (at most 16 characters; NUL: none)
 //   holding register  140-155  order_number  production order or batch (at most 32)
+//   holding register  156      variant       the variant's plc_code (station/variants.h) of the
+//                                            unit to start; 0: none, the serial's part-number
+//                                            rules pick it
 //   coil              100      start         the PLC sets it to start a test of `serial`; the
 //                                            station clears it when it has taken the request
 //                                            (accepted or refused, see `refusal`)
@@ -28,10 +31,10 @@
 //                                            0 when it was accepted)
 //
 // The handshake: write `serial` (and operator_id, shift, order_number, which are stored with
-// the record; leave them NUL for none), set `start`; wait until `start` reads 0; `refusal` 0 means
-// accepted (busy follows at once), otherwise nothing was started and the previous result
-// stays readable. Then wait for `done`, read `result`, `reason` and `counter`. A start
-// refused by the sequencer itself (lockout, retest limit, database down) ends with done = 1,
+// the record; leave them NUL for none; and `variant`, 0 for none), set `start`; wait until `start`
+// reads 0; `refusal` 0 means accepted (busy follows at once), otherwise nothing was started and the
+// previous result stays readable. Then wait for `done`, read `result`, `reason` and `counter`. A
+// start refused by the sequencer itself (lockout, retest limit, database down) ends with done = 1,
 // result 3 (ERROR) and its reason, and the counter unchanged: nothing was stored. Tests
 // started over HTTP or from the scanner show in busy, result, reason and counter too.
 //
@@ -65,6 +68,7 @@ struct PlcMap {
   int operator_id = 116;   // .. + kOperatorIdRegisters - 1
   int shift = 132;         // .. + kShiftRegisters - 1
   int order_number = 140;  // .. + kOrderNumberRegisters - 1
+  int variant = 156;       // one holding register
   int start = 100;         // coil
   int busy = 100;          // discrete inputs
   int done = 101;
@@ -118,6 +122,12 @@ enum class PlcRefusal : std::uint16_t {
   kBusy = 2,       // a test is waiting or running
   kStopping = 3,   // the station is shutting down
   kBadField = 4,   // an operator/shift/order block holds invalid text
+  // Variants (station/variants.h): nothing was started, clamped or excited.
+  kUnknownVariant = 5,   // the variant register holds a code no variant has (or the
+                         // station runs one recipe and the register is not 0)
+  kNoVariant = 6,        // the register is 0 and the serial matches no variant's rule
+                         // (or the rules of several)
+  kVariantConflict = 7,  // the register's variant is not the one the serial's rule gives
 };
 const char* ToString(PlcRefusal r);
 

@@ -71,7 +71,8 @@ void PlcServer::Start() {
   const Range holding = Span({{m.serial, kSerialRegisters},
                               {m.operator_id, kOperatorIdRegisters},
                               {m.shift, kShiftRegisters},
-                              {m.order_number, kOrderNumberRegisters}});
+                              {m.order_number, kOrderNumberRegisters},
+                              {m.variant, 1}});
   const Range input_registers =
       Span({{m.result, 1}, {m.counter, 1}, {m.reason, 1}, {m.refusal, 1}});
   mapping_ = modbus_mapping_new_start_address(
@@ -192,6 +193,7 @@ void PlcServer::TakeStart() {
   } else if (!ValidWorkContext(r.work, &why)) {
     reply = {PlcRefusal::kBadField, why, 0};
   } else {
+    r.variant.plc_code = mapping_->tab_registers[m.variant - mapping_->start_registers];
     reply = backend_.start(r);
   }
   refusal_ = reply.refusal;

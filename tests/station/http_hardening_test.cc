@@ -41,7 +41,7 @@ struct Api {
     o.db_path = dir / "s.sqlite";
     o.limits = limits;
     HttpHandlers h;
-    h.start_test = [this](const TestRequest&, std::string*) {
+    h.start_test = [this](const TestRequest&, std::string*, VariantRefusal*) {
       ++started;
       return true;
     };

@@ -44,7 +44,7 @@ struct Api {
     o.limits = limits;
     o.hosts = std::move(hosts);
     HttpHandlers h;
-    h.start_test = [](const TestRequest&, std::string*) { return true; };
+    h.start_test = [](const TestRequest&, std::string*, VariantRefusal*) { return true; };
     api = std::make_unique<HttpApi>(board, o, h);
     api->Start();
   }
