@@ -38,7 +38,7 @@ nlohmann::json Catalogue(std::string_view language) {
 // The {placeholders} a text fills in: a translation must keep every one.
 std::set<std::string> Placeholders(const std::string& text) {
   std::set<std::string> names;
-  static const std::regex kName(R"(\{([a-z_]+)\})");
+  static const std::regex kName(R"(\{([a-z0-9_]+)\})");
   for (std::sregex_iterator it(text.begin(), text.end(), kName), end; it != end; ++it)
     names.insert((*it)[1]);
   return names;
