@@ -520,6 +520,9 @@ TEST(OperatorPage, SpeaksTheStationsLanguageAndEveryLanguageHasEveryWord) {
         EXPECT_EQ(m["label"], words[key]) << lang;
       }
     }
+    EXPECT_EQ(shown["priorities"]["clamped"], "fixture.clamp_left_closed") << lang;
+    EXPECT_EQ(shown["priorities"]["legacy"], "legacy") << lang;
+    EXPECT_EQ(shown["priorities"]["legacy_what"], words["what.legacy"]) << lang;
     // Every code and cause: that language's instruction and words, on screen.
     for (const auto& key : keys) {
       const nlohmann::json& got = shown["instructions"][key.get<std::string>()];

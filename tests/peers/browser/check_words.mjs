@@ -71,6 +71,19 @@ function everyInstruction(keys) {
   return result;
 }
 
+// A door opened during the test with the rotor left clamped: the do-not-touch instruction
+// goes first, whatever came before it; a reason stored as a plain string (before codes) reads
+// as "legacy".
+function priorities() {
+  renderOutcome("ERROR", "WORDS-2", [
+      { code: "interlock", cause: "interlock.lost_during_excitation", text: "interlock lost during excitation: door open" },
+      { code: "interlock", cause: "fixture.clamp_left_closed", text: "clamp left as it is: door open" }]);
+  const clamped = document.getElementById("instruction").dataset.key;
+  renderOutcome("ERROR", "WORDS-3", ["an old reason"]);
+  return { clamped, legacy: document.getElementById("instruction").dataset.key,
+           legacy_what: document.querySelector("#reasons li .what").textContent };
+}
+
 await runCheck(out, async browser => {
   const context = await browser.newContext({ viewport: { width: 1280, height: 800 }, locale: "en-GB" });
   const page = await context.newPage();
@@ -107,6 +120,7 @@ await runCheck(out, async browser => {
     shown.raw_keys = await page.evaluate(rawKeys);
     await page.screenshot({ path: `${artifacts}/words-${lang}-fail-1280x800.png` });
     shown.instructions = await page.evaluate(everyInstruction, KEYS);
+    shown.priorities = await page.evaluate(priorities);
     shown.missing_after = await page.evaluate(() => document.body.dataset.missingWords || "");
     out.languages[lang] = shown;
   }
