@@ -14,7 +14,7 @@ build_pkgs=(
 test_pkgs=(
   python3 python3-numpy python3-scipy python3-pymodbus python3-serial-asyncio python3-can
   can-utils socat sqlite3 mosquitto python3-paho-mqtt postgresql-15 openssl
-  chromium dpkg-dev pulseaudio libasound2-plugins clang-format systemd
+  chromium dpkg-dev pulseaudio libasound2-plugins clang-format systemd fonts-noto-cjk
   clang-14 libclang-rt-14-dev
 )
 
