@@ -17,6 +17,8 @@ install(FILES ${PROJECT_SOURCE_DIR}/station/web/index.html ${PROJECT_SOURCE_DIR}
               ${PROJECT_SOURCE_DIR}/station/web/engineer.js
               ${PROJECT_SOURCE_DIR}/station/web/engineer.css
         DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/web)
+# The operator page's word catalogues, one per language (station/web/README.md).
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/station/web/i18n DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/web)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/deploy/bench/ DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/bench)
 # The config may hold API tokens: readable by root and the service's group only (postinst
 # gives it to group eol).
@@ -33,6 +35,8 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION "science")
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+# The operator page in Japanese needs a CJK font in the browser that shows it.
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "fonts-noto-cjk")
 # The packaged program carries no debug information (build/eol.debug keeps it).
 set(CPACK_STRIP_FILES ON)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA

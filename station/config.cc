@@ -9,6 +9,7 @@
 
 #include "drivers/io/json_config.h"
 #include "station/plant_urls.h"
+#include "station/reason_cause.h"
 #include "station/serial_number.h"
 #include "station/variants.h"
 
@@ -78,6 +79,10 @@ StationConfig ParseStationConfig(const nlohmann::json& j, const std::string& sou
     }
     c.db_path = Resolve(base_dir, root.RequiredString("db"));
     c.init_store = root.Bool("init_store", false);
+    c.language = root.String("language", c.language);
+    root.Require(
+        std::find(kPageLanguages.begin(), kPageLanguages.end(), c.language) != kPageLanguages.end(),
+        "language", "must be one of: en, de, ja (a catalogue in station/web/i18n/)");
     if (auto http = root.OptionalObject("http")) {
       c.http_listen = http->String("listen", c.http_listen);
       c.http_port = http->Integer("port", c.http_port);

@@ -25,6 +25,9 @@
 //                                                    the DAQ while no test runs (station/health.h):
 //                                                    "ready" follows a loss or a return within
 //                                                    one period (plus one failed read)
+//   "language": "en" | "de" | "ja",                the operator page's language (its
+//                                                    catalogue station/web/i18n/<code>.json);
+//                                                    the engineer switches a page with ?lang=
 //   "serial_from_stdin": false,                      a scanner typing serials into stdin
 //                                                    (its line format: station/test_request.h)
 //   "self_check": {"good_master": "MASTER-G", "limit_master": "MASTER-L",
@@ -126,6 +129,7 @@ struct StationConfig {
   SafetyOptions safety;
   HealthOptions health;
   bool serial_from_stdin = false;
+  std::string language = "en";  // the operator page's (kPageLanguages, station/reason_cause.h)
   // Store and publish the verdict while the clamp opens (SequencerOptions, station/sequencer.h).
   bool publish_before_release = false;
   SelfCheckConfig self_check;

@@ -92,7 +92,8 @@ struct HttpOptions {
   // Host header names answered besides `listen`, the address connected to and loopback names
   // (station/http/gate.h); others are refused 421.
   std::vector<std::string> hosts;
-  std::string web_root;  // folder of the operator page; empty: built-in fallback page
+  std::string web_root;         // folder of the operator page; empty: built-in fallback page
+  std::string language = "en";  // the operator page's language (GET /api/status "language")
   // The central record's URI (station/central/): GET /api/units/{serial}?scope=plant reads
   // it; empty: that scope answers 400.
   std::string central_postgres;

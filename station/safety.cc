@@ -6,6 +6,7 @@
 #include <random>
 
 #include "analysis/text.h"
+#include "station/reason_cause.h"
 
 namespace eol::station {
 
@@ -30,18 +31,24 @@ bool HeartbeatMonitor::Update(std::uint32_t beat, Clock::time_point now) {
 
 double HeartbeatMonitor::stale_ms(Clock::time_point now) const { return Ms(now - changed_at_); }
 
-std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& r, bool require_clamp) {
-  if (!in.estop_ok) return "emergency stop chain open";
-  if (!in.door_closed) return "door open";
-  if (!in.part_present) return "no part present";
+InterlockFinding FindInterlockFault(const drivers::FixtureInputs& in, const Recipe& r,
+                                    bool require_clamp) {
+  if (!in.estop_ok) return {cause::kEstopOpen, "emergency stop chain open"};
+  if (!in.door_closed) return {cause::kDoorOpen, "door open"};
+  if (!in.part_present) return {cause::kNoPart, "no part present"};
   if (require_clamp) {
-    if (!in.clamped) return "clamp not confirmed (clamped sensor off)";
+    if (!in.clamped) return {cause::kClampNotConfirmed, "clamp not confirmed (clamped sensor off)"};
     if (in.clamp_pressure_bar < r.clamp_pressure_lo_bar ||
         in.clamp_pressure_bar > r.clamp_pressure_hi_bar)
-      return "clamp pressure " + Fixed(in.clamp_pressure_bar, 2) + " bar outside " +
-             Fixed(r.clamp_pressure_lo_bar, 2) + ".." + Fixed(r.clamp_pressure_hi_bar, 2) + " bar";
+      return {cause::kClampPressure, "clamp pressure " + Fixed(in.clamp_pressure_bar, 2) +
+                                         " bar outside " + Fixed(r.clamp_pressure_lo_bar, 2) +
+                                         ".." + Fixed(r.clamp_pressure_hi_bar, 2) + " bar"};
   }
-  return "";
+  return {};
+}
+
+std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& r, bool require_clamp) {
+  return FindInterlockFault(in, r, require_clamp).text;
 }
 
 double ReactionLimitMs(const SafetyOptions& s) {

@@ -29,6 +29,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <utility>
 
@@ -56,6 +57,15 @@ class HeartbeatMonitor {
 // named with its value ("door open", "clamp pressure 3.10 bar outside 4.50..6.50 bar").
 std::string InterlockFault(const drivers::FixtureInputs& in, const Recipe& recipe,
                            bool require_clamp);
+
+// The same check with the broken interlock's cause key (station/reason_cause.h); both empty
+// when every interlock holds.
+struct InterlockFinding {
+  std::string_view cause;
+  std::string text;
+};
+InterlockFinding FindInterlockFault(const drivers::FixtureInputs& in, const Recipe& recipe,
+                                    bool require_clamp);
 
 // The longest gap between two successful interlock reads the watchdog accepts during
 // excitation: safety.watchdog_reaction_ms, or when that is 0, 4 x watchdog_period_ms and

@@ -16,6 +16,7 @@
 #include "drivers/daq/calibration_file.h"
 #include "station/cycle_time.h"
 #include "station/judge.h"
+#include "station/reason_cause.h"
 #include "station/self_check.h"
 #include "station/version.h"
 
@@ -149,7 +150,8 @@ drivers::FixtureInputs Sequencer::ReadInputs(const char* purpose) {
   auto in = fixture_.ReadInputs();
   if (!in.ok())
     throw Fault{Outcome::kError,
-                {ReasonCode::kFixture, std::string(purpose) + ": " + in.status().message()}};
+                {ReasonCode::kFixture, std::string(purpose) + ": " + in.status().message(),
+                 std::string(cause::kFixtureUnreachable)}};
   return in.value();
 }
 
@@ -160,7 +162,9 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
       fixture_.lifecycle() != drivers::Lifecycle::kActive) {
     if (const drivers::Status s = fixture_.Connect(); !s.ok()) {
       board_.SetCause(NotReadyCause::kFixtureUnreachable, "fixture unavailable: " + s.message());
-      throw Fault{Outcome::kError, {ReasonCode::kFixture, "fixture unavailable: " + s.message()}};
+      throw Fault{Outcome::kError,
+                  {ReasonCode::kFixture, "fixture unavailable: " + s.message(),
+                   std::string(cause::kFixtureUnreachable)}};
     }
   }
   if (daq_.lifecycle() != drivers::Lifecycle::kInactive) {
@@ -168,7 +172,8 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
       board_.SetCause(NotReadyCause::kAcquisitionUnavailable,
                       "acquisition unavailable: " + s.message());
       throw Fault{Outcome::kError,
-                  {ReasonCode::kAcquisition, "acquisition unavailable: " + s.message()}};
+                  {ReasonCode::kAcquisition, "acquisition unavailable: " + s.message(),
+                   std::string(cause::kAcquisitionUnavailable)}};
     }
   }
   // The controller latches interlock drops until read (safety.h): the first read clears
@@ -183,37 +188,44 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
     board_.ClearCause(c);
   if (!heartbeat_.Update(in.heartbeat, Clock::now()))
     throw Fault{Outcome::kError,
-                {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, Clock::now())}};
-  if (const std::string why = InterlockFault(in, *recipe_, false); !why.empty())
-    throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock: " + why}};
+                {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, Clock::now()),
+                 std::string(cause::kHeartbeatFrozen)}};
+  if (const InterlockFinding f = FindInterlockFault(in, *recipe_, false); !f.text.empty())
+    throw Fault{Outcome::kError,
+                {ReasonCode::kInterlock, "interlock: " + f.text, std::string(f.cause)}};
 }
 
 void Sequencer::ClampAndConfirm(db::TestRecord& record) {
   Enter(record, SeqState::kClamp,
         "phase pair " + std::to_string(static_cast<int>(recipe_->phase_pair)));
   if (const drivers::Status s = fixture_.Activate(); !s.ok())
-    throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
+    throw Fault{Outcome::kError,
+                {ReasonCode::kFixture, s.message(), std::string(cause::kFixtureCommand)}};
   if (const drivers::Status s = fixture_.SelectPhasePair(recipe_->phase_pair); !s.ok())
-    throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
+    throw Fault{Outcome::kError,
+                {ReasonCode::kFixture, s.message(), std::string(cause::kFixtureCommand)}};
   selected_pair_ = recipe_->phase_pair;
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, true); !s.ok())
-    throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
+    throw Fault{Outcome::kError,
+                {ReasonCode::kFixture, s.message(), std::string(cause::kFixtureCommand)}};
 
   Enter(record, SeqState::kConfirmClamp);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(recipe_->clamp_timeout_s));
   const auto poll = std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms);
-  std::string why;
+  InterlockFinding why;
   drivers::FixtureInputs in;
   while (true) {
     ThrowIfAborted();
     in = ReadInputs("confirm clamp");
-    why = InterlockFault(in, *recipe_, true);
-    if (why.empty()) break;
+    why = FindInterlockFault(in, *recipe_, true);
+    if (why.text.empty()) break;
     if (Clock::now() > deadline)
-      throw Fault{Outcome::kError,
-                  {ReasonCode::kInterlock, "clamp not confirmed within " +
-                                               Fixed(recipe_->clamp_timeout_s, 1) + " s: " + why}};
+      throw Fault{
+          Outcome::kError,
+          {ReasonCode::kInterlock,
+           "clamp not confirmed within " + Fixed(recipe_->clamp_timeout_s, 1) + " s: " + why.text,
+           std::string(why.cause)}};
     std::this_thread::sleep_for(poll);
   }
   record.conditions["clamp_pressure_bar"] = in.clamp_pressure_bar;
@@ -225,8 +237,10 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size
   // (Still in the clamp's state: the excite state, and the cycle's excitation step, begin
   // when the stator is about to be excited.)
   const drivers::FixtureInputs in = ReadInputs("interlocks before excitation");
-  if (const std::string why = InterlockFault(in, *recipe_, true); !why.empty())
-    throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock before excitation: " + why}};
+  if (const InterlockFinding f = FindInterlockFault(in, *recipe_, true); !f.text.empty())
+    throw Fault{
+        Outcome::kError,
+        {ReasonCode::kInterlock, "interlock before excitation: " + f.text, std::string(f.cause)}};
   ThrowIfAborted();
   Enter(record, SeqState::kExcite,
         std::to_string(periods) + " periods of " + Fixed(1.0 / excitation_.line_spacing_hz, 3) +
@@ -251,7 +265,8 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size
     if (s.ok()) s = fixture_.Write(FixtureOutput::kExcitationEnable, true);
     if (!s.ok()) {
       (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
-      throw Fault{Outcome::kError, {ReasonCode::kFixture, s.message()}};
+      throw Fault{Outcome::kError,
+                  {ReasonCode::kFixture, s.message(), std::string(cause::kFixtureCommand)}};
     }
     result.emplace(daq_.Acquire(req, abort_));
     const auto excitation_off = Clock::now();
@@ -262,23 +277,30 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size
   }
   record.calibration = drivers::CalibrationToJson(daq_.calibration());
   record.calibration["daq"] = daq_.name();
-  if (watchdog_fault) throw Fault{Outcome::kError, {ReasonCode::kInterlock, *watchdog_fault}};
+  if (watchdog_fault)
+    throw Fault{
+        Outcome::kError,
+        {ReasonCode::kInterlock, *watchdog_fault, std::string(cause::kLostDuringExcitation)}};
   ThrowIfAborted();
   // The interlocks must still hold now that the relay is open: one that broke between the
   // watchdog's last read and the end of the record makes the recording worthless. The
   // heartbeat is confirmed alive by a fresh beat before the verdict (Unclamp).
   Enter(record, SeqState::kCheckInterlocks, "after excitation");
   const drivers::FixtureInputs after = ReadInputs("interlocks after excitation");
-  if (const std::string why = InterlockFault(after, *recipe_, true); !why.empty())
-    throw Fault{Outcome::kError, {ReasonCode::kInterlock, "interlock after excitation: " + why}};
+  if (const InterlockFinding f = FindInterlockFault(after, *recipe_, true); !f.text.empty())
+    throw Fault{
+        Outcome::kError,
+        {ReasonCode::kInterlock, "interlock after excitation: " + f.text, std::string(f.cause)}};
   if (!heartbeat_.Update(after.heartbeat, Clock::now()))
     throw Fault{Outcome::kError,
                 {ReasonCode::kInterlock,
-                 FrozenHeartbeat(heartbeat_, Clock::now()) + " at the end of excitation"}};
+                 FrozenHeartbeat(heartbeat_, Clock::now()) + " at the end of excitation",
+                 std::string(cause::kHeartbeatFrozen)}};
   beat_after_excitation_ = after.heartbeat;
   if (!result->ok())
     throw Fault{Outcome::kError,
-                {ReasonCode::kAcquisition, "acquisition failed: " + result->status().message()}};
+                {ReasonCode::kAcquisition, "acquisition failed: " + result->status().message(),
+                 std::string(cause::kAcquisitionFailed)}};
   return std::move(result->value());
 }
 
@@ -289,7 +311,8 @@ void Sequencer::SelectPair(db::TestRecord& record, drivers::PhasePair pair) {
   if (const drivers::Status s = fixture_.SelectPhasePair(pair); !s.ok())
     throw Fault{
         Outcome::kError,
-        {ReasonCode::kFixture, "phase pair " + std::string(PairName(pair)) + ": " + s.message()}};
+        {ReasonCode::kFixture, "phase pair " + std::string(PairName(pair)) + ": " + s.message(),
+         std::string(cause::kFixtureCommand)}};
   selected_pair_ = pair;
 }
 
@@ -431,7 +454,9 @@ void Sequencer::Judge(db::TestRecord& record, const std::vector<MeasuredPair>& m
 void Sequencer::Unclamp(db::TestRecord& record, bool until_released) {
   Enter(record, SeqState::kUnclamp, until_released ? "" : "verdict before the clamp is open");
   if (const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false); !s.ok())
-    throw Fault{Outcome::kError, {ReasonCode::kFixture, "unclamp: " + s.message()}};
+    throw Fault{
+        Outcome::kError,
+        {ReasonCode::kFixture, "unclamp: " + s.message(), std::string(cause::kClampNotReleased)}};
   release_commanded_at_ = Clock::now();
   const auto deadline = ReleaseDeadline();
   // Before the verdict is published the controller must prove it was alive at the end of
@@ -446,14 +471,16 @@ void Sequencer::Unclamp(db::TestRecord& record, bool until_released) {
     fresh_beat = fresh_beat || in.heartbeat != *beat_after_excitation_;
     if (!fresh_beat && !heartbeat_.Update(in.heartbeat, now))
       throw Fault{Outcome::kError,
-                  {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, now) +
-                                               " after excitation: its inputs during the "
-                                               "test cannot be trusted"}};
+                  {ReasonCode::kInterlock,
+                   FrozenHeartbeat(heartbeat_, now) + " after excitation: its inputs during the "
+                                                      "test cannot be trusted",
+                   std::string(cause::kHeartbeatFrozen)}};
     if (released && fresh_beat) break;
     if (!released && now > deadline)
       throw Fault{Outcome::kError,
                   {ReasonCode::kFixture,
-                   "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s"}};
+                   "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s",
+                   std::string(cause::kClampNotReleased)}};
     std::this_thread::sleep_for(
         std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
   }
@@ -506,7 +533,8 @@ bool Sequencer::RefusedForReleaseFault(db::TestRecord& record) {
     return false;
   }
   // Refused before anything moves; not a test of the motor, so nothing is stored.
-  record.reasons = {{ReasonCode::kFixture, "station stopped: " + release_fault_}};
+  record.reasons = {{ReasonCode::kFixture, "station stopped: " + release_fault_,
+                     std::string(cause::kClampNotReleased)}};
   board_.SetCause(NotReadyCause::kClampNotReleased, release_fault_);
   PublishRefusal(record);
   return true;
@@ -534,10 +562,11 @@ void Sequencer::SafeState(db::TestRecord& record) {
     std::this_thread::sleep_for(pause);
   }
   if (!off.ok())
-    record.reasons.push_back(
-        {ReasonCode::kFixture, "excitation off not confirmed after " + std::to_string(attempts) +
-                                   " attempts: " + off.message() +
-                                   " (the relay is wired to drop on controller loss)"});
+    record.reasons.push_back({ReasonCode::kFixture,
+                              "excitation off not confirmed after " + std::to_string(attempts) +
+                                  " attempts: " + off.message() +
+                                  " (the relay is wired to drop on controller loss)",
+                              std::string(cause::kExcitationOffUnconfirmed)});
   // 2. Unclamp only when it is safe: the controller answers, nobody is at the door, the
   //    emergency-stop chain is healthy. Otherwise leave the part clamped and say so.
   std::string unsafe;
@@ -565,11 +594,19 @@ void Sequencer::SafeState(db::TestRecord& record) {
         continue;
       }
       if (!s.ok())
-        record.reasons.push_back({ReasonCode::kFixture, "unclamp not confirmed: " + s.message()});
+        record.reasons.push_back({ReasonCode::kFixture, "unclamp not confirmed: " + s.message(),
+                                  std::string(cause::kClampLeftClosed)});
     }
     break;
   }
-  if (!unsafe.empty()) record.reasons.push_back({code, "clamp left as it is: " + unsafe});
+  // Before the clamp state (refused at check_interlocks) the clamp was never commanded closed:
+  // the rotor is not clamped and the reason says only why nothing was commanded.
+  const bool clamp_commanded =
+      std::any_of(record.trace.begin(), record.trace.end(),
+                  [](const db::StateEntry& e) { return e.state == ToString(SeqState::kClamp); });
+  if (!unsafe.empty())
+    record.reasons.push_back({code, "clamp left as it is: " + unsafe,
+                              clamp_commanded ? std::string(cause::kClampLeftClosed) : ""});
   (void)fixture_.Deactivate();
 }
 

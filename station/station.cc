@@ -255,6 +255,7 @@ void Station::StartHttp(const std::string& web_root) {
   o.tokens = config_.tokens;
   o.hosts = config_.http_hosts;
   o.web_root = web_root;
+  o.language = config_.language;
   if (config_.central) o.central_postgres = config_.central->postgres;
   HttpHandlers h;
   h.start_test = [this](const TestRequest& r, std::string* why, VariantRefusal* refusal) {

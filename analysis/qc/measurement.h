@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace eol::analysis {
@@ -50,12 +51,27 @@ enum class ReasonCode {
   kClipped,      // "clipped": the recording's voltage or current reached the converter's range
                  //   (analysis/signal/clipping.h); nothing was fitted (ERROR)
 };
+inline constexpr std::array kAllReasonCodes = {
+    ReasonCode::kLimit,     ReasonCode::kMask,        ReasonCode::kCondition,
+    ReasonCode::kInterlock, ReasonCode::kFixture,     ReasonCode::kAcquisition,
+    ReasonCode::kAnalysis,  ReasonCode::kAborted,     ReasonCode::kStore,
+    ReasonCode::kLockout,   ReasonCode::kRetestLimit, ReasonCode::kSelfCheck,
+    ReasonCode::kInternal,  ReasonCode::kLegacy,      ReasonCode::kClipped};
 const char* ToString(ReasonCode c);
 std::optional<ReasonCode> ParseReasonCode(const std::string& s);
 
+// `cause`: a finer stable key under the code where one code covers several causes an operator
+// acts on differently ("interlock.door_open", "fixture.clamp_not_released"; the station's keys
+// are station/reason_cause.h). Empty when the code says it all, and on every record stored
+// before causes existed (never guessed from the text). The operator page's catalogue
+// (station/web/i18n/) has the operator's words for every code and every cause.
 struct Reason {
+  Reason() = default;
+  Reason(ReasonCode c, std::string t, std::string k = {})
+      : code(c), text(std::move(t)), cause(std::move(k)) {}
   ReasonCode code = ReasonCode::kInternal;
   std::string text;
+  std::string cause;
   bool operator==(const Reason&) const = default;
 };
 

@@ -57,6 +57,7 @@ void from_json(const nlohmann::json& j, Measurement& m) {
 
 void to_json(nlohmann::json& j, const Reason& r) {
   j = {{"code", ToString(r.code)}, {"text", r.text}};
+  if (!r.cause.empty()) j["cause"] = r.cause;
 }
 
 void from_json(const nlohmann::json& j, Reason& r) {
@@ -68,7 +69,7 @@ void from_json(const nlohmann::json& j, Reason& r) {
   const auto parsed = ParseReasonCode(code);
   if (!parsed)
     throw nlohmann::json::other_error::create(501, "reasons: unknown code '" + code + "'", &j);
-  r = {*parsed, j.at("text").get<std::string>()};
+  r = {*parsed, j.at("text").get<std::string>(), j.value("cause", std::string())};
 }
 
 void to_json(nlohmann::json& j, const Verdict& v) {

@@ -27,8 +27,10 @@ void to_json(nlohmann::json& j, const Limit& l);
 void from_json(const nlohmann::json& j, Limit& l);
 void to_json(nlohmann::json& j, const Measurement& m);
 void from_json(const nlohmann::json& j, Measurement& m);
-// {"code": "limit", "text": "..."}; a plain string (records written before reasons had codes)
-// reads as code kLegacy; an unknown code is refused naming it.
+// {"code": "limit", "text": "..."} or {"code": "interlock", "text": "...", "cause":
+// "interlock.door_open"} ("cause" only when set; a record without it reads with none); a plain
+// string (records written before reasons had codes) reads as code kLegacy; an unknown code is
+// refused naming it.
 void to_json(nlohmann::json& j, const Reason& r);
 void from_json(const nlohmann::json& j, Reason& r);
 void to_json(nlohmann::json& j, const Verdict& v);

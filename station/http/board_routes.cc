@@ -12,7 +12,9 @@ namespace eol::station::http {
 namespace {
 
 void GetStatus(ApiContext& c, const httplib::Request&, httplib::Response& res) {
-  Send(res, HttpReply{200, c.board.Snapshot()});
+  nlohmann::json status = c.board.Snapshot();
+  status["language"] = c.options.language;  // the operator page's (station config "language")
+  Send(res, HttpReply{200, std::move(status)});
 }
 
 void GetEvents(ApiContext& c, const httplib::Request&, httplib::Response& res) {

@@ -10,26 +10,65 @@ const FINAL = ["PASS", "FAIL", "ERROR", "ABORTED"];
 let recipe = null;
 let shownTestId = null;
 
-// The measurements in the operator's words and units (analysis/qc/measurement_names.h).
-// scale converts the recorded unit into the one shown; digits are significant digits.
+// --- Words: every text the page shows comes from the catalogue of its language
+// (station/web/i18n/<lang>.json, README there): the station's ("language" in /api/status, from
+// the station config), or the engineer's choice in the address (?lang=de). English is loaded
+// too: a key missing from the chosen catalogue shows in English and is named in
+// body[data-missing-words] (the browser tests fail on it); a raw key is never shown.
+const LANGUAGES = ["en", "de", "ja"];
+let WORDS = {}, ENGLISH = {};
+const missingWords = new Set();
+
+function t(key, vars) {
+  let text = WORDS[key];
+  if (typeof text !== "string") {
+    missingWords.add(key);
+    document.body.dataset.missingWords = [...missingWords].join(" ");
+    text = typeof ENGLISH[key] === "string" ? ENGLISH[key] : key;
+  }
+  return text.replace(/\{([a-z0-9_]+)\}/g, (m, name) => (vars && name in vars ? String(vars[name]) : m));
+}
+
+async function loadWords() {
+  const asked = new URLSearchParams(location.search).get("lang");
+  let lang = LANGUAGES.includes(asked) ? asked : null;
+  if (!lang) lang = await getJson("/api/status").then(s => s.language, () => "en");
+  if (!LANGUAGES.includes(lang)) lang = "en";
+  ENGLISH = await getJson("/static/i18n/en.json").catch(() => ({}));
+  WORDS = lang === "en" ? ENGLISH : await getJson(`/static/i18n/${lang}.json`).catch(() => ({}));
+  document.documentElement.lang = lang;
+  document.body.dataset.lang = lang;
+  document.title = t("ui.title");
+  for (const e of document.querySelectorAll("[data-i18n]")) e.textContent = t(e.dataset.i18n);
+  for (const e of document.querySelectorAll("[data-i18n-aria]")) e.setAttribute("aria-label", t(e.dataset.i18nAria));
+  for (const e of document.querySelectorAll("[data-i18n-placeholder]")) e.placeholder = t(e.dataset.i18nPlaceholder);
+}
+
+// The measurements' units and digits (analysis/qc/measurement_names.h); their names are the
+// catalogue's "measurement.<name>". scale converts the recorded unit into the one shown; digits
+// are significant digits.
 const MEASUREMENTS = {
-  resonance_f_hz: {label: "Resonance", unit: "Hz", digits: 4, fixed: true},
-  resonance_q: {label: "Quality factor Q", unit: "", digits: 3, fixed: true},
-  winding_r_ohm: {label: "Winding resistance", unit: "Ω", digits: 3, fixed: true},
-  winding_l_h: {label: "Winding inductance", unit: "mH", scale: 1e3, digits: 3, fixed: true},
-  motional_rp_ohm: {label: "Resonance peak height", unit: "Ω", digits: 3, fixed: true},
-  fit_chi2_per_dof: {label: "Curve fit χ²/dof", unit: "", digits: 2, fixed: true},
+  resonance_f_hz: {unit: "Hz", digits: 4, fixed: true},
+  resonance_q: {unit: "", digits: 3, fixed: true},
+  winding_r_ohm: {unit: "Ω", digits: 3, fixed: true},
+  winding_l_h: {unit: "mH", scale: 1e3, digits: 3, fixed: true},
+  motional_rp_ohm: {unit: "Ω", digits: 3, fixed: true},
+  fit_chi2_per_dof: {unit: "", digits: 2, fixed: true},
+  motional_residue_ohm_per_s: {unit: "Ω/s", digits: 4, fixed: true},
+  bond_index_pct: {unit: "%", digits: 3},
+  second_mode_chi2_drop: {unit: "", digits: 3},
+  resonance_f_ref_pressure_hz: {unit: "Hz", digits: 4, fixed: true},
 };
 
 // How a recorded measurement is shown: {label, unit, scale, digits, fixed}. Names of further phase
 // pairs end in "@V-W"; a mask's count is "mask_<name>_lines_outside".
 function describe(m) {
   const [base, pair] = m.name.split("@");
-  let d = MEASUREMENTS[base];
+  let d = MEASUREMENTS[base] && {...MEASUREMENTS[base], label: t("measurement." + base)};
   const mask = /^mask_(.+)_lines_outside$/.exec(base);
-  if (!d && mask) d = {label: `Curve mask ${mask[1].replaceAll("_", " ")}: lines outside`, unit: "", digits: 6};
+  if (!d && mask) d = {label: t("measurement.mask", {name: mask[1].replaceAll("_", " ")}), unit: "", digits: 6};
   if (!d) d = {label: base, unit: m.unit === "1" ? "" : m.unit, digits: 5};
-  return {scale: 1, ...d, label: d.label + (pair ? ` (phase pair ${pair})` : "")};
+  return {scale: 1, ...d, label: d.label + (pair ? " " + t("ui.phase_pair", {pair}) : "")};
 }
 
 function $(id) { return document.getElementById(id); }
@@ -76,21 +115,42 @@ function renderStates(current) {
   const idx = STATES.indexOf(current);
   STATES.forEach((s, i) => {
     const cls = s === current ? "current" : (idx >= 0 && i < idx ? "done" : "");
-    ol.appendChild(el("li", {class: cls, "data-state": s}, s.replace("_", " ")));
+    ol.appendChild(el("li", {class: cls, "data-state": s}, t("state." + s)));
   });
-  if (current === "safe_state") ol.appendChild(el("li", {class: "current"}, "safe state"));
+  if (current === "safe_state") ol.appendChild(el("li", {class: "current"}, t("state.safe_state")));
 }
 
-// A reason is {code, text} (analysis/qc/measurement.h); the operator reads the text.
-function reasonText(r) {
-  return typeof r === "string" ? r : (r && r.text) || "";
+// A reason is {code, text, cause?} (analysis/qc/measurement.h); a plain string is one stored
+// before reasons had codes. Its operator words are the catalogue's "what.<key>" and "do.<key>",
+// the key being its cause (station/reason_cause.h) where it has one, else its code.
+function asReason(r) {
+  return typeof r === "string" ? {code: "legacy", text: r} : {code: "legacy", text: "", ...r};
+}
+function reasonKey(r) {
+  return r.cause && typeof ENGLISH["do." + r.cause] === "string" ? r.cause : r.code;
 }
 
-// The recipe's instruction for FAIL, ERROR and ABORTED (GET /api/recipe writes the defaults
-// out); none for PASS.
-function instructionFor(outcome) {
-  const i = recipe && recipe.instructions;
-  return (i && FINAL.includes(outcome) && outcome !== "PASS" && i[outcome.toLowerCase()]) || "";
+// Causes that leave the rotor clamped or live: their instruction goes first, whatever came before.
+const DO_NOT_TOUCH = ["fixture.clamp_left_closed", "fixture.excitation_off_unconfirmed",
+                      "fixture.clamp_not_released"];
+
+// The recipe's defaults (station/recipe.h OperatorInstructions): the page shows the catalogue's
+// instruction per cause instead, and the recipe's own only where the plant changed it.
+const RECIPE_DEFAULTS = {fail: "Put the rotor in the red reject bin",
+                         error: "Test the rotor again; if ERROR repeats, call maintenance",
+                         aborted: "Test the rotor again"};
+
+// What the operator does after FAIL, ERROR or ABORTED: the catalogue's instruction for the
+// reason that matters most, and the recipe's instruction for the outcome where the plant wrote
+// its own (e.g. which bin); none for PASS.
+function instructionFor(outcome, reasons) {
+  if (!FINAL.includes(outcome) || outcome === "PASS") return {text: "", note: ""};
+  const all = (reasons || []).map(asReason);
+  const first = all.find(r => DO_NOT_TOUCH.includes(r.cause)) || all[0];
+  const text = first ? t("do." + reasonKey(first)) : t("do." + (outcome === "FAIL" ? "limit" : outcome === "ABORTED" ? "aborted" : "internal"));
+  const own = recipe && recipe.instructions && recipe.instructions[outcome.toLowerCase()];
+  const note = own && own !== RECIPE_DEFAULTS[outcome.toLowerCase()] ? t("ui.plant_note", {text: own}) : "";
+  return {text, note, cause: first ? reasonKey(first) : ""};
 }
 
 // outcome: PASS, FAIL, ERROR, ABORTED, RUNNING (shown as TESTING) or none. A master part's
@@ -98,70 +158,76 @@ function instructionFor(outcome) {
 function renderOutcome(outcome, serial, reasons, kind) {
   const v = $("verdict");
   v.className = "verdict " + (outcome || "none");
-  v.textContent = outcome === "RUNNING" ? "TESTING" : (outcome || "—");
+  v.textContent = outcome ? t("outcome." + outcome) : "—";
   $("serial").textContent = serial || "";
   const master = kind === "self_check";
-  const instruction = master ? "Master part (self-check): keep it with the master parts" : instructionFor(outcome);
+  const instruction = master ? {text: t("ui.master_instruction"), note: ""} : instructionFor(outcome, reasons);
   const box = $("instruction");
-  box.hidden = !instruction;
+  box.hidden = !instruction.text;
   box.className = master ? "MASTER" : outcome || "";
-  box.textContent = instruction;
+  box.dataset.key = master ? "" : instruction.cause || "";
+  box.replaceChildren(instruction.text);
+  if (instruction.note) box.append(el("span", {class: "note"}, instruction.note));
   const ul = $("reasons");
   ul.replaceChildren();
-  for (const r of reasons || [])
-    ul.appendChild(el("li", {"data-code": (r && r.code) || ""}, reasonText(r)));
+  for (const r of (reasons || []).map(asReason)) {
+    const li = el("li", {"data-code": r.code, "data-cause": r.cause || ""});
+    li.append(el("span", {class: "what"}, t("what." + reasonKey(r))), " ", el("span", {class: "why"}, r.text));
+    ul.appendChild(li);
+  }
   if (outcome === "RUNNING") $("tested").textContent = "";
 }
 
 function renderTested(record) {
   const who = [];
-  if (record.operator_id) who.push("operator " + record.operator_id);
-  if (record.shift) who.push("shift " + record.shift);
-  if (record.order_number) who.push("order " + record.order_number);
+  if (record.operator_id) who.push(t("ui.tested_operator", {id: record.operator_id}));
+  if (record.shift) who.push(t("ui.tested_shift", {shift: record.shift}));
+  if (record.order_number) who.push(t("ui.tested_order", {order: record.order_number}));
   const when = localTime(record.finished_at, DATE_TIME);
-  $("tested").textContent = (when ? "Finished " + when : "") + (who.length ? " · " + who.join(" · ") : "");
+  $("tested").textContent = (when ? t("ui.finished", {when}) : "") + (who.length ? " · " + who.join(" · ") : "");
 }
 
 function renderHistory(status) {
-  const t = $("history");
-  t.replaceChildren(el("tr", {}, ""));
-  t.firstChild.append(el("th", {scope: "col"}, "serial"), el("th", {scope: "col"}, "outcome"),
-                      el("th", {scope: "col"}, "resonance (Hz)"), el("th", {scope: "col"}, "finished"));
+  const table = $("history");
+  table.replaceChildren(el("tr", {}, ""));
+  table.firstChild.append(...["serial", "outcome", "resonance", "finished"].map(c => el("th", {scope: "col"}, t("ui.col_" + c))));
   for (const r of status.recent || []) {
     const f0 = (r.measurements || []).find(m => m.name === "resonance_f_hz");
     const row = el("tr");
-    row.append(el("td", {}, r.serial), el("td", {class: r.outcome}, r.outcome),
+    row.append(el("td", {}, r.serial), el("td", {class: r.outcome, "data-outcome": r.outcome}, t("outcome." + r.outcome)),
                el("td", {}, num(f0 && f0.value, 4, true)),
                el("td", {"data-utc": r.finished_at || r.started_at || ""},
                   localTime(r.finished_at || r.started_at)));
-    t.appendChild(row);
+    table.appendChild(row);
   }
   const c = status.counts || {};
-  $("counts").textContent = (c.day ? "Today: " : "") + `PASS ${c.pass || 0} · FAIL ${c.fail || 0} · ERROR ${c.error || 0}` +
-      ` · ABORTED ${c.aborted || 0}`;
+  $("counts").textContent = (c.day ? t("ui.counts_today") + " " : "") +
+      FINAL.map(o => `${t("outcome." + o)} ${c[o.toLowerCase()] || 0}`).join(" · ");
 }
 
+// The failing measurements first (they must be visible at 1280x800 without scrolling), then
+// the others in the record's order.
 function renderMeasurements(measurements) {
-  const t = $("measurements");
-  t.replaceChildren();
+  const table = $("measurements");
+  table.replaceChildren();
   const head = el("tr");
-  head.append(el("th", {scope: "col"}, "measurement"), el("th", {scope: "col"}, "value"),
-              el("th", {scope: "col"}, "limits"), el("th", {scope: "col"}, "result"));
-  t.appendChild(head);
-  for (const m of measurements || []) {
+  head.append(...["measurement", "value", "limits", "result"].map(c => el("th", {scope: "col"}, t("ui.col_" + c))));
+  table.appendChild(head);
+  const all = measurements || [];
+  for (const m of [...all.filter(x => x.outcome === "FAIL"), ...all.filter(x => x.outcome !== "FAIL")]) {
     const d = describe(m);
     const scaled = v => (v === null || v === undefined) ? null : v * d.scale;
     const lo = m.limit.lo ?? null, hi = m.limit.hi ?? null;
     const limits = lo !== null && hi !== null ? `${num(scaled(lo), 6)} … ${num(scaled(hi), 6)}`
-        : lo !== null ? "≥ " + num(scaled(lo), 6) : hi !== null ? "≤ " + num(scaled(hi), 6) : "none";
-    const result = m.outcome === "PASS" || m.outcome === "FAIL" ? m.outcome : "not judged";
+        : lo !== null ? "≥ " + num(scaled(lo), 6) : hi !== null ? "≤ " + num(scaled(hi), 6) : t("ui.limits_none");
+    const result = m.outcome === "PASS" || m.outcome === "FAIL" ? t("outcome." + m.outcome) : t("ui.not_judged");
     const row = el("tr", {"data-name": m.name});
     row.append(el("td", {title: m.name + (m.doc ? ": " + m.doc : "")}, d.label),
                el("td", {class: "value"}, withUnit(num(scaled(m.value), d.digits, d.fixed), d.unit)),
                el("td", {}, withUnit(limits, d.unit)),
                el("td", {class: m.outcome === "PASS" || m.outcome === "FAIL" ? m.outcome : "UNSET"},
-                  result + (m.marginal ? " (marginal)" : "")));
-    t.appendChild(row);
+                  result + (m.marginal ? " " + t("ui.marginal") : "")));
+    table.appendChild(row);
   }
 }
 
@@ -187,7 +253,7 @@ function clearPlot(note) {
   for (const id of PLOTS) {
     $(id).replaceChildren();
     $(id).removeAttribute("data-serial");
-    $(id).setAttribute("aria-label", "no curve" + (note ? ": " + note : ""));
+    $(id).setAttribute("aria-label", t("ui.no_curve") + (note ? ": " + note : ""));
   }
   $("plot-abs").toggleAttribute("hidden", true);  // an SVG element has no .hidden property
   $("curve-note").textContent = note ? "(" + note + ")" : "";
@@ -202,7 +268,7 @@ const PAIR_NAMES = ["U-V", "V-W", "W-U"];
 // measurements ("resonance_f_hz@V-W").
 function measuredPairs(record) {
   const curves = record.curves || [];
-  const first = PAIR_NAMES[(record.conditions || {}).phase_pair] || "first pair";
+  const first = PAIR_NAMES[(record.conditions || {}).phase_pair] || t("ui.first_pair");
   const pairs = [];
   for (const c of curves) {
     const m = /^impedance(?:@(.+))?$/.exec(c.name);
@@ -310,28 +376,29 @@ function plotCurves(record) {
   const win = resonance && resonance.limit;
   const several = pairs.length > 1;
   const pairText = p => (several ? " " + p.name : "");
-  const keys = pairs.map((p, k) => ["measured", "measured" + pairText(p), k]);
-  pairs.forEach((p, k) => { if (p.model) keys.push(["model", "fitted model" + pairText(p), k]); });
+  const keys = pairs.map((p, k) => ["measured", t("ui.legend_measured") + pairText(p), k]);
+  pairs.forEach((p, k) => { if (p.model) keys.push(["model", t("ui.legend_model") + pairText(p), k]); });
   if (win && (win.lo != null || win.hi != null)) {
     const range = win.lo == null ? "≤ " + num(win.hi, 6) : win.hi == null ? "≥ " + num(win.lo, 6)
         : num(win.lo, 6) + "–" + num(win.hi, 6);
-    keys.push(["window", `resonance window ${range} Hz`]);
+    keys.push(["window", t("ui.legend_window", {range})]);
   }
-  const note = sameRecipe ? "" : " (recipe in use)";
+  const note = sameRecipe ? "" : " " + t("ui.legend_recipe_in_use");
   if (drawPanel($("plot"), pairs, "re_ohm", reMasks, win))
-    keys.push(["mask", "limit mask: Re Z must stay out of the shaded area" + note]);
+    keys.push(["mask", t("ui.legend_mask_re") + note]);
   $("plot-abs").toggleAttribute("hidden", absMasks.length === 0);
   if (!absMasks.length) $("plot-abs").replaceChildren();
   else if (drawPanel($("plot-abs"), pairs, "abs_ohm", absMasks, win))
-    keys.push(["mask", "limit mask: |Z| must stay out of the shaded area" + note]);
+    keys.push(["mask", t("ui.legend_mask_abs") + note]);
   pairs.forEach((p, k) => {
-    if (p.f0 !== null) keys.push(["f0", `measured resonance${pairText(p)} ${num(p.f0, 4, true)} Hz`, k]);
+    if (p.f0 !== null) keys.push(["f0", t("ui.legend_f0", {f0: num(p.f0, 4, true)}) + pairText(p), k]);
   });
   renderLegend(keys);
-  $("curve-note").textContent = "— " + record.serial + (several ? ", phase pairs " + pairs.map(p => p.name).join(", ") : "");
+  $("curve-note").textContent = "— " + record.serial +
+      (several ? ", " + t("ui.phase_pairs", {pairs: pairs.map(p => p.name).join(", ")}) : "");
   for (const [id, q] of [["plot", "Re Z"], ["plot-abs", "|Z|"]]) {
     $(id).setAttribute("data-serial", record.serial);
-    $(id).setAttribute("aria-label", `${q} of ${record.serial} over frequency: ` + keys.map(k => k[1]).join(", "));
+    $(id).setAttribute("aria-label", t("ui.curve_label", {quantity: q, serial: record.serial, keys: keys.map(k => k[1]).join(", ")}));
   }
 }
 
@@ -366,9 +433,9 @@ function showResult(summary) {
     showTest(summary.id);
   } else {
     shownTestId = null;
-    clearPlot("not stored: refused before testing");
+    clearPlot(t("ui.not_stored"));
     renderMeasurements([]);
-    $("tested").textContent = "Refused " + localTime(summary.finished_at || summary.started_at, DATE_TIME);
+    $("tested").textContent = t("ui.refused", {when: localTime(summary.finished_at || summary.started_at, DATE_TIME)});
   }
 }
 
@@ -376,7 +443,7 @@ function showRunning(serial) {
   renderOutcome("RUNNING", serial, []);
   renderAttempt(null);
   shownTestId = null;  // the last unit's curve is not this one's
-  clearPlot("test running");
+  clearPlot(t("ui.test_running"));
   renderMeasurements([]);
 }
 
@@ -384,8 +451,7 @@ function showRunning(serial) {
 function renderLockout(lockout) {
   const b = $("lockout");
   b.hidden = !(lockout && lockout.locked);
-  b.textContent = b.hidden ? "" : "LOCKED OUT: production tests are refused until the master parts pass — " +
-      lockout.reason;
+  b.textContent = b.hidden ? "" : t("ui.lockout", {reason: lockout.reason});
   document.body.classList.toggle("locked", !b.hidden);
 }
 
@@ -393,7 +459,7 @@ function renderLockout(lockout) {
 function renderSimulation(why) {
   const b = $("simulation");
   b.hidden = !why;
-  b.textContent = why ? "SIMULATION: " + why + ", not production results" : "";
+  b.textContent = why ? t("ui.simulation", {why}) : "";
 }
 
 // Readiness (station/health.h): what the operator does in large type, the technical reason
@@ -406,7 +472,9 @@ function renderReadiness(r) {
     b.replaceChildren();
     return;
   }
-  b.replaceChildren(el("span", {class: "what"}, "NOT READY: " + (r.not_ready_text || r.not_ready_reason)),
+  const words = r.not_ready_code && typeof ENGLISH["not_ready." + r.not_ready_code] === "string"
+      ? t("not_ready." + r.not_ready_code) : r.not_ready_text || r.not_ready_reason;
+  b.replaceChildren(el("span", {class: "what"}, t("ui.not_ready", {text: words})),
                     el("span", {class: "why"}, r.not_ready_reason || ""));
 }
 
@@ -421,7 +489,7 @@ function setOffline(now) {
   if (now === offline) return;
   offline = now;
   const c = $("connection");
-  c.textContent = now ? "station offline" : "live";
+  c.textContent = now ? t("ui.offline") : t("ui.live");
   c.className = now ? "offline" : "online";
   document.body.classList.toggle("offline", now);
   $("offline").hidden = !now;
@@ -454,7 +522,7 @@ async function refreshStatus() {
   if (fresh("lockout")) renderLockout(s.lockout);
   renderSimulation(s.simulation);
   if (fresh("readiness")) renderReadiness(s);
-  $("station").textContent = "EOL station " + s.station_id;
+  $("station").textContent = t("ui.station", {id: s.station_id});
   if (fresh("message")) $("message").textContent = s.message || "";
   renderHistory(s);
   if (!fresh("state", "verdict")) return;
@@ -470,9 +538,9 @@ async function refreshStatus() {
 async function loadRecipe() {
   try {
     recipe = await getJson("/api/recipe");
-    $("recipe").textContent = `recipe ${recipe.id} v${recipe.version}`;
+    $("recipe").textContent = t("ui.recipe", {id: recipe.id, version: recipe.version});
   } catch (e) {
-    $("recipe").textContent = "recipe unavailable";
+    $("recipe").textContent = t("ui.recipe_unavailable");
   }
 }
 
@@ -529,21 +597,40 @@ function startStatus(text, problem) {
   }
 }
 
-// A short low tone for a scan that did not start a test (made in the page: no sound file,
-// nothing loaded). Counted in body[data-cues] for the tests.
-function refusalCue() {
-  document.body.dataset.cues = Number(document.body.dataset.cues || 0) + 1;
+// Tones made in the page (WebAudio: no sound file, nothing loaded): `count` beeps of `hz`,
+// each 0.35 s with 0.15 s between them.
+function beep(hz, count) {
   try {
-    const ctx = refusalCue.ctx || (refusalCue.ctx = new AudioContext());
-    const tone = ctx.createOscillator(), gain = ctx.createGain();
-    tone.frequency.value = 330;
-    gain.gain.value = 0.25;
-    tone.connect(gain).connect(ctx.destination);
-    tone.start();
-    tone.stop(ctx.currentTime + 0.35);
+    const ctx = beep.ctx || (beep.ctx = new AudioContext());
+    for (let i = 0; i < count; i++) {
+      const tone = ctx.createOscillator(), gain = ctx.createGain();
+      const at = ctx.currentTime + i * 0.5;
+      tone.frequency.value = hz;
+      gain.gain.value = 0.25;
+      tone.connect(gain).connect(ctx.destination);
+      tone.start(at);
+      tone.stop(at + 0.35);
+    }
   } catch (e) {
     // no audio device: the red text stands alone
   }
+}
+
+// A short low tone for a scan that did not start a test. Counted in body[data-cues] for the
+// tests.
+function refusalCue() {
+  document.body.dataset.cues = Number(document.body.dataset.cues || 0) + 1;
+  beep(330, 1);
+}
+
+// The same tone on a new FAIL (twice) or ERROR (three times), so that an operator who looks
+// away hears that the unit needs a hand; none for PASS and ABORTED, none for a result shown
+// on loading the page. Counted in body[data-verdict-cues] ("FAIL ERROR ...") for the tests.
+function verdictCue(outcome) {
+  if (outcome !== "FAIL" && outcome !== "ERROR") return;
+  const heard = document.body.dataset.verdictCues;
+  document.body.dataset.verdictCues = (heard ? heard + " " : "") + outcome;
+  beep(330, outcome === "FAIL" ? 2 : 3);
 }
 
 // POST /api/tests as any client does: no token while the station has none configured (the
@@ -561,19 +648,19 @@ async function startTest(serial) {
     res = await fetch("/api/tests", {method: "POST", headers, body: JSON.stringify(body)});
     answer = await res.json().catch(() => ({}));
   } catch (e) {
-    startStatus("not started: station not reachable (" + e.message + ")", true);
+    startStatus(t("ui.unreachable", {why: e.message}), true);
     return;
   }
   if (res.status === 202) {
-    startStatus(serial + " started");
+    startStatus(t("ui.started", {serial}));
     return;
   }
   const why = (answer.error && answer.error.message) || "HTTP " + res.status;
   if (res.status === 401 || res.status === 403) {
     $("token-row").hidden = false;
-    startStatus(serial + " not started: this station needs an operator token (" + why + ")", true);
+    startStatus(t("ui.needs_token", {serial, why}), true);
   } else {
-    startStatus(serial + " not started: " + why, true);
+    startStatus(t("ui.refused_scan", {serial, why}), true);
   }
 }
 
@@ -584,7 +671,7 @@ function refuseScanWhileOffline(e) {
   e.preventDefault();
   const serial = $("scan").value.trim();
   $("scan").value = "";
-  if (serial) startStatus(serial + " not started: station offline", true);
+  if (serial) startStatus(t("ui.refused_offline", {serial}), true);
 }
 
 function setupStart() {
@@ -597,7 +684,7 @@ function setupStart() {
     $("scan").focus();
     if (!serial) return;
     saveWork();
-    startStatus(serial + " sent…");
+    startStatus(t("ui.sent", {serial}));
     startTest(serial);
   });
   keepScanFocus();
@@ -618,6 +705,7 @@ const HANDLERS = {
     $("message").textContent = "";
     if ($("start-status").className === "problem" && problemAt < testBeganAt) startStatus("");
     showResult(e.record);
+    if (e.record && e.record.kind !== "self_check") verdictCue(e.record.outcome);
     refreshStatus().catch(() => {});
   },
   recipe: () => { loadRecipe(); },
@@ -645,6 +733,7 @@ function openStream() {
 }
 
 async function main() {
+  await loadWords();
   setupStart();
   await loadRecipe();
   await refreshStatus().catch(e => { $("message").textContent = e.message; });

@@ -23,7 +23,9 @@
 #include "../support/gap_units.h"
 #include "../support/station_ready.h"
 #include "../support/stored_test.h"
+#include "analysis/qc/measurement.h"
 #include "drivers/io/frf_files.h"
+#include "station/reason_cause.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -243,10 +245,17 @@ TEST(OperatorPage, DrawsEveryPhasePairAndTheAbsZMasks) {
   station->Stop(SIGTERM, 20s);
 }
 
-// The recipe's instructions (issue 17): the page shows the one for the outcome.
+// The recipe's instructions (issue 17): the page shows the one the plant wrote for the
+// outcome under the catalogue's instruction for the reason (issue 36).
 nlohmann::json ShippedInstructions() {
   std::ifstream in(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json");
   return nlohmann::json::parse(in).at("instructions");
+}
+
+// The operator page's words in `language` (station/web/i18n/).
+nlohmann::json Catalogue(const std::string& language) {
+  std::ifstream in(std::string(EOL_SOURCE_DIR) + "/station/web/i18n/" + language + ".json");
+  return nlohmann::json::parse(in);
 }
 
 // Issue 17: a keyboard-wedge scanner starts tests from the page; the verdict fits its box
@@ -342,14 +351,19 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
   EXPECT_EQ(stored("SCAN-BAD-1")["max_tests"], 3);
   EXPECT_TRUE(stored("SCAN-LOCKED-1").is_null()) << "a refused serial is not stored";
 
-  // Lockout: a banner; the refused serial is ERROR with the recipe's instruction above the
-  // technical reason; ERROR's lamp is not FAIL's.
+  // Lockout: a banner; the refused serial is ERROR with the catalogue's instruction for a
+  // lockout above the reason (the recipe's "error" instruction is its default: not shown);
+  // ERROR's lamp is not FAIL's. FAIL: the catalogue's instruction, then the recipe's own.
+  const nlohmann::json en = Catalogue("en");
   EXPECT_NE(states["lockout"]["lockout"].get<std::string>().find("LOCKED OUT"), std::string::npos);
   EXPECT_EQ(states["error"]["sizes"]["1280x800"]["verdict"]["text"], "ERROR");
-  EXPECT_EQ(states["error"]["instruction"], instructions["error"]);
+  EXPECT_EQ(states["error"]["instruction"], en["do.lockout"]);
   ASSERT_FALSE(states["error"]["reasons"].empty());
   EXPECT_NE(states["error"]["reasons"][0].get<std::string>().find("locked out"), std::string::npos);
-  EXPECT_EQ(states["fail"]["instruction"], instructions["fail"]);
+  const std::string fail_instruction = states["fail"]["instruction"];
+  EXPECT_EQ(fail_instruction.rfind(en["do.limit"].get<std::string>(), 0), 0u) << fail_instruction;
+  EXPECT_NE(fail_instruction.find(instructions["fail"].get<std::string>()), std::string::npos)
+      << fail_instruction;
   EXPECT_EQ(states["pass"]["instruction"], "");
   for (const char* size : {"words_1280x800", "words_1920x1080"}) {
     const nlohmann::json& w = j[size];
@@ -427,6 +441,105 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
   for (const auto& shot : j["screenshots"])
     EXPECT_GT(std::filesystem::file_size(shot.get<std::string>()), 10000u) << shot;
   station.Stop(SIGTERM, 20s);
+}
+
+// Every reason code and cause the C++ can emit, as the catalogue names them.
+nlohmann::json EmittedReasonKeys() {
+  nlohmann::json keys = nlohmann::json::array();
+  for (analysis::ReasonCode c : analysis::kAllReasonCodes) keys.push_back(analysis::ToString(c));
+  for (std::string_view c : station::cause::kAllCauses) keys.push_back(std::string(c));
+  return keys;
+}
+
+// Issue 36: a station configured for German speaks German on the operator page: the verdict
+// word, the instruction for the reason (a lockout, a FAIL), the reasons in the operator's
+// words, with a cue on the new ERROR and FAIL; the engineer's ?lang= shows it in each language,
+// never a raw key or a missing word; every reason code and cause gets its instruction in every
+// language, and the verdict, the instruction and the failing measurements fit 1280x800.
+TEST(OperatorPage, SpeaksTheStationsLanguageAndEveryLanguageHasEveryWord) {
+  const std::string node = BrowserCheckNode();
+  ASSERT_FALSE(node.empty());
+  eol::testing::TempDir dir;
+  const nlohmann::json config = {
+      {"station_id", "page-words"},
+      {"language", "de"},
+      {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
+      {"db", dir / "s.sqlite"},
+      {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
+      {"fixture", {{"driver", "sim"}}},
+      {"daq", {{"driver", "sim"}}},
+      {"sim",
+       {{"clamp_close_s", 0.05},
+        {"clamp_open_s", 0.05},
+        {"population", {{"defect_share", 0.0}}},
+        {"masters",
+         {{{"serial", "MASTER-G"}},
+          {{"serial", "MASTER-L"}, {"defective", true}},
+          {{"serial", "WORDS-BAD-1"}, {"defective", true}}}}}},
+      {"self_check", {{"good_master", "MASTER-G"}, {"limit_master", "MASTER-L"}}}};
+  int port = 0;
+  auto station = StartPageStation(dir, config, &port);
+  ASSERT_GT(port, 0);
+  const std::string artifacts = std::filesystem::path(EOL_BINARY).parent_path() / "artifacts";
+  std::filesystem::create_directories(artifacts);
+  const nlohmann::json keys = EmittedReasonKeys();
+  ChildProcess browser(
+      {node, kBrowserDir + "/check_words.mjs", "http://127.0.0.1:" + std::to_string(port),
+       artifacts, "WORDS-LOCKED-1", "MASTER-G", "MASTER-L", "WORDS-BAD-1", keys.dump(), "de,ja,en"},
+      /*merge_stderr=*/false);
+  const auto code = browser.Wait(180s);
+  ASSERT_TRUE(code.has_value()) << "browser did not finish";
+  ASSERT_EQ(*code, 0) << browser.output() << station->output();
+  const auto j = nlohmann::json::parse(browser.output());
+  const nlohmann::json de = Catalogue("de");
+
+  // The station's language, from its config.
+  EXPECT_EQ(j["station_language"], "de");
+  EXPECT_EQ(j["error"]["verdict"], de["outcome.ERROR"]);
+  EXPECT_EQ(j["error"]["instruction"], de["do.lockout"]);
+  EXPECT_EQ(j["error"]["reasons"], nlohmann::json::array({de["what.lockout"]}));
+  EXPECT_EQ(j["fail"]["verdict"], de["outcome.FAIL"]);
+  const std::string fail_instruction = j["fail"]["instruction"];
+  EXPECT_EQ(fail_instruction.rfind(de["do.limit"].get<std::string>(), 0), 0u) << fail_instruction;
+  // The audible cue: once for the refused ERROR, once for the FAIL; not for the masters'
+  // self-checks (the limit master's FAIL is a passing check).
+  EXPECT_EQ(j["fail"]["cues"], "ERROR FAIL");
+  EXPECT_TRUE(j["fail"]["raw_keys"].empty()) << j["fail"]["raw_keys"];
+
+  for (const std::string lang : {"de", "ja", "en"}) {
+    const nlohmann::json& shown = j["languages"][lang];
+    const nlohmann::json words = Catalogue(lang);
+    EXPECT_EQ(shown["lang"], lang);
+    EXPECT_EQ(shown["missing"], "") << lang;
+    EXPECT_EQ(shown["missing_after"], "") << lang;
+    EXPECT_TRUE(shown["raw_keys"].empty()) << lang << ": " << shown["raw_keys"];
+    EXPECT_EQ(shown["verdict"], words["outcome.FAIL"]) << lang;
+    // Verdict, instruction and the failing measurements on screen, the page unscrolled.
+    EXPECT_TRUE(shown["verdict_fits"].get<bool>()) << lang;
+    EXPECT_TRUE(shown["verdict_inside"].get<bool>()) << lang;
+    EXPECT_TRUE(shown["instruction_inside"].get<bool>()) << lang;
+    EXPECT_EQ(shown["scrolled"], 0) << lang;
+    ASSERT_FALSE(shown["failing"].empty()) << lang << ": no failing measurement shown";
+    for (const auto& m : shown["failing"]) {
+      EXPECT_TRUE(m["inside"].get<bool>()) << lang << ": " << m;
+      const std::string key = "measurement." + m["name"].get<std::string>();
+      if (words.contains(key)) {  // a mask's row is named after the mask
+        EXPECT_EQ(m["label"], words[key]) << lang;
+      }
+    }
+    EXPECT_EQ(shown["priorities"]["clamped"], "fixture.clamp_left_closed") << lang;
+    EXPECT_EQ(shown["priorities"]["legacy"], "legacy") << lang;
+    EXPECT_EQ(shown["priorities"]["legacy_what"], words["what.legacy"]) << lang;
+    // Every code and cause: that language's instruction and words, on screen.
+    for (const auto& key : keys) {
+      const nlohmann::json& got = shown["instructions"][key.get<std::string>()];
+      EXPECT_EQ(got["instruction"], words["do." + key.get<std::string>()]) << lang << " " << key;
+      EXPECT_EQ(got["what"], words["what." + key.get<std::string>()]) << lang << " " << key;
+      EXPECT_TRUE(got["inside"].get<bool>()) << lang << " " << key;
+    }
+  }
+  EXPECT_TRUE(j["page_errors"].empty()) << j["page_errors"];
+  station->Stop(SIGTERM, 20s);
 }
 
 // A station with tokens (any station that listens beyond loopback must have them): the page

@@ -33,7 +33,8 @@ TEST(DebianPackage, HoldsProgramUnitConfigRecipesAndPage) {
   for (const char* f : {"./usr/bin/eol", "./lib/systemd/system/eol-station.service",
                         "./etc/eol/station.json", "./usr/share/eol/recipes/pmsm-10pole.json",
                         "./usr/share/eol/web/index.html", "./usr/share/eol/web/app.js",
-                        "./usr/share/eol/web/engineer.html", "./usr/share/eol/web/engineer.js"})
+                        "./usr/share/eol/web/engineer.html", "./usr/share/eol/web/engineer.js",
+                        "./usr/share/eol/web/i18n/en.json", "./usr/share/eol/web/i18n/ja.json"})
     EXPECT_NE(contents.output().find(f), std::string::npos) << f << " missing:\n"
                                                             << contents.output();
   // The manual page, made from the program's help (cmake/ManPage.cmake).

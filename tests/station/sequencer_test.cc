@@ -15,6 +15,7 @@
 #include "drivers/sim/sim_daq.h"
 #include "drivers/sim/sim_fixture.h"
 #include "station/cycle_time.h"
+#include "station/reason_cause.h"
 
 namespace eol::station {
 namespace {
@@ -63,6 +64,13 @@ class SequencerTest : public ::testing::Test {
     for (const auto& reason : r.reasons)
       if (reason.text.find(text) != std::string::npos) return true;
     return false;
+  }
+
+  // The cause key of the first reason whose text holds `text` ("" when none has).
+  static std::string CauseOf(const db::TestRecord& r, const std::string& text) {
+    for (const auto& reason : r.reasons)
+      if (reason.text.find(text) != std::string::npos) return reason.cause;
+    return "";
   }
 
   // The stored copy must agree with what the sequencer returned.
@@ -135,6 +143,7 @@ TEST_F(SequencerTest, ClampThatDoesNotOpenIsErrorByDefault) {
   const db::TestRecord r = Test("STICK-0", false);
   EXPECT_EQ(r.outcome, Outcome::kError);
   EXPECT_TRUE(HasReason(r, "clamp not released within 0.3 s")) << r.reasons.front().text;
+  EXPECT_EQ(CauseOf(r, "clamp not released within"), cause::kClampNotReleased);
   ExpectStored(r);
   EXPECT_LT(StateAtMs(r, "unclamp"), StateAtMs(r, "store"));
   EXPECT_EQ(StateAtMs(r, "confirm_release"), -1);
@@ -419,7 +428,24 @@ TEST_F(SequencerTest, DoorOpenBeforeTestNeverExcites) {
   EXPECT_EQ(r.outcome, Outcome::kError);
   EXPECT_TRUE(HasReason(r, "interlock: door open"));
   EXPECT_TRUE(HasReason(r, "clamp left as it is: door open"));
+  // The finer causes the operator page words (station/reason_cause.h), stored with the record:
+  // the door, and no clamp left closed (refused before the clamp was ever commanded).
+  EXPECT_EQ(r.reasons.front().cause, cause::kDoorOpen);
+  EXPECT_EQ(CauseOf(r, "clamp left as it is"), "");
   EXPECT_FALSE(bench_->last_excitation_off().has_value()) << "the relay was closed at some point";
+  ExpectStored(r);
+}
+
+// Issue 36: a door opened while the stator is excited leaves the rotor clamped (the station
+// does not move the clamp with the door open); the record says so with the cause the operator
+// page turns into "do not touch the rotor".
+TEST_F(SequencerTest, DoorOpenedDuringExcitationLeavesTheClampClosedWithItsCause) {
+  Build(1.0);
+  bench_->InjectFault(SimFault::kDoorOpens, 100ms, /*on_excitation=*/true);
+  const db::TestRecord r = Test("DOOR-2", false);
+  EXPECT_EQ(r.outcome, Outcome::kError);
+  EXPECT_EQ(r.reasons.front().cause, cause::kLostDuringExcitation) << r.reasons.front().text;
+  EXPECT_EQ(CauseOf(r, "clamp left as it is: door open"), cause::kClampLeftClosed);
   ExpectStored(r);
 }
 
@@ -429,6 +455,7 @@ TEST_F(SequencerTest, FixtureThatStopsAnsweringIsErrorAndStationRecovers) {
   const db::TestRecord r = Test("DEAD-1", false);
   EXPECT_EQ(r.outcome, Outcome::kError);
   EXPECT_TRUE(HasReason(r, "fixture not answering during excitation")) << r.reasons.front().text;
+  EXPECT_EQ(CauseOf(r, "fixture not answering during excitation"), cause::kLostDuringExcitation);
   EXPECT_FALSE(bench_->excitation_connected());
   ExpectStored(r);
   bench_->ClearFaults();
