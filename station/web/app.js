@@ -637,6 +637,7 @@ function verdictCue(outcome) {
 // API then opens operator routes, station/http/request.h); with tokens, the operator's.
 async function startTest(serial) {
   const body = {serial};
+  if ($("variant").value) body.variant = $("variant").value;  // else the serial's rule picks
   const operator = $("operator-id").value.trim(), shift = $("shift").value.trim();
   if (operator) body.operator_id = operator;
   if (shift) body.shift = shift;
@@ -674,8 +675,23 @@ function refuseScanWhileOffline(e) {
   if (serial) startStatus(t("ui.refused_offline", {serial}), true);
 }
 
+// A station of several motor types (GET /api/variants) lets the operator name the unit's
+// type; left at "from the serial", the station's prefix rules pick it (station/variants.h).
+async function loadVariants() {
+  const answer = await getJson("/api/variants").catch(() => null);
+  const list = (answer && answer.variants) || [];
+  for (const v of list) {
+    const option = document.createElement("option");
+    option.value = v.name;
+    option.textContent = v.recipe ? v.name + " (" + v.recipe.id + ")" : v.name;
+    $("variant").appendChild(option);
+  }
+  $("variant-row").hidden = list.length === 0;
+}
+
 function setupStart() {
   loadWork();
+  loadVariants();
   $("scan").addEventListener("keydown", refuseScanWhileOffline);
   $("start-form").addEventListener("submit", e => {
     e.preventDefault();

@@ -24,6 +24,7 @@
 #include "../support/station_ready.h"
 #include "../support/stored_test.h"
 #include "analysis/qc/measurement.h"
+#include "db/store.h"
 #include "drivers/io/frf_files.h"
 #include "station/reason_cause.h"
 
@@ -586,6 +587,54 @@ TEST(OperatorPage, AsksForTheOperatorsTokenWhenTheStationHasTokens) {
   const auto tests = nlohmann::json::parse(res->body)["tests"];
   ASSERT_EQ(tests.size(), 1u) << "the refused scan must not have started a test";
   EXPECT_EQ(j["verdict"], tests[0]["outcome"]);
+  station.Stop(SIGTERM, 20s);
+}
+
+// A station of two motor types (station/variants.h): the page lists them, and a serial no
+// prefix rule claims starts with the type the operator picks, recorded with the unit.
+TEST(OperatorPage, OffersTheStationsMotorTypesAndStartsWithThePickedOne) {
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"));
+  const std::string node = NodeBinary();
+  ASSERT_FALSE(node.empty());
+  eol::testing::TempDir dir;
+  const std::string eight = dir / "p8h.json", db = dir / "s.sqlite";
+  std::filesystem::copy_file(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-8pole-heavy.json", eight);
+  db::Store::Open(db);  // recipe-approve audits into an existing store
+  ChildProcess approve(
+      {EOL_BINARY, "recipe-approve", "--recipe", eight, "--by", "qe-test", "--db", db});
+  ASSERT_EQ(approve.Wait(60s).value_or(-1), 0) << approve.output();
+  std::ofstream(dir / "station.json") << nlohmann::json{
+      {"station_id", "page-variants"},
+      {"variants",
+       {{{"name", "P10"},
+         {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
+         {"prefixes", {"P10-"}}},
+        {{"name", "P8H"}, {"recipe", eight}, {"prefixes", {"P8H-"}}}}},
+      {"db", db},
+      {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
+      {"fixture", {{"driver", "sim"}}},
+      {"daq", {{"driver", "sim"}}}}.dump();
+  ChildProcess station({EOL_BINARY, "station", "--config", dir / "station.json", "--web-root",
+                        std::string(EOL_SOURCE_DIR) + "/station/web"});
+  ASSERT_TRUE(station.WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; }, 30s))
+      << station.output();
+  const int port = PortFromReadyLine(station.output());
+  ChildProcess browser({node, kBrowserDir + "/check_variant.mjs",
+                        "http://127.0.0.1:" + std::to_string(port), "P10", "LINE-0001"},
+                       /*merge_stderr=*/false);
+  const auto code = browser.Wait(120s);
+  ASSERT_TRUE(code.has_value()) << "browser did not finish";
+  ASSERT_EQ(*code, 0) << browser.output() << station.output();
+  const auto j = nlohmann::json::parse(browser.output());
+  EXPECT_EQ(j["options"], nlohmann::json::array({"", "P10", "P8H"})) << j.dump();
+  EXPECT_EQ(j["labels"][1], "P10 (pmsm-10pole)") << j.dump();
+  EXPECT_EQ(j["started"], "LINE-0001 started") << j.dump();
+  httplib::Client http("127.0.0.1", port);
+  const auto res = http.Get("/api/units/LINE-0001");
+  ASSERT_TRUE(res && res->status == 200);
+  const auto tests = nlohmann::json::parse(res->body)["tests"];
+  ASSERT_EQ(tests.size(), 1u);
+  EXPECT_EQ(tests[0]["recipe"]["id"], "pmsm-10pole") << tests[0].dump();
   station.Stop(SIGTERM, 20s);
 }
 
