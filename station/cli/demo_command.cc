@@ -17,6 +17,7 @@
 #include "station/cycle_time.h"
 #include "station/data_files.h"
 #include "station/station.h"
+#include "station/status_board.h"
 
 namespace eol::station::cli {
 namespace {
@@ -91,7 +92,8 @@ int RunDemo(const DemoArgs& a) {
       << ", recipe " << station.recipe()->id << " v" << station.recipe()->version << ", records in "
       << a.db << ", status at http://" << a.listen << ":" << station.http_port() << "/api/status\n";
 
-  int pass = 0, fail = 0, error = 0, defective = 0, detected = 0, false_rejects = 0;
+  VerdictCounts counts;  // the demo reports an ABORTED unit with the ERRORs
+  int defective = 0, detected = 0, false_rejects = 0;
   nlohmann::json serials = nlohmann::json::array();
   // Cycle time per unit (station/cycle_time.h): excitation of all phase pairs, serial
   // received -> verdict published, and the station's own overhead.
@@ -106,17 +108,7 @@ int RunDemo(const DemoArgs& a) {
     excitation_s.push_back(CycleStepS(r.cycle_s, "excitation"));
     cycle_s.push_back(CycleStepS(r.cycle_s, "total"));
     overhead_s.push_back(StationOverheadS(r.cycle_s));
-    switch (r.outcome) {
-      case analysis::Outcome::kPass:
-        ++pass;
-        break;
-      case analysis::Outcome::kFail:
-        ++fail;
-        break;
-      default:
-        ++error;
-        break;
-    }
+    counts.Add(r.outcome);
     if (is_defective) {
       ++defective;
       if (r.outcome == analysis::Outcome::kFail) ++detected;
@@ -130,9 +122,10 @@ int RunDemo(const DemoArgs& a) {
                   CycleStepS(r.cycle_s, "total"));
     out << line << (r.reasons.empty() ? "" : r.reasons.front().text) << "\n" << std::flush;
   }
-  out << "summary: " << a.units << " units: " << pass << " PASS, " << fail << " FAIL, " << error
-      << " ERROR; " << detected << " of " << defective << " defective rotors caught, "
-      << false_rejects << " good rotors rejected\n"
+  const std::uint64_t error = counts.error + counts.aborted;
+  out << "summary: " << a.units << " units: " << counts.pass << " PASS, " << counts.fail
+      << " FAIL, " << error << " ERROR; " << detected << " of " << defective
+      << " defective rotors caught, " << false_rejects << " good rotors rejected\n"
       << "cycle (medians per unit): excitation "
       << analysis::Fixed(analysis::Median(excitation_s), 3) << " s, serial to verdict "
       << analysis::Fixed(analysis::Median(cycle_s), 3) << " s, station overhead "
@@ -140,8 +133,8 @@ int RunDemo(const DemoArgs& a) {
       << ")\n";
   if (a.json) {
     const nlohmann::json summary = {{"units", a.units},
-                                    {"pass", pass},
-                                    {"fail", fail},
+                                    {"pass", counts.pass},
+                                    {"fail", counts.fail},
                                     {"error", error},
                                     {"defective", defective},
                                     {"detected", detected},
