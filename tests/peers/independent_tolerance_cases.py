@@ -34,7 +34,8 @@ always are.
 
 Usage:
   independent_tolerance_cases.py --out DIR [--cases 48] [--seed 1]
-  independent_tolerance_cases.py --out DIR --score --eol build/eol [-- extra eol gap arguments]
+  independent_tolerance_cases.py --out DIR --score --eol build/eol [--classes none,single]
+                                 [-- extra eol gap arguments]
 """
 import argparse
 import json
@@ -241,9 +242,9 @@ def exact(answer, kinds):
             (got[0] in gen.EXPECTED[b] and got[1] in gen.EXPECTED[a]))
 
 
-def score(out_dir, eol, extra):
+def score(out_dir, eol, extra, classes):
     with open(os.path.join(out_dir, "truth.json")) as f:
-        truth = json.load(f)
+        truth = [t for t in json.load(f) if t["class"] in classes]
     rows = []
     t0 = time.time()
     for t in truth:
@@ -299,10 +300,15 @@ def main():
     ap.add_argument("--s-hi", type=float, default=150.0)
     ap.add_argument("--score", action="store_true", help="run `eol gap` on the cases")
     ap.add_argument("--eol", default="build/eol")
+    ap.add_argument("--classes", default="none,single,pair",
+                    help="--score only the cases of these classes (comma-separated)")
     ap.add_argument("extra", nargs="*", help="extra `eol gap` arguments (after --)")
     a = ap.parse_args()
     if a.score:
-        score(a.out, a.eol, a.extra)
+        classes = a.classes.split(",")
+        if not classes or any(c not in ("none", "single", "pair") for c in classes):
+            ap.error("--classes: a comma-separated list of none, single, pair")
+        score(a.out, a.eol, a.extra, classes)
     else:
         if a.cases < 1 or not 0 < a.s_lo <= a.s_hi:
             ap.error("want --cases >= 1 and 0 < --s-lo <= --s-hi")
