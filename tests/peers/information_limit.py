@@ -23,7 +23,11 @@ per defect class.
               the features: a nonlinear rule for a class spread along a curve;
    feat_outlier  the good units' normal alone on the features (how unlikely a unit is as a
               good one; the class's units are not used);
-   both_qda   QDA on the features and the curve's leading 8 components together.
+   curve_spe_qda  QDA on the curve's components and its log SPE: the squared residual outside
+              the good units' leading --components (each line scaled by the good units'
+              residual std there; a soft magnet's own mode at any frequency leaves one);
+   feat_spe_qda, feat_spe_kde  the features and the curve's log SPE, QDA and kernel density;
+   both_qda   QDA on the features, the log SPE and the curve's leading 8 components.
    Each rule's threshold is the (1 - budget) quantile of the good training units' held-out
    scores (5-fold: each scored by the rule fitted without its fold; the false-reject budget,
    default 0.3 %). A unit eol cannot analyse counts as rejected by the feature rules. The
@@ -32,7 +36,8 @@ per defect class.
    recipe detects more on test, the recipe is the lower bound of the limit and the table says
    so.
 Prints one table (class, test units, rejected by the recipe, by each rule, the limit and the
-recipe's distance to it) and the good units' false rejects; --json FILE writes it. Needs
+recipe's distance to it) and the good units' false rejects; --json FILE writes it; --cache
+FILE.npz keeps what was measured (a second run with it judges again without drawing). Needs
 python3-numpy and the eol binary. Run it with /usr/bin/python3 (Debian's numpy).
 """
 import argparse
@@ -222,12 +227,43 @@ def judge_rule(kind, train, c_train, test, c_test, cls, budget):
             "hits": hit[c_test == cls], "good_hits": hit[c_test == "good"]}
 
 
+def fit_residual(x_good, components):
+    """log SPE: the squared residual of a curve outside the good units' leading principal
+    components, each line scaled by the good units' residual std there (an anomaly anywhere on
+    the curve: a soft magnet's own mode at any frequency)."""
+    mu, sd = x_good.mean(axis=0), x_good.std(axis=0) + 1e-12
+    z = (x_good - mu) / sd
+    _, _, vt = np.linalg.svd(z, full_matrices=False)
+    basis = vt[:components].T
+
+    def residual(x):
+        zz = (x - mu) / sd
+        return zz - (zz @ basis) @ basis.T
+    scale = residual(x_good).std(axis=0) + 1e-12
+    return lambda x: np.log(((residual(x) / scale) ** 2).sum(axis=1, keepdims=True))
+
+
+def residual_scores(x_train, good, x_test, components, folds=5):
+    """log SPE of every unit; the good training units' each from a fit without its fold (an
+    in-sample residual is smaller than a new unit's)."""
+    spe = fit_residual(x_train[good], components)
+    q_train, q_test = spe(x_train), spe(x_test)
+    index = np.nonzero(good)[0]
+    fold = np.arange(index.size) % folds
+    for k in range(folds):
+        q_train[index[fold == k]] = fit_residual(x_train[index[fold != k]],
+                                                 components)(x_train[index[fold == k]])
+    return q_train, q_test
+
+
 def rule_inputs(a, train, test):
     """name -> (rule kind, training matrix, test matrix)."""
     (x_train, f_train, c_train), (x_test, f_test, _) = train, test
     project = fit_projection(x_train, c_train == "good", a.components)
     p_train, p_test = project(x_train), project(x_test)
-    rules = {"curve_qda": ("qda", p_train, p_test)}
+    q_train, q_test = residual_scores(x_train, c_train == "good", x_test, a.components)
+    rules = {"curve_qda": ("qda", p_train, p_test),
+             "curve_spe_qda": ("qda", np.hstack([p_train, q_train]), np.hstack([p_test, q_test]))}
     if f_train is not None:
         good = f_train[(c_train == "good") & np.all(np.isfinite(f_train), axis=1)]
         mu, sd = good.mean(axis=0), good.std(axis=0) + 1e-30
@@ -235,8 +271,12 @@ def rule_inputs(a, train, test):
         rules["feat_qda"] = ("qda", s_train, s_test)
         rules["feat_kde"] = ("kde", s_train, s_test)
         rules["feat_outlier"] = ("outlier", s_train, s_test)
-        rules["both_qda"] = ("qda", np.hstack([s_train, p_train[:, :8]]),
-                             np.hstack([s_test, p_test[:, :8]]))
+        rules["feat_spe_qda"] = ("qda", np.hstack([s_train, q_train]),
+                                 np.hstack([s_test, q_test]))
+        rules["feat_spe_kde"] = ("kde", np.hstack([s_train, q_train]),
+                                 np.hstack([s_test, q_test]))
+        rules["both_qda"] = ("qda", np.hstack([s_train, q_train, p_train[:, :8]]),
+                             np.hstack([s_test, q_test, p_test[:, :8]]))
     return rules
 
 
@@ -268,8 +308,11 @@ def print_table(a, rows, good):
           % (a.loss_lo, a.loss_hi, " | ".join(names)))
     print("|---" * (5 + len(names)) + "|")
     for cls, r in rows.items():
-        limit = ("%d (recipe: lower bound)" % r["limit"] if r["recipe_is_lower_bound"]
-                 else "%d (%s)" % (r["limit"], r["limit_rule"]))
+        chosen = r["rules"][r["limit_rule"]]
+        limit = ("%d (recipe: lower bound; best rule %s %d)"
+                 % (r["limit"], r["limit_rule"], chosen["rejected"])
+                 if r["recipe_is_lower_bound"] else "%d (%s, %d good rejected)"
+                 % (r["limit"], r["limit_rule"], chosen["good_rejected"]))
         print("| %s | %d | %d | %s | %s | %d |" % (
             cls, r["units"], r["recipe"],
             " | ".join("%d" % r["rules"][n]["rejected"] for n in names), limit, r["distance"]))
@@ -278,6 +321,37 @@ def print_table(a, rows, good):
     print("(a rule's good row counts a unit any of its three class thresholds flags, each at the "
           "%g budget; the limit is the rule with the best held-out training detection)"
           % a.budget)
+
+
+def measure_populations(a):
+    """(curves, features, classes) of the training and the judged test units, and the recipe's
+    rejects."""
+    raw = excitation_of(a.raw) if a.raw else None
+    with tempfile.TemporaryDirectory() as tmp:
+        draw(a, a.train_seed, a.train_good, a.per_class, os.path.join(tmp, "train"))
+        rejects = recipe_column(a, os.path.join(tmp, "test"))
+        pop = os.path.join(tmp, "test", "pop-%d" % a.test_seed)
+        with open(os.path.join(pop, "truth.csv")) as f:
+            golden = [t["unit"] for t in csv.DictReader(f) if t["class"] == "good"][:40]
+        train = read_population(a, os.path.join(tmp, "train"), raw)
+        test = read_population(a, pop, raw, skip=set(golden))
+    return train, test, rejects
+
+
+def save_cache(path, train, test, rejects):
+    arrays = {}
+    for name, (x, f, c) in (("train", train), ("test", test)):
+        arrays.update({name + "_x": x, name + "_c": c})
+        if f is not None:
+            arrays[name + "_f"] = f
+    np.savez(path, rejects=json.dumps(rejects), **arrays)
+
+
+def load_cache(path):
+    d = np.load(path)
+    pops = [(d[n + "_x"], d[n + "_f"] if n + "_f" in d else None, d[n + "_c"])
+            for n in ("train", "test")]
+    return pops[0], pops[1], json.loads(str(d["rejects"]))
 
 
 def main():
@@ -302,17 +376,16 @@ def main():
     ap.add_argument("--design-slack", type=float, default=1.0,
                     help="teach from a copy of --recipe with excitation_design.sigma_f0_hz times "
                     "this (see taught_from; 1: the recipe as it is)")
+    ap.add_argument("--cache", help="keep the measured curves, features and the recipe's rejects "
+                    "in this .npz; when it exists, judge from it instead of drawing again")
     ap.add_argument("--json")
     a = ap.parse_args()
-    raw = excitation_of(a.raw) if a.raw else None
-    with tempfile.TemporaryDirectory() as tmp:
-        draw(a, a.train_seed, a.train_good, a.per_class, os.path.join(tmp, "train"))
-        rejects = recipe_column(a, os.path.join(tmp, "test"))
-        pop = os.path.join(tmp, "test", "pop-%d" % a.test_seed)
-        with open(os.path.join(pop, "truth.csv")) as f:
-            golden = [t["unit"] for t in csv.DictReader(f) if t["class"] == "good"][:40]
-        train = read_population(a, os.path.join(tmp, "train"), raw)
-        test = read_population(a, pop, raw, skip=set(golden))
+    if a.cache and os.path.exists(a.cache):
+        train, test, rejects = load_cache(a.cache)
+    else:
+        train, test, rejects = measure_populations(a)
+        if a.cache:
+            save_cache(a.cache, train, test, rejects)
     rows, good = class_rows(a, rule_inputs(a, train, test), train[2], test[2], rejects)
     print_table(a, rows, good)
     if a.json:
