@@ -236,6 +236,92 @@ def measure(z, rng, periods=4, f_lines=601, peak_v=2.0, crest=1.7, s_u=2e-3, s_i
     return zh, sigma
 
 
+def read_waveform(path):
+    """Sample rate, played voltage and its period (samples) of a recording CSV (docstring)."""
+    with open(path) as f:
+        head = f.readline().strip().split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    t, u = data[:, head.index("t_s")], data[:, head.index("u_v")]
+    n = u.size
+    for period in (p for p in range(2, n + 1) if n % p == 0):
+        if np.allclose(u[period:], u[:n - period], rtol=0.0, atol=1e-9 * np.abs(u).max()):
+            break
+    return (n - 1) / (t[-1] - t[0]), u, period
+
+
+def state_space(p, r_bond):
+    """A, B of the state x = (i, theta, w) (docstring); output i = x[0]."""
+    m, k, c = chain_matrices(p, r_bond)
+    n = m.shape[0]
+    b = np.zeros(n)
+    b[:MAGNETS] = 1.0 / MAGNETS
+    minv = np.diag(1.0 / np.diag(m))
+    a = np.zeros((2 * n + 1, 2 * n + 1))
+    a[0, 0] = -p["r"] / p["l"]
+    a[0, n + 1:] = -p["t"] * b / p["l"]
+    a[1:n + 1, n + 1:] = np.eye(n)
+    a[n + 1:, 0] = minv @ (p["t"] * b)
+    a[n + 1:, 1:n + 1] = -minv @ k
+    a[n + 1:, n + 1:] = -minv @ c
+    bb = np.zeros(2 * n + 1)
+    bb[0] = 1.0 / p["l"]
+    return a, bb
+
+
+def raw_current(p, r_bond, rate, u, period):
+    """The current from rest for the played voltage u (periodic with `period` samples)."""
+    spec = np.fft.rfft(u[:period]) / period
+    bins = np.nonzero(np.abs(spec) > 1e-9 * np.abs(spec).max())[0]
+    bins = bins[bins > 0]
+    f_hz = bins * rate / period
+    a, bb = state_space(p, r_bond)
+    x0 = np.zeros(a.shape[0])
+    i_spec = np.zeros(spec.size, dtype=complex)
+    z = impedance(p, r_bond, f_hz)
+    for k, f, zk in zip(bins, f_hz, z):
+        xk = np.linalg.solve(2j * np.pi * f * np.eye(a.shape[0]) - a, bb * spec[k])
+        if abs(xk[0] - spec[k] / zk) > 1e-9 * abs(xk[0]):
+            raise RuntimeError("state equations disagree with the impedance at %.2f Hz" % f)
+        i_spec[k] = xk[0]
+        x0 += 2.0 * xk.real  # u(t) = sum over lines of 2 Re(U_k exp(j w_k t))
+    i_ss = np.tile(np.fft.irfft(i_spec * period, n=period), u.size // period)
+    step = scipy.linalg.expm(a / rate)
+    free = np.empty(u.size)
+    x = -x0
+    for s in range(u.size):
+        free[s] = x[0]
+        x = step @ x
+    return i_ss + free
+
+
+def quantise(x, full_scale, bits):
+    lsb = 2.0 * full_scale / 2 ** bits
+    return np.clip(np.round(x / lsb), -2 ** (bits - 1), 2 ** (bits - 1) - 1) * lsb
+
+
+def write_raw_unit(path, p, r_bond, wave, rng, a):
+    """One unit's raw recording (docstring: Raw recordings)."""
+    rate, u, period = wave
+    i = raw_current(p, r_bond, rate, u, period)
+    u_rec = quantise(u + a.noise_v * rng.standard_normal(u.size), a.full_scale_v, a.adc_bits)
+    i_rec = quantise(i + a.noise_a * rng.standard_normal(u.size), a.full_scale_a, a.adc_bits)
+    t = np.arange(u.size) / rate
+    with open(path, "w") as f:
+        f.write("t_s,u_v,i_a,u_full_scale_v,i_full_scale_a\n")
+        for row in zip(t, u_rec, i_rec):
+            f.write("%.7f,%.6f,%.7f,%g,%g\n" % (row + (a.full_scale_v, a.full_scale_a)))
+
+
+def write_frf_unit(path, p, r_bond, f_hz, rng, a, sample_rate):
+    zh, sigma = measure(impedance(p, r_bond, f_hz), rng, periods=a.periods, f_lines=f_hz.size,
+                        peak_v=a.peak_v, crest=a.crest,
+                        n_samples=int(round(sample_rate / a.spacing)))
+    with open(path, "w") as f:
+        f.write("f_hz,re_ohm,im_ohm,sigma_ohm\n")
+        for fk, zk, sk in zip(f_hz, zh, sigma):
+            f.write("%.4f,%.9g,%.9g,%.6g\n" % (fk, zk.real, zk.imag, sk))
+
+
 def main():
     soft = __doc__[__doc__.index("Bond softness"):__doc__.index("Measurement:")]
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0], epilog=soft,
@@ -259,6 +345,16 @@ def main():
                          ("--peak-v", 3, float), ("--periods", 4, int), ("--crest", 5, float)):
         ap.add_argument(opt, type=kind, default=None, dest=opt[2:].replace("-", "_"),
                         help="measurement (default: the motor's, see above)")
+    ap.add_argument("--raw", metavar="WAVE",
+                    help="write raw recordings of the voltage in this recording CSV (see above)")
+    for opt, default, what in (("--noise-v", 2e-3, "voltage noise, V rms per sample"),
+                               ("--noise-a", 1e-3, "current noise, A rms per sample"),
+                               ("--full-scale-v", 10.0, "voltage converter's full scale, V"),
+                               ("--full-scale-a", 2.0, "current converter's full scale, A")):
+        ap.add_argument(opt, type=float, default=default, help="--raw: %s (default %g)"
+                        % (what, default))
+    ap.add_argument("--adc-bits", type=int, default=16,
+                    help="--raw: converter resolution over +-full scale (default 16)")
     ap.add_argument("--nominal", action="store_true",
                     help="print the nominal chain's first modes and exit")
     ap.add_argument("--loss-table", action="store_true",
@@ -301,6 +397,12 @@ def main():
         ap.error("--loss-lo and --loss-hi: need 0 < lo <= hi < 1 (got %g, %g)"
                  % (a.loss_lo, a.loss_hi))
 
+    wave = None
+    if a.raw:
+        if not (a.noise_v >= 0 and a.noise_a >= 0 and a.full_scale_v > 0 and a.full_scale_a > 0
+                and 2 <= a.adc_bits <= 32):
+            ap.error("--raw: need noise >= 0, full scales > 0 and 2 <= adc-bits <= 32")
+        wave = read_waveform(a.raw)
     os.makedirs(a.out, exist_ok=True)
     rng = np.random.default_rng(a.seed)
     plan = [c for c in CLASSES for _ in range(getattr(a, c))]
@@ -315,14 +417,12 @@ def main():
             p = draw_parts(rng)
             p["eta_poor"] = a.poor_loss_factor
             r, size = draw_bonds(rng, CLASSES[cls], a.loss_lo, a.loss_hi)
-            zh, sigma = measure(impedance(p, r, f_hz), rng, periods=a.periods, f_lines=f_hz.size,
-                                peak_v=a.peak_v, crest=a.crest,
-                                n_samples=int(round(sample_rate / a.spacing)))
             name = "unit-%04d" % (idx + 1)
-            with open(os.path.join(a.out, name + ".csv"), "w") as f:
-                f.write("f_hz,re_ohm,im_ohm,sigma_ohm\n")
-                for fk, zk, sk in zip(f_hz, zh, sigma):
-                    f.write("%.4f,%.9g,%.9g,%.6g\n" % (fk, zk.real, zk.imag, sk))
+            if wave is not None:
+                write_raw_unit(os.path.join(a.out, name + ".csv"), p, r, wave, rng, a)
+            else:
+                write_frf_unit(os.path.join(a.out, name + ".csv"), p, r, f_hz, rng, a,
+                               sample_rate)
             tw.writerow([name, cls, "%.3f" % first_mode_hz(p, r), "%.2f" % p["k_fixture"],
                          "%.4f" % size] + ["%.4f" % x for x in r] + ["%.4f" % (1.0 - x) for x in r]
                         + ["%.3f" % p["clamp_pressure_bar"]])
