@@ -126,11 +126,13 @@ TEST(DemoEndToEnd, CatchesEveryDefectAndRecordsAreServed) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 202) << res->body;
   nlohmann::json tests;
-  eol::testing::WaitUntil([&] {
-    res = http.Get("/api/units/E2E-0001");
-    return res && res->status == 200 &&
-           !(tests = nlohmann::json::parse(res->body)["tests"]).empty();
-  });
+  eol::testing::WaitUntil(
+      [&] {
+        res = http.Get("/api/units/E2E-0001");
+        return res && res->status == 200 &&
+               !(tests = nlohmann::json::parse(res->body)["tests"]).empty();
+      },
+      eol::testing::kGenerousDeadline, 100ms);
   ASSERT_EQ(tests.size(), 1u) << "the test started over HTTP was not stored";
   EXPECT_NE(tests[0]["outcome"], "ERROR") << tests[0]["reasons"];
 

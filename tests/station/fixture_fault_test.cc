@@ -72,7 +72,7 @@ nlohmann::json WaitForFinishedTest(httplib::Client& http, const std::string& ser
         test = unit["tests"].back();
         return true;
       },
-      timeout);
+      timeout, 50ms);
   return test;
 }
 
@@ -159,14 +159,23 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
 
   // Excitation off at the fixture: read once the fixture answers again.
   int coil = -1;
-  eol::testing::WaitUntil([&] { return (coil = ReadExcitationCoil(fixture_port)) >= 0; }, 10s);
+  eol::testing::WaitUntil([&] { return (coil = ReadExcitationCoil(fixture_port)) >= 0; }, 10s,
+                          100ms);
   EXPECT_EQ(coil, 0) << "excitation_enable must be off after the fault";
 
   // Recovery without a restart: once the fault is over at the fixture (as the record dates
-  // it), the next serial gets a verdict.
+  // it) and the station sees the fixture healthy again (ready), the next serial gets a verdict.
   ASSERT_NE(fault_over, std::chrono::system_clock::time_point{}) << "no excite state stored";
   ASSERT_TRUE(
       eol::testing::WaitUntil([&] { return std::chrono::system_clock::now() >= fault_over; }, 10s));
+  ASSERT_TRUE(eol::testing::WaitUntil(
+      [&] {
+        const auto status = http.Get("/api/status");
+        return status && status->status == 200 &&
+               nlohmann::json::parse(status->body).value("ready", false);
+      },
+      30s, 50ms))
+      << station.output();
   const auto again =
       http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-2"}}.dump(), "application/json");
   ASSERT_TRUE(again && again->status == 202) << (again ? again->body : "no answer");

@@ -128,7 +128,7 @@ TEST_F(MqttResultsTest, ABrokerOutageInTheMiddleOfARunLosesNothingAndKeepsTheOrd
   // The broker returns: the outbox replays in order, then the run goes on.
   ASSERT_TRUE(broker_.Start());
   const auto t0 = std::chrono::steady_clock::now();
-  eol::testing::WaitUntil([&] { return reader->OutboxPending("mqtt") == 0; }, 300s);
+  eol::testing::WaitUntil([&] { return reader->OutboxPending("mqtt") == 0; }, 300s, 10ms);
   const double replay_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_EQ(reader->OutboxPending("mqtt"), 0);
@@ -266,7 +266,7 @@ TEST_F(MqttTlsTest, ResultsGoOverTlsCheckedAgainstTheConfiguredCa) {
       << mes.output() << "\nbroker: " << broker_.output();
   EXPECT_TRUE(publisher.connected());
   auto reader = db::Store::Open(db_path, db::Store::Role::kReader);
-  eol::testing::WaitUntil([&] { return reader->OutboxPending("mqtt") == 0; }, 10s);
+  eol::testing::WaitUntil([&] { return reader->OutboxPending("mqtt") == 0; }, 10s, 10ms);
   EXPECT_EQ(reader->OutboxPending("mqtt"), 0) << "acknowledged over TLS";
   publisher.Stop();
 

@@ -196,7 +196,7 @@ TEST_F(PlcHandshakeTest, APlcThatDisconnectsMidTestReadsTheStoredResultOnReconne
   ASSERT_EQ(r.size(), 4u);
   EXPECT_EQ(r[3]["values"], nlohmann::json({1, 0})) << "busy, not done, when the PLC left";
 
-  eol::testing::WaitUntil([&] { return !Stored().empty(); }, 120s);
+  eol::testing::WaitUntil([&] { return !Stored().empty(); }, 120s, 50ms);
   const std::vector<db::TestRecord> stored = Stored();
   ASSERT_EQ(stored.size(), 1u) << "the test must complete and be stored without its PLC";
   EXPECT_EQ(stored.front().outcome, analysis::Outcome::kPass);

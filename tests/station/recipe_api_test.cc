@@ -87,10 +87,12 @@ TEST(RecipeApi, EngineersChangeRecipesAuditedAndVersioned) {
   res = http.Post("/api/tests", with(kOperator), R"({"serial": "RA-2"})", "application/json");
   ASSERT_EQ(res->status, 202) << res->body;
   nlohmann::json tests;
-  eol::testing::WaitUntil([&] {
-    tests = nlohmann::json::parse(http.Get("/api/units/RA-2")->body)["tests"];
-    return !tests.empty();
-  });
+  eol::testing::WaitUntil(
+      [&] {
+        tests = nlohmann::json::parse(http.Get("/api/units/RA-2")->body)["tests"];
+        return !tests.empty();
+      },
+      eol::testing::kGenerousDeadline, 100ms);
   ASSERT_EQ(tests.size(), 1u);
   EXPECT_EQ(tests[0]["recipe"]["version"], 2);
   EXPECT_EQ(tests[0]["recipe"]["hash"], changed["hash"]);

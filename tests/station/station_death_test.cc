@@ -86,17 +86,21 @@ class StationDeath : public ::testing::Test {
     const auto started =
         http_->Post("/api/tests", nlohmann::json{{"serial", serial}}.dump(), "application/json");
     ASSERT_TRUE(started && started->status == 202) << (started ? started->body : "no answer");
-    ASSERT_TRUE(eol::testing::WaitUntil([&] { return ReadExcitationCoil(observer_) == 1; }))
+    ASSERT_TRUE(eol::testing::WaitUntil([&] { return ReadExcitationCoil(observer_) == 1; },
+                                        eol::testing::kGenerousDeadline, 2ms))
         << "the relay never closed\n"
         << station_->output();
     int changes = 0;
     int last = ReadAlive(observer_);
-    ASSERT_TRUE(eol::testing::WaitUntil([&] {
-      const int now = ReadAlive(observer_);
-      if (now >= 0 && now != last) ++changes;
-      last = now;
-      return changes >= 3;
-    })) << "station_alive stood still in excitation\n"
+    ASSERT_TRUE(eol::testing::WaitUntil(
+        [&] {
+          const int now = ReadAlive(observer_);
+          if (now >= 0 && now != last) ++changes;
+          last = now;
+          return changes >= 3;
+        },
+        eol::testing::kGenerousDeadline, 5ms))
+        << "station_alive stood still in excitation\n"
         << station_->output();
     ASSERT_EQ(ReadExcitationCoil(observer_), 1);
   }
@@ -139,15 +143,17 @@ TEST_F(StationDeath, FrozenInExcitationTheRelayOpensAndTheResumedTestIsErrorStal
   EXPECT_LE(off_ms, 300.0);
 
   nlohmann::json test;
-  eol::testing::WaitUntil([&] {
-    const auto res = http_->Get("/api/units/STOP-1");
-    if (!res || res->status != 200) return false;
-    const auto unit = nlohmann::json::parse(res->body);
-    if (unit["tests"].empty() || unit["tests"].back()["finished_at"].get<std::string>().empty())
-      return false;
-    test = unit["tests"].back();
-    return true;
-  });
+  eol::testing::WaitUntil(
+      [&] {
+        const auto res = http_->Get("/api/units/STOP-1");
+        if (!res || res->status != 200) return false;
+        const auto unit = nlohmann::json::parse(res->body);
+        if (unit["tests"].empty() || unit["tests"].back()["finished_at"].get<std::string>().empty())
+          return false;
+        test = unit["tests"].back();
+        return true;
+      },
+      eol::testing::kGenerousDeadline, 50ms);
   ASSERT_FALSE(test.is_null()) << station_->output();
   EXPECT_EQ(test["outcome"], "ERROR") << test.dump();
   EXPECT_NE(test["reasons"].dump().find("watchdog stalled"), std::string::npos) << test.dump();

@@ -272,7 +272,7 @@ class TwoRecipeStation : public ::testing::Test {
           tests = db::Store::Open(db_path_, db::Store::Role::kReader)->Tests(db::TestQuery{});
           return tests.size() >= n;
         },
-        120s);
+        120s, 50ms);
     return tests;
   }
 
@@ -385,11 +385,14 @@ TEST_F(TwoRecipeStation, EachUnitIsTestedAndRecordedWithItsOwnRecipeOverHttp) {
   // verdict is published just after it is stored: the status shows ANY-8 a moment later.
   httplib::Client http("127.0.0.1", station_->http_port());
   nlohmann::json last;
-  ASSERT_TRUE(eol::testing::WaitUntil([&] {
-    const auto status = http.Get("/api/status");
-    if (status) last = nlohmann::json::parse(status->body)["last"];
-    return last.is_object() && last.value("serial", "") == "ANY-8";
-  })) << last.dump();
+  ASSERT_TRUE(eol::testing::WaitUntil(
+      [&] {
+        const auto status = http.Get("/api/status");
+        if (status) last = nlohmann::json::parse(status->body)["last"];
+        return last.is_object() && last.value("serial", "") == "ANY-8";
+      },
+      eol::testing::kGenerousDeadline, 50ms))
+      << last.dump();
   EXPECT_EQ(last["recipe"]["hash"], eight.hash);
   EXPECT_EQ(last["recipe"]["variant"], "P8H");
   res = http.Get("/api/variants");

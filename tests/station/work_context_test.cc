@@ -51,7 +51,7 @@ std::vector<db::TestRecord> WaitStored(const std::string& db_path, const std::st
         }
         return tests.size() >= n;
       },
-      120s);
+      120s, 50ms);
   return tests;
 }
 
