@@ -89,7 +89,8 @@ class FixtureProbe {
 
 // Calls `tick` every `period` on a thread of its own until destroyed (the first call at
 // once; at a fixed rate: a tick longer than the period is followed by the next at once). The
-// destructor waits for a tick in flight.
+// destructor waits for a tick in flight. Paced in real time (a condition wait on the steady
+// clock); what a tick measures comes from the station's clock (station/station_clock.h).
 class PeriodicTask {
  public:
   PeriodicTask(std::chrono::milliseconds period, std::function<void()> tick);

@@ -92,11 +92,11 @@ ExcitationWatchdog::ExcitationWatchdog(WatchdogContext context)
     : c_(context),
       limit_ms_(ReactionLimitMs(c_.safety)),
       alive_period_(c_.safety.alive_period_ms),
-      last_ok_(Clock::now()),
+      last_ok_(c_.clock.now()),
       last_alive_(last_ok_),
       thread_([this] { Run(); }) {}
 
-ExcitationWatchdog::~ExcitationWatchdog() { Stop(Clock::now()); }
+ExcitationWatchdog::~ExcitationWatchdog() { Stop(c_.clock.now()); }
 
 void ExcitationWatchdog::Stop(Clock::time_point excitation_off) {
   {
@@ -155,10 +155,10 @@ std::string ExcitationWatchdog::GapFault(Clock::time_point now, double read_ms) 
 
 std::string ExcitationWatchdog::Check() {
   // A stall is seen before anything read after it is believed.
-  if (std::string stall = GapFault(Clock::now(), 0.0); !stall.empty()) return stall;
-  const auto t0 = Clock::now();
+  if (std::string stall = GapFault(c_.clock.now(), 0.0); !stall.empty()) return stall;
+  const auto t0 = c_.clock.now();
   auto in = c_.fixture.ReadInputs();
-  const auto now = Clock::now();
+  const auto now = c_.clock.now();
   if (!in.ok())
     return "interlock lost during excitation: fixture not answering during excitation: " +
            in.status().message();

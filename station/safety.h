@@ -36,6 +36,7 @@
 #include "drivers/fixture/fixture.h"
 #include "station/config.h"
 #include "station/recipe.h"
+#include "station/station_clock.h"
 
 namespace eol::station {
 
@@ -116,6 +117,9 @@ struct WatchdogContext {
   SafetyOptions safety;
   std::atomic<bool>& abort;           // raised on a trip: the acquisition stops
   std::atomic<std::uint64_t>& trips;  // counted on a trip
+  // Gaps and the alive period are measured on clock.now (station/station_clock.h); the
+  // period between two reads is paced in real time.
+  StationClock clock = {};
 };
 
 // Polls the interlocks while the stator is excited (see the top of this file). Starts in
@@ -124,7 +128,7 @@ class ExcitationWatchdog {
  public:
   using Clock = std::chrono::steady_clock;
   explicit ExcitationWatchdog(WatchdogContext context);
-  ~ExcitationWatchdog();  // Stop(now)
+  ~ExcitationWatchdog();  // Stop(clock.now())
   ExcitationWatchdog(const ExcitationWatchdog&) = delete;
   ExcitationWatchdog& operator=(const ExcitationWatchdog&) = delete;
 

@@ -88,7 +88,7 @@ struct Sequencer::Fault {
 
 // One phase pair measured: its recording is kept for the judge (conditions are computed
 // from it). The analysis of its first look ran on a worker from analysis_start to
-// analysis_end (steady clock).
+// analysis_end (the sequencer's clock).
 struct Sequencer::MeasuredPair {
   drivers::PhasePair pair;
   analysis::Recording recording;
@@ -140,7 +140,8 @@ void Sequencer::ThrowIfAborted() {
 
 void Sequencer::Enter(db::TestRecord& record, SeqState s, const std::string& detail) {
   state_.store(s);
-  const double t_ms = std::chrono::duration<double, std::milli>(Clock::now() - test_start_).count();
+  const double t_ms =
+      std::chrono::duration<double, std::milli>(options_.clock.now() - test_start_).count();
   record.trace.push_back({ToString(s), t_ms, detail});
   spdlog::info("[{}] {}{}{}", record.serial, ToString(s), detail.empty() ? "" : ": ", detail);
   board_.OnState(record.serial, s, detail);
@@ -186,9 +187,9 @@ void Sequencer::CheckInterlocks(db::TestRecord& record) {
        {NotReadyCause::kFixtureUnreachable, NotReadyCause::kAcquisitionUnavailable,
         NotReadyCause::kDriversNotConnected})
     board_.ClearCause(c);
-  if (!heartbeat_.Update(in.heartbeat, Clock::now()))
+  if (!heartbeat_.Update(in.heartbeat, options_.clock.now()))
     throw Fault{Outcome::kError,
-                {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, Clock::now()),
+                {ReasonCode::kInterlock, FrozenHeartbeat(heartbeat_, options_.clock.now()),
                  std::string(cause::kHeartbeatFrozen)}};
   if (const InterlockFinding f = FindInterlockFault(in, *recipe_, false); !f.text.empty())
     throw Fault{Outcome::kError,
@@ -210,8 +211,9 @@ void Sequencer::ClampAndConfirm(db::TestRecord& record) {
                 {ReasonCode::kFixture, s.message(), std::string(cause::kFixtureCommand)}};
 
   Enter(record, SeqState::kConfirmClamp);
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(recipe_->clamp_timeout_s));
+  const auto deadline =
+      options_.clock.now() + std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double>(recipe_->clamp_timeout_s));
   const auto poll = std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms);
   InterlockFinding why;
   drivers::FixtureInputs in;
@@ -220,13 +222,13 @@ void Sequencer::ClampAndConfirm(db::TestRecord& record) {
     in = ReadInputs("confirm clamp");
     why = FindInterlockFault(in, *recipe_, true);
     if (why.text.empty()) break;
-    if (Clock::now() > deadline)
+    if (options_.clock.now() > deadline)
       throw Fault{
           Outcome::kError,
           {ReasonCode::kInterlock,
            "clamp not confirmed within " + Fixed(recipe_->clamp_timeout_s, 1) + " s: " + why.text,
            std::string(why.cause)}};
-    std::this_thread::sleep_for(poll);
+    options_.clock.Sleep(poll);
   }
   record.conditions["clamp_pressure_bar"] = in.clamp_pressure_bar;
   record.conditions["phase_pair"] = static_cast<int>(recipe_->phase_pair);
@@ -258,8 +260,8 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size
   std::optional<drivers::StatusOr<analysis::Recording>> result;
   std::optional<std::string> watchdog_fault;
   {
-    ExcitationWatchdog watchdog(
-        {fixture_, *recipe_, heartbeat_, alive_, options_.safety, abort_, watchdog_trips_});
+    ExcitationWatchdog watchdog({fixture_, *recipe_, heartbeat_, alive_, options_.safety, abort_,
+                                 watchdog_trips_, options_.clock});
     // A fresh station_alive right before the relay closes: the controller closes it only then.
     drivers::Status s = alive_.Fresh();
     if (s.ok()) s = fixture_.Write(FixtureOutput::kExcitationEnable, true);
@@ -269,7 +271,7 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size
                   {ReasonCode::kFixture, s.message(), std::string(cause::kFixtureCommand)}};
     }
     result.emplace(daq_.Acquire(req, abort_));
-    const auto excitation_off = Clock::now();
+    const auto excitation_off = options_.clock.now();
     (void)fixture_.Write(FixtureOutput::kExcitationEnable, false);
     watchdog.Stop(excitation_off);  // a trip in flight has stored its cause before this returns
     watchdog_fault = watchdog.fault();
@@ -291,10 +293,10 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size
     throw Fault{
         Outcome::kError,
         {ReasonCode::kInterlock, "interlock after excitation: " + f.text, std::string(f.cause)}};
-  if (!heartbeat_.Update(after.heartbeat, Clock::now()))
+  if (!heartbeat_.Update(after.heartbeat, options_.clock.now()))
     throw Fault{Outcome::kError,
                 {ReasonCode::kInterlock,
-                 FrozenHeartbeat(heartbeat_, Clock::now()) + " at the end of excitation",
+                 FrozenHeartbeat(heartbeat_, options_.clock.now()) + " at the end of excitation",
                  std::string(cause::kHeartbeatFrozen)}};
   beat_after_excitation_ = after.heartbeat;
   if (!result->ok())
@@ -318,12 +320,13 @@ void Sequencer::SelectPair(db::TestRecord& record, drivers::PhasePair pair) {
 
 std::vector<Sequencer::MeasuredPair> Sequencer::MeasurePairs(db::TestRecord& record) {
   const std::vector<drivers::PhasePair>& pairs = recipe_->phase_pairs;
-  // The analysis reads only what the task owns: the recording, the lines and the recipe.
-  auto analyse = [recipe = recipe_, lines = excitation_.lines](drivers::PhasePair pair,
-                                                               analysis::Recording recording) {
-    MeasuredPair m{pair, std::move(recording), {}, Clock::now(), {}};
+  // The analysis reads only what the task owns: the recording, the lines, the recipe and
+  // the clock.
+  auto analyse = [recipe = recipe_, lines = excitation_.lines, now = options_.clock.now](
+                     drivers::PhasePair pair, analysis::Recording recording) {
+    MeasuredPair m{pair, std::move(recording), {}, now(), {}};
     m.analysis = analysis::AnalyzeRecording(m.recording, lines, recipe->analysis);
-    m.analysis_end = Clock::now();
+    m.analysis_end = now();
     return m;
   };
   // Unwinding on a fault waits for the tasks still running (std::async's futures), at most
@@ -334,10 +337,10 @@ std::vector<Sequencer::MeasuredPair> Sequencer::MeasurePairs(db::TestRecord& rec
   auto collect_next = [&] { measured.push_back(pending[measured.size()].get()); };
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     if (k > 0) SelectPair(record, pairs[k]);
-    const Clock::time_point t0 = Clock::now();
+    const Clock::time_point t0 = options_.clock.now();
     analysis::Recording recording =
         ExciteAndRecord(record, recipe_->transient_periods + recipe_->periods);
-    excited.emplace_back(t0, Clock::now());
+    excited.emplace_back(t0, options_.clock.now());
     pending.push_back(std::async(std::launch::async, analyse, pairs[k], std::move(recording)));
     if (k > 0) {
       // Pair k-1 was analysed while pair k was excited: an unusable pair makes the verdict
@@ -457,7 +460,7 @@ void Sequencer::Unclamp(db::TestRecord& record, bool until_released) {
     throw Fault{
         Outcome::kError,
         {ReasonCode::kFixture, "unclamp: " + s.message(), std::string(cause::kClampNotReleased)}};
-  release_commanded_at_ = Clock::now();
+  release_commanded_at_ = options_.clock.now();
   const auto deadline = ReleaseDeadline();
   // Before the verdict is published the controller must prove it was alive at the end of
   // excitation: a heartbeat newer than the one read when the relay opened (a freeze near the
@@ -466,7 +469,7 @@ void Sequencer::Unclamp(db::TestRecord& record, bool until_released) {
   bool fresh_beat = !beat_after_excitation_;
   for (;;) {
     const drivers::FixtureInputs in = ReadInputs("confirm release");
-    const auto now = Clock::now();
+    const auto now = options_.clock.now();
     released = released || in.released;
     fresh_beat = fresh_beat || in.heartbeat != *beat_after_excitation_;
     if (!fresh_beat && !heartbeat_.Update(in.heartbeat, now))
@@ -481,8 +484,7 @@ void Sequencer::Unclamp(db::TestRecord& record, bool until_released) {
                   {ReasonCode::kFixture,
                    "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s",
                    std::string(cause::kClampNotReleased)}};
-    std::this_thread::sleep_for(
-        std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
+    options_.clock.Sleep(std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
   }
   if (until_released) (void)fixture_.Deactivate();
 }
@@ -499,13 +501,12 @@ void Sequencer::ConfirmRelease(db::TestRecord& record) {
   for (;;) {
     auto in = fixture_.ReadInputs();
     if (in.ok() && in.value().released) break;
-    if (Clock::now() > deadline) {
+    if (options_.clock.now() > deadline) {
       why = in.ok() ? "clamp not released within " + Fixed(recipe_->release_timeout_s, 1) + " s"
                     : "fixture not answering (" + in.status().message() + ")";
       break;
     }
-    std::this_thread::sleep_for(
-        std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
+    options_.clock.Sleep(std::chrono::duration<double, std::milli>(options_.safety.poll_period_ms));
   }
   (void)fixture_.Deactivate();
   if (why.empty()) return;
@@ -546,8 +547,8 @@ bool Sequencer::RefusedForReleaseFault(db::TestRecord& record) {
 void Sequencer::SafeState(db::TestRecord& record) {
   Enter(record, SeqState::kSafeState, record.reasons.empty() ? "" : record.reasons.front().text);
   const auto give_up =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                         std::chrono::duration<double>(options_.safety.safe_state_retry_s));
+      options_.clock.now() + std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double>(options_.safety.safe_state_retry_s));
   const auto pause =
       std::chrono::duration<double, std::milli>(std::max(options_.safety.poll_period_ms, 50.0));
   // 1. Excitation off, always first, whatever state the fixture is in.
@@ -558,8 +559,8 @@ void Sequencer::SafeState(db::TestRecord& record) {
     off = fixture_.lifecycle() == drivers::Lifecycle::kError
               ? fixture_.Connect()  // a fresh connection drives excitation off first
               : fixture_.Write(FixtureOutput::kExcitationEnable, false);
-    if (off.ok() || Clock::now() >= give_up) break;
-    std::this_thread::sleep_for(pause);
+    if (off.ok() || options_.clock.now() >= give_up) break;
+    options_.clock.Sleep(pause);
   }
   if (!off.ok())
     record.reasons.push_back({ReasonCode::kFixture,
@@ -577,8 +578,8 @@ void Sequencer::SafeState(db::TestRecord& record) {
     if (!in.ok()) {
       unsafe = "fixture not answering (" + in.status().message() + ")";
       code = ReasonCode::kFixture;
-      if (Clock::now() < give_up) {
-        std::this_thread::sleep_for(pause);
+      if (options_.clock.now() < give_up) {
+        options_.clock.Sleep(pause);
         continue;
       }
     } else if (!in.value().estop_ok) {
@@ -589,8 +590,8 @@ void Sequencer::SafeState(db::TestRecord& record) {
       unsafe.clear();
       (void)fixture_.Activate();
       const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false);
-      if (!s.ok() && Clock::now() < give_up) {
-        std::this_thread::sleep_for(pause);
+      if (!s.ok() && options_.clock.now() < give_up) {
+        options_.clock.Sleep(pause);
         continue;
       }
       if (!s.ok())
@@ -614,7 +615,7 @@ void Sequencer::StoreAndPublish(db::TestRecord& record) {
   Enter(record, SeqState::kStore, analysis::ToString(record.outcome));
   record.cycle_s =
       CycleBreakdown({record.trace.begin(), record.trace.end() - 1}, record.trace.back().t_ms);
-  record.finished_at = db::UtcNowIso8601();
+  record.finished_at = db::UtcIso8601(options_.clock.wall());
   try {
     store_.FinishTest(record);
   } catch (const std::exception& e) {
@@ -639,7 +640,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial) {
 }
 
 db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkContext& work) {
-  test_start_ = Clock::now();
+  test_start_ = options_.clock.now();
   abort_.store(stop_requested_.load());
   beat_after_excitation_.reset();
   db::TestRecord record;
@@ -650,7 +651,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
   record.recipe_version = recipe_->version;
   record.recipe_hash = recipe_->hash;
   record.software_version = SoftwareVersion();
-  record.started_at = db::UtcNowIso8601();
+  record.started_at = db::UtcIso8601(options_.clock.wall());
   record.outcome = analysis::Outcome::kError;
   if (!options_.simulation.empty()) record.conditions["simulation"] = options_.simulation;
   if (!variant_.empty()) {
@@ -664,8 +665,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
   try {
     if (RefusedForReleaseFault(record)) return record;
     if (options_.self_check.enabled() && !master) {
-      const LockoutState lock =
-          EvaluateLockout(options_.self_check, store_, std::chrono::system_clock::now());
+      const LockoutState lock = EvaluateLockout(options_.self_check, store_, options_.clock.wall());
       if (lock.locked) {
         // Refused before anything moves; not a test of the motor, so nothing is stored.
         record.reasons = {{ReasonCode::kLockout, "station locked out: " + lock.reason}};
@@ -740,8 +740,7 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
 void Sequencer::PublishLockout() {
   if (!options_.self_check.enabled()) return;
   try {
-    board_.SetLockout(
-        EvaluateLockout(options_.self_check, store_, std::chrono::system_clock::now()).ToJson());
+    board_.SetLockout(EvaluateLockout(options_.self_check, store_, options_.clock.wall()).ToJson());
   } catch (const std::exception& e) {
     board_.SetLockout(
         {{"locked", true}, {"reason", std::string("self-check state unknown: ") + e.what()}});

@@ -34,6 +34,7 @@
 #include "station/config.h"
 #include "station/recipe.h"
 #include "station/safety.h"
+#include "station/station_clock.h"
 #include "station/status_board.h"
 
 namespace eol::station {
@@ -72,6 +73,10 @@ struct SequencerOptions {
   // the motor's: the stored verdict stands, the board says the station is not ready and why,
   // and every serial is refused (nothing clamps or excites) until the clamp reads released.
   bool publish_before_release = false;
+  // Every time the sequencer reads or waits for (station/station_clock.h): its deadlines,
+  // polls, trace, record timestamps and the lockout's "now"; the watchdog gets it too.
+  // Default: the real clocks.
+  StationClock clock;
 };
 
 class Sequencer {

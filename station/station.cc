@@ -49,8 +49,8 @@ Recipe LoadRecipeOrLastGood(const std::string& path, std::string* problem) {
 
 }  // namespace
 
-Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
-    : config_(std::move(config)) {
+Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench, StationClock clock)
+    : config_(std::move(config)), clock_(std::move(clock)) {
   if (config_.variants.empty()) {
     recipe_ =
         std::make_shared<const Recipe>(LoadRecipeOrLastGood(config_.recipe_path, &recipe_problem_));
@@ -101,6 +101,7 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench)
   opts.safety = config_.safety;
   opts.self_check = config_.self_check;
   opts.publish_before_release = config_.publish_before_release;
+  opts.clock = clock_;
   if (drivers_.bench && drivers_.bench->settings().load_part_on_serial) {
     drivers::SimBench* bench = drivers_.bench.get();
     opts.on_serial = [bench](const std::string& serial) { bench->LoadPart(serial); };
@@ -221,7 +222,7 @@ void Station::ConnectDrivers() {
 // Shift continuity: "Last results" and the day's counts as the store holds them,
 // so that a restart shows what the shift did so far.
 void Station::RestoreBoard() {
-  const auto now = std::chrono::system_clock::now();
+  const auto now = clock_.wall();
   db::TestQuery day;
   day.from = db::UtcIso8601(LocalMidnight(now));
   day.limit = 1000;
@@ -437,7 +438,7 @@ void Station::LookAtDrivers() {
   }
   std::unique_lock<std::mutex> fixture_lock(fixture_use_mu_, std::try_to_lock);
   if (!fixture_lock.owns_lock()) return;
-  const std::vector<FixtureProbe::Finding> found = probe_->Look(std::chrono::steady_clock::now());
+  const std::vector<FixtureProbe::Finding> found = probe_->Look(clock_.now());
   for (NotReadyCause cause : kFixtureCauses) {
     const auto it = std::find_if(found.begin(), found.end(),
                                  [cause](const auto& f) { return f.first == cause; });
@@ -551,7 +552,7 @@ void Station::HealthLoop(const std::atomic<bool>& serving) {
       std::lock_guard<std::mutex> lock(queue_mu_);
       if (running_test_) {
         const double running_s =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - test_started_).count();
+            std::chrono::duration<double>(clock_.now() - test_started_).count();
         if (running_s > test_deadline_s_)
           stuck = "test of " + running_serial_ + " running for " + analysis::Fixed(running_s, 0) +
                   " s, beyond its deadline of " + analysis::Fixed(test_deadline_s_, 0) + " s";
@@ -588,7 +589,7 @@ void Station::ServeQueue() {
       queue_.pop_front();
       running_test_ = true;
       running_serial_ = queued.request.serial;
-      test_started_ = std::chrono::steady_clock::now();
+      test_started_ = clock_.now();
       test_deadline_s_ = TestDeadlineS(
           variants_.empty() ? *recipe() : *variants_[queued.variant].recipe, config_.safety);
     }

@@ -20,6 +20,7 @@
 #include "station/recipe.h"
 #include "station/recipe_change.h"
 #include "station/sequencer.h"
+#include "station/station_clock.h"
 #include "station/station_metrics.h"
 #include "station/status_board.h"
 #include "station/test_request.h"
@@ -40,7 +41,11 @@ class Station {
   // that does not (a proposal) throws io::ConfigError naming the variant and the file, and two
   // variants of one recipe id are refused; there is no last-good fallback for them.
   // `bench`: a simulated bench shared with a fixture emulator (the demo); normally null.
-  explicit Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench = nullptr);
+  // `clock`: the time it lives by (station/station_clock.h), handed to the sequencer and read
+  // by the idle look and the stuck-test deadline; the real clocks unless a test passes one.
+  // A clock whose sleep advances a manual clock needs the bench on that clock too.
+  explicit Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench = nullptr,
+                   StationClock clock = {});
   ~Station();
   Station(const Station&) = delete;
   Station& operator=(const Station&) = delete;
@@ -106,6 +111,7 @@ class Station {
 
  private:
   StationConfig config_;
+  const StationClock clock_;
   mutable std::mutex recipe_mu_;
   std::shared_ptr<const Recipe> recipe_;
   // Non-empty when the configured recipe did not load at start: tests are refused (Enqueue)

@@ -11,6 +11,7 @@
 
 #include "../support/child_process.h"
 #include "../support/station_ready.h"
+#include "../support/wait_until.h"
 #include "db/store.h"
 
 namespace eol {
@@ -125,13 +126,13 @@ TEST(DemoEndToEnd, CatchesEveryDefectAndRecordsAreServed) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 202) << res->body;
   nlohmann::json tests;
-  const auto deadline = std::chrono::steady_clock::now() + 60s;
-  while (std::chrono::steady_clock::now() < deadline) {
-    res = http.Get("/api/units/E2E-0001");
-    if (res && res->status == 200 && !(tests = nlohmann::json::parse(res->body)["tests"]).empty())
-      break;
-    std::this_thread::sleep_for(100ms);
-  }
+  eol::testing::WaitUntil(
+      [&] {
+        res = http.Get("/api/units/E2E-0001");
+        return res && res->status == 200 &&
+               !(tests = nlohmann::json::parse(res->body)["tests"]).empty();
+      },
+      eol::testing::kGenerousDeadline, 100ms);
   ASSERT_EQ(tests.size(), 1u) << "the test started over HTTP was not stored";
   EXPECT_NE(tests[0]["outcome"], "ERROR") << tests[0]["reasons"];
 

@@ -7,16 +7,21 @@
 #include <httplib.h>
 #include <modbus/modbus.h>
 
+#include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <thread>
 
 #include "db/store.h"
 #include "tests/support/child_process.h"
 #include "tests/support/station_ready.h"
+#include "tests/support/wait_until.h"
 
 namespace eol {
 namespace {
@@ -56,17 +61,42 @@ int ReadExcitationCoil(int port) {
 // Waits until the serial's latest test has finished; returns it (null on timeout).
 nlohmann::json WaitForFinishedTest(httplib::Client& http, const std::string& serial,
                                    std::chrono::seconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    const auto res = http.Get(("/api/units/" + serial).c_str());
-    if (res && res->status == 200) {
-      const auto unit = nlohmann::json::parse(res->body);
-      if (!unit["tests"].empty() && !unit["tests"].back()["finished_at"].get<std::string>().empty())
-        return unit["tests"].back();
-    }
-    std::this_thread::sleep_for(50ms);
-  }
-  return nullptr;
+  nlohmann::json test;
+  eol::testing::WaitUntil(
+      [&] {
+        const auto res = http.Get(("/api/units/" + serial).c_str());
+        if (!res || res->status != 200) return false;
+        const auto unit = nlohmann::json::parse(res->body);
+        if (unit["tests"].empty() || unit["tests"].back()["finished_at"].get<std::string>().empty())
+          return false;
+        test = unit["tests"].back();
+        return true;
+      },
+      timeout, 50ms);
+  return test;
+}
+
+// When a fault injected with --fault-on-excitation --fault-after-ms `after` and
+// --fault-duration-ms `lasts` is over at the fixture, read from the stored record: the relay
+// closed no earlier than the record's excite state, plus `margin` for the Modbus writes that
+// close it. The epoch when the record has no excite state.
+std::chrono::system_clock::time_point FaultOver(const db::TestRecord& r,
+                                                std::chrono::milliseconds after,
+                                                std::chrono::milliseconds lasts,
+                                                std::chrono::milliseconds margin) {
+  std::tm tm{};
+  int ms = 0;
+  std::istringstream in(r.started_at);
+  in >> std::get_time(&tm, "%Y-%m-%dT%H:%M:%S");
+  char dot = 0;
+  in >> dot >> ms;
+  if (in.fail()) return {};
+  const auto started =
+      std::chrono::system_clock::from_time_t(timegm(&tm)) + std::chrono::milliseconds(ms);
+  for (const db::StateEntry& e : r.trace)
+    if (e.state == "excite")
+      return started + std::chrono::milliseconds(std::lround(e.t_ms)) + after + lasts + margin;
+  return {};
 }
 
 class FixtureFault : public ::testing::TestWithParam<FaultCase> {};
@@ -115,6 +145,7 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
   EXPECT_NE(reasons.find(c.cause), std::string::npos) << "reasons: " << reasons;
 
   // The stored record says the same; the daemon wrote it before it published the verdict.
+  std::chrono::system_clock::time_point fault_over{};
   {
     auto reader = db::Store::Open(db_path, db::Store::Role::kReader);
     const auto tests = reader->TestsOfSerial("FAULT-1");
@@ -123,18 +154,28 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
     ASSERT_FALSE(tests.front().reasons.empty());
     EXPECT_NE(tests.front().reasons.front().text.find(c.cause), std::string::npos)
         << tests.front().reasons.front().text;
+    fault_over = FaultOver(tests.front(), 300ms, 2500ms, 250ms);
   }
 
   // Excitation off at the fixture: read once the fixture answers again.
   int coil = -1;
-  for (int i = 0; i < 100 && coil < 0; ++i) {
-    coil = ReadExcitationCoil(fixture_port);
-    if (coil < 0) std::this_thread::sleep_for(100ms);
-  }
+  eol::testing::WaitUntil([&] { return (coil = ReadExcitationCoil(fixture_port)) >= 0; }, 10s,
+                          100ms);
   EXPECT_EQ(coil, 0) << "excitation_enable must be off after the fault";
 
-  // Recovery without a restart: the fault has cleared, the next serial gets a verdict.
-  std::this_thread::sleep_for(2500ms);
+  // Recovery without a restart: once the fault is over at the fixture (as the record dates
+  // it) and the station sees the fixture healthy again (ready), the next serial gets a verdict.
+  ASSERT_NE(fault_over, std::chrono::system_clock::time_point{}) << "no excite state stored";
+  ASSERT_TRUE(
+      eol::testing::WaitUntil([&] { return std::chrono::system_clock::now() >= fault_over; }, 10s));
+  ASSERT_TRUE(eol::testing::WaitUntil(
+      [&] {
+        const auto status = http.Get("/api/status");
+        return status && status->status == 200 &&
+               nlohmann::json::parse(status->body).value("ready", false);
+      },
+      30s, 50ms))
+      << station.output();
   const auto again =
       http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-2"}}.dump(), "application/json");
   ASSERT_TRUE(again && again->status == 202) << (again ? again->body : "no answer");

@@ -23,6 +23,7 @@
 #include "tests/support/free_port.h"
 #include "tests/support/mosquitto_broker.h"
 #include "tests/support/mqtt_mes.h"
+#include "tests/support/wait_until.h"
 
 namespace eol::station {
 namespace {
@@ -70,13 +71,13 @@ class MqttResultsTest : public ::testing::Test {
 
   // Waits until the subscriber has `n` distinct results (or 120 s).
   std::vector<std::int64_t> WaitResults(std::size_t n, int* duplicates) {
-    const auto deadline = std::chrono::steady_clock::now() + 120s;
     std::vector<std::int64_t> ids;
-    while (std::chrono::steady_clock::now() < deadline) {
-      ids = ResultIds(Messages(*subscriber_), "plant/eol/mq-1/result", duplicates);
-      if (ids.size() >= n) break;
-      std::this_thread::sleep_for(20ms);
-    }
+    eol::testing::WaitUntil(
+        [&] {
+          ids = ResultIds(Messages(*subscriber_), "plant/eol/mq-1/result", duplicates);
+          return ids.size() >= n;
+        },
+        120s);
     return ids;
   }
 
@@ -127,8 +128,7 @@ TEST_F(MqttResultsTest, ABrokerOutageInTheMiddleOfARunLosesNothingAndKeepsTheOrd
   // The broker returns: the outbox replays in order, then the run goes on.
   ASSERT_TRUE(broker_.Start());
   const auto t0 = std::chrono::steady_clock::now();
-  while (reader->OutboxPending("mqtt") > 0 && std::chrono::steady_clock::now() - t0 < 300s)
-    std::this_thread::sleep_for(10ms);
+  eol::testing::WaitUntil([&] { return reader->OutboxPending("mqtt") == 0; }, 300s, 10ms);
   const double replay_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_EQ(reader->OutboxPending("mqtt"), 0);
@@ -185,17 +185,13 @@ TEST_F(MqttResultsTest, ADaemonKilledLeavesItsLastWillOfflineRetained) {
       if (m.topic == "plant/eol/mq-1/status") s.push_back(m.payload);
     return s;
   };
-  const auto deadline = std::chrono::steady_clock::now() + 30s;
-  while (status().empty() && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(20ms);
+  eol::testing::WaitUntil([&] { return !status().empty(); }, 30s);
   daemon.WaitFor([](const std::string&) { return false; }, 100ms);
   ASSERT_FALSE(status().empty()) << daemon.output() << "\nsubscriber: " << subscriber_->output()
                                  << "\nbroker: " << broker_.output();
   EXPECT_EQ(nlohmann::json::parse(status().back())["state"], "idle");
   daemon.Stop(SIGKILL, 10s);
-  const auto until = std::chrono::steady_clock::now() + 30s;
-  while (status().back() != "offline" && std::chrono::steady_clock::now() < until)
-    std::this_thread::sleep_for(20ms);
+  eol::testing::WaitUntil([&] { return status().back() == "offline"; }, 30s);
   EXPECT_EQ(status().back(), "offline") << "no last will after SIGKILL";
   // Retained: a client that subscribes now still reads it.
   ChildProcess late(MesArgv(port_, "plant/eol/mq-1/status", {"--client-id", "late-reader"}));
@@ -270,9 +266,7 @@ TEST_F(MqttTlsTest, ResultsGoOverTlsCheckedAgainstTheConfiguredCa) {
       << mes.output() << "\nbroker: " << broker_.output();
   EXPECT_TRUE(publisher.connected());
   auto reader = db::Store::Open(db_path, db::Store::Role::kReader);
-  const auto t0 = std::chrono::steady_clock::now();
-  while (reader->OutboxPending("mqtt") > 0 && std::chrono::steady_clock::now() - t0 < 10s)
-    std::this_thread::sleep_for(10ms);
+  eol::testing::WaitUntil([&] { return reader->OutboxPending("mqtt") == 0; }, 10s, 10ms);
   EXPECT_EQ(reader->OutboxPending("mqtt"), 0) << "acknowledged over TLS";
   publisher.Stop();
 
@@ -289,8 +283,12 @@ TEST_F(MqttTlsTest, ResultsGoOverTlsCheckedAgainstTheConfiguredCa) {
   }
   MqttPublisher wrong(Config(other + "/other-ca.crt"), "tls-1", db_path,
                       [] { return std::string("idle"); });
+  const std::size_t broker_log = broker_.output().size();
   wrong.Start();
-  std::this_thread::sleep_for(2s);
+  // The broker saw the handshake the publisher refused (its certificate is not trusted).
+  EXPECT_TRUE(eol::testing::WaitUntil(
+      [&] { return broker_.output().find("OpenSSL Error", broker_log) != std::string::npos; }, 30s))
+      << "broker: " << broker_.output();
   EXPECT_FALSE(wrong.connected());
   wrong.Stop();
   EXPECT_EQ(reader->OutboxPending("mqtt"), 1) << "TLS-2 waits for a broker it can trust";

@@ -17,6 +17,7 @@
 #include "station/station.h"
 #include "tests/peers/modbus_peer_support.h"
 #include "tests/support/child_process.h"
+#include "tests/support/wait_until.h"
 
 namespace eol::station {
 namespace {
@@ -195,9 +196,7 @@ TEST_F(PlcHandshakeTest, APlcThatDisconnectsMidTestReadsTheStoredResultOnReconne
   ASSERT_EQ(r.size(), 4u);
   EXPECT_EQ(r[3]["values"], nlohmann::json({1, 0})) << "busy, not done, when the PLC left";
 
-  const auto deadline = std::chrono::steady_clock::now() + 120s;
-  while (Stored().empty() && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(50ms);
+  eol::testing::WaitUntil([&] { return !Stored().empty(); }, 120s, 50ms);
   const std::vector<db::TestRecord> stored = Stored();
   ASSERT_EQ(stored.size(), 1u) << "the test must complete and be stored without its PLC";
   EXPECT_EQ(stored.front().outcome, analysis::Outcome::kPass);

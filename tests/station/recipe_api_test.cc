@@ -11,6 +11,7 @@
 #include "../support/child_process.h"
 #include "../support/station_ready.h"
 #include "../support/token_station.h"
+#include "../support/wait_until.h"
 #include "db/store.h"
 #include "drivers/io/json_config.h"
 
@@ -86,10 +87,12 @@ TEST(RecipeApi, EngineersChangeRecipesAuditedAndVersioned) {
   res = http.Post("/api/tests", with(kOperator), R"({"serial": "RA-2"})", "application/json");
   ASSERT_EQ(res->status, 202) << res->body;
   nlohmann::json tests;
-  for (int i = 0; i < 300 && tests.empty(); ++i) {
-    std::this_thread::sleep_for(100ms);
-    tests = nlohmann::json::parse(http.Get("/api/units/RA-2")->body)["tests"];
-  }
+  eol::testing::WaitUntil(
+      [&] {
+        tests = nlohmann::json::parse(http.Get("/api/units/RA-2")->body)["tests"];
+        return !tests.empty();
+      },
+      eol::testing::kGenerousDeadline, 100ms);
   ASSERT_EQ(tests.size(), 1u);
   EXPECT_EQ(tests[0]["recipe"]["version"], 2);
   EXPECT_EQ(tests[0]["recipe"]["hash"], changed["hash"]);

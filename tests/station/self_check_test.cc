@@ -6,9 +6,11 @@
 
 #include <gtest/gtest.h>
 
-#include <thread>
+#include <chrono>
+#include <memory>
 
 #include "../support/child_process.h"
+#include "../support/manual_station_clock.h"
 #include "station/station.h"
 #include "station/stats_report.h"
 
@@ -167,17 +169,22 @@ TEST_F(SelfCheckTest, ACheckIsDueAfterEveryNTestsAndAfterEveryHours) {
     EXPECT_EQ(s.RunTest("U-3").outcome, Outcome::kPass);
   }
   {
-    // A check valid for 1e-4 h (0.36 s): after waiting longer, production is refused.
-    Station s(Config(true, 0, 1e-4));
+    // A check valid for 8 h, on a calendar the test moves (the station's wall clock): valid
+    // just before the 8 h are over, production refused once they are.
+    auto calendar = std::make_shared<drivers::ManualClock>();
+    Station s(Config(true, 0, 8), nullptr, eol::testing::ManualWallClock(calendar));
     EXPECT_EQ(s.RunTest("MASTER-G").outcome, Outcome::kPass);
     EXPECT_EQ(s.RunTest("MASTER-L").outcome, Outcome::kFail);
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    const db::TestRecord due = s.RunTest("U-4");
+    calendar->Advance(std::chrono::hours(8) - std::chrono::minutes(1));
+    const db::TestRecord valid = s.RunTest("U-4");
+    EXPECT_EQ(valid.outcome, Outcome::kPass) << Reasons(valid);
+    calendar->Advance(std::chrono::minutes(2));
+    const db::TestRecord due = s.RunTest("U-5");
     EXPECT_EQ(due.outcome, Outcome::kError);
     ASSERT_FALSE(due.reasons.empty());
     EXPECT_NE(due.reasons.front().text.find("self-check due: the last check"), std::string::npos)
         << Reasons(due);
-    EXPECT_NE(due.reasons.front().text.find("is older than 0.0001 h"), std::string::npos)
+    EXPECT_NE(due.reasons.front().text.find("is older than 8 h"), std::string::npos)
         << Reasons(due);
   }
 }

@@ -11,6 +11,7 @@
 #include <functional>
 
 #include "../support/child_process.h"
+#include "../support/manual_station_clock.h"
 #include "analysis/qc/measurement_names.h"
 #include "drivers/sim/sim_daq.h"
 #include "drivers/sim/sim_fixture.h"
@@ -33,7 +34,8 @@ class SequencerTest : public ::testing::Test {
     bench_settings.clamp_close_s = 0.05;
     bench_settings.clamp_open_s = 0.03;
     if (tweak) tweak(bench_settings);
-    bench_ = std::make_shared<drivers::SimBench>(bench_settings);
+    bench_ = std::make_shared<drivers::SimBench>(
+        bench_settings, clock_ ? drivers::ManualClock::Of(clock_) : drivers::SteadySimClock());
     fixture_ = std::make_unique<drivers::SimFixture>(bench_);
     drivers::SimDaqSettings daq_settings;
     daq_settings.time_scale = time_scale;
@@ -51,6 +53,7 @@ class SequencerTest : public ::testing::Test {
     SequencerOptions o;
     o.station_id = "test";
     o.publish_before_release = publish_before_release;
+    if (clock_) o.clock = eol::testing::ManualStationClock(clock_);
     sequencer_ = std::make_unique<Sequencer>(*fixture_, *daq_, *store_,
                                              std::make_shared<const Recipe>(recipe_), *board_, o);
   }
@@ -83,7 +86,12 @@ class SequencerTest : public ::testing::Test {
     EXPECT_EQ(stored->recipe_hash, recipe_.hash);
   }
 
+  // Before Build: the bench and the sequencer on this manual clock (the sequencer's pauses
+  // between polls advance it), else both on the steady clock.
+  void UseManualClock() { clock_ = std::make_shared<drivers::ManualClock>(); }
+
   eol::testing::TempDir dir_;
+  std::shared_ptr<drivers::ManualClock> clock_;
   std::shared_ptr<drivers::SimBench> bench_;
   std::unique_ptr<drivers::Fixture> fixture_;
   std::unique_ptr<drivers::Daq> daq_;
@@ -136,6 +144,7 @@ double StateAtMs(const db::TestRecord& r, const std::string& state) {
 
 // By default the release is part of the test: a clamp that does not open makes it ERROR.
 TEST_F(SequencerTest, ClampThatDoesNotOpenIsErrorByDefault) {
+  UseManualClock();
   Build(0.0);
   recipe_.release_timeout_s = 0.3;
   Rebuild();
@@ -147,13 +156,45 @@ TEST_F(SequencerTest, ClampThatDoesNotOpenIsErrorByDefault) {
   ExpectStored(r);
   EXPECT_LT(StateAtMs(r, "unclamp"), StateAtMs(r, "store"));
   EXPECT_EQ(StateAtMs(r, "confirm_release"), -1);
+  // On the manual clock the release was given exactly its 0.3 s (plus at most one 10 ms poll).
+  const double gave_up_after = StateAtMs(r, "safe_state") - StateAtMs(r, "unclamp");
+  EXPECT_GT(gave_up_after, 300.0);
+  EXPECT_LE(gave_up_after, 310.0 + 1e-6);
   bench_->ClearFaults();
   EXPECT_EQ(Test("STICK-0B", false).outcome, Outcome::kPass);
+}
+
+// The clamp's deadline on the manual clock: a clamp that closes within the recipe's 2 s is
+// confirmed, one that needs longer ends ERROR after exactly the 2 s (plus one 10 ms poll),
+// never excited; neither takes real time.
+TEST_F(SequencerTest, ClampWithinItsTimeoutIsConfirmedOnTheSequencersClock) {
+  UseManualClock();
+  Build(0.0, [](drivers::SimBenchSettings& s) { s.clamp_close_s = 1.9; });
+  const db::TestRecord slow = Test("CLAMP-SLOW", false);
+  EXPECT_EQ(slow.outcome, Outcome::kPass)
+      << (slow.reasons.empty() ? "" : slow.reasons.front().text);
+  EXPECT_GE(StateAtMs(slow, "excite") - StateAtMs(slow, "confirm_clamp"), 1900.0);
+}
+
+TEST_F(SequencerTest, ClampLaterThanItsTimeoutIsErrorAfterExactlyTheTimeout) {
+  UseManualClock();
+  Build(0.0, [](drivers::SimBenchSettings& s) { s.clamp_close_s = 2.5; });
+  const db::TestRecord late = Test("CLAMP-LATE", false);
+  EXPECT_EQ(late.outcome, Outcome::kError);
+  EXPECT_TRUE(HasReason(late, "clamp not confirmed within 2.0 s"))
+      << (late.reasons.empty() ? "" : late.reasons.front().text);
+  EXPECT_EQ(StateAtMs(late, "excite"), -1);
+  EXPECT_FALSE(bench_->last_excitation_off().has_value()) << "the relay was closed at some point";
+  const double gave_up_after = StateAtMs(late, "safe_state") - StateAtMs(late, "confirm_clamp");
+  EXPECT_GT(gave_up_after, 2000.0);
+  EXPECT_LE(gave_up_after, 2010.0 + 1e-6);
+  ExpectStored(late);
 }
 
 // Issue 16: with publish_before_release the record is stored and the verdict published once
 // the release is commanded and a fresh heartbeat seen; the clamp's 0.4 s of travel comes after.
 TEST_F(SequencerTest, VerdictIsPublishedWhileTheClampOpens) {
+  UseManualClock();
   Build(0.0, [](drivers::SimBenchSettings& s) {
     s.clamp_open_s = 0.4;
     s.heartbeat_period_s = 0.02;
@@ -182,6 +223,7 @@ TEST_F(SequencerTest, VerdictIsPublishedWhileTheClampOpens) {
 // why it is not ready and refuses every serial (nothing clamps, excites or is stored) until
 // the clamp reads released.
 TEST_F(SequencerTest, ClampStuckBehindAPublishedVerdictStopsTheStationUntilReleased) {
+  UseManualClock();
   Build(0.0);
   recipe_.release_timeout_s = 0.3;
   Rebuild(/*publish_before_release=*/true);
@@ -475,13 +517,16 @@ TEST_F(SequencerTest, FrozenHeartbeatIsError) {
 
 // Issue 14: a freeze that starts near the end of excitation is shorter than the watchdog's
 // timeout when the relay opens; the verdict must still not be published as PASS. Instant
-// acquisition: the whole excitation fits inside the freeze's first milliseconds.
+// acquisition: the whole excitation fits inside the freeze's first milliseconds. On the
+// manual clock the 1.5 s heartbeat timeout passes in the sequencer's polls, not in real time.
 TEST_F(SequencerTest, HeartbeatFrozenAtTheEndOfExcitationIsNeverPass) {
+  UseManualClock();
   Build(0.0);
   bench_->InjectFault(SimFault::kHeartbeatFreezes, 0ms);
   const db::TestRecord r = Test("HB-END", false);
   EXPECT_EQ(r.outcome, Outcome::kError);
   EXPECT_TRUE(HasReason(r, "heartbeat frozen")) << r.reasons.front().text;
+  EXPECT_TRUE(HasReason(r, "after excitation")) << r.reasons.front().text;
   EXPECT_EQ(r.reasons.front().code, analysis::ReasonCode::kInterlock);
   EXPECT_FALSE(bench_->output(FixtureOutput::kExcitationEnable));
   ExpectStored(r);

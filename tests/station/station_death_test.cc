@@ -18,6 +18,7 @@
 
 #include "tests/support/child_process.h"
 #include "tests/support/station_ready.h"
+#include "tests/support/wait_until.h"
 
 namespace eol {
 namespace {
@@ -32,6 +33,12 @@ using eol::testing::TempDir;
 int ReadExcitationCoil(modbus_t* ctx) {
   std::uint8_t bit = 2;
   return modbus_read_bits(ctx, 1, 1, &bit) == 1 ? bit : -1;
+}
+
+// Holding register 1 of the default map (station_alive); -1 on failure.
+int ReadAlive(modbus_t* ctx) {
+  std::uint16_t value = 0;
+  return modbus_read_registers(ctx, 1, 1, &value) == 1 ? value : -1;
 }
 
 class StationDeath : public ::testing::Test {
@@ -73,17 +80,28 @@ class StationDeath : public ::testing::Test {
     }
   }
 
-  // Starts a test and returns once the observer reads the relay closed (300 ms into it).
+  // Starts a test and returns once the observer reads the relay closed and the station's
+  // watchdog keeping it closed: station_alive changed three times since (about 150 ms).
   void StartAndWaitForExcitation(const std::string& serial) {
     const auto started =
         http_->Post("/api/tests", nlohmann::json{{"serial", serial}}.dump(), "application/json");
     ASSERT_TRUE(started && started->status == 202) << (started ? started->body : "no answer");
-    const auto end = Clock::now() + 30s;
-    while (ReadExcitationCoil(observer_) != 1) {
-      ASSERT_LT(Clock::now(), end) << "the relay never closed\n" << station_->output();
-      std::this_thread::sleep_for(2ms);
-    }
-    std::this_thread::sleep_for(300ms);
+    ASSERT_TRUE(eol::testing::WaitUntil([&] { return ReadExcitationCoil(observer_) == 1; },
+                                        eol::testing::kGenerousDeadline, 2ms))
+        << "the relay never closed\n"
+        << station_->output();
+    int changes = 0;
+    int last = ReadAlive(observer_);
+    ASSERT_TRUE(eol::testing::WaitUntil(
+        [&] {
+          const int now = ReadAlive(observer_);
+          if (now >= 0 && now != last) ++changes;
+          last = now;
+          return changes >= 3;
+        },
+        eol::testing::kGenerousDeadline, 5ms))
+        << "station_alive stood still in excitation\n"
+        << station_->output();
     ASSERT_EQ(ReadExcitationCoil(observer_), 1);
   }
 
@@ -125,19 +143,17 @@ TEST_F(StationDeath, FrozenInExcitationTheRelayOpensAndTheResumedTestIsErrorStal
   EXPECT_LE(off_ms, 300.0);
 
   nlohmann::json test;
-  const auto end = Clock::now() + 60s;
-  while (Clock::now() < end) {
-    const auto res = http_->Get("/api/units/STOP-1");
-    if (res && res->status == 200) {
-      const auto unit = nlohmann::json::parse(res->body);
-      if (!unit["tests"].empty() &&
-          !unit["tests"].back()["finished_at"].get<std::string>().empty()) {
+  eol::testing::WaitUntil(
+      [&] {
+        const auto res = http_->Get("/api/units/STOP-1");
+        if (!res || res->status != 200) return false;
+        const auto unit = nlohmann::json::parse(res->body);
+        if (unit["tests"].empty() || unit["tests"].back()["finished_at"].get<std::string>().empty())
+          return false;
         test = unit["tests"].back();
-        break;
-      }
-    }
-    std::this_thread::sleep_for(50ms);
-  }
+        return true;
+      },
+      eol::testing::kGenerousDeadline, 50ms);
   ASSERT_FALSE(test.is_null()) << station_->output();
   EXPECT_EQ(test["outcome"], "ERROR") << test.dump();
   EXPECT_NE(test["reasons"].dump().find("watchdog stalled"), std::string::npos) << test.dump();

@@ -11,6 +11,8 @@
 #include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
 #include <thread>
 
 #include "db/store.h"
@@ -22,6 +24,7 @@
 #include "tests/peers/modbus_peer_support.h"
 #include "tests/support/child_process.h"
 #include "tests/support/eol_cli.h"
+#include "tests/support/wait_until.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -253,25 +256,23 @@ class TwoRecipeStation : public ::testing::Test {
   httplib::Result Post(const nlohmann::json& body) {
     httplib::Client http("127.0.0.1", station_->http_port());
     http.set_read_timeout(10, 0);
-    const auto deadline = std::chrono::steady_clock::now() + 60s;
-    while (true) {
-      auto res = http.Post("/api/tests", body.dump(), "application/json");
-      if (!res || res->status != 409 || res->body.find("\"busy\"") == std::string::npos ||
-          std::chrono::steady_clock::now() > deadline)
-        return res;
-      std::this_thread::sleep_for(20ms);
-    }
+    std::optional<httplib::Result> res;
+    eol::testing::WaitUntil([&] {
+      res.emplace(http.Post("/api/tests", body.dump(), "application/json"));
+      return !*res || (*res)->status != 409 || (*res)->body.find("\"busy\"") == std::string::npos;
+    });
+    return std::move(*res);
   }
 
   // Waits (up to 120 s) until `n` records are stored; returns them newest first.
   std::vector<db::TestRecord> Stored(std::size_t n) const {
-    const auto deadline = std::chrono::steady_clock::now() + 120s;
     std::vector<db::TestRecord> tests;
-    while (std::chrono::steady_clock::now() < deadline) {
-      tests = db::Store::Open(db_path_, db::Store::Role::kReader)->Tests(db::TestQuery{});
-      if (tests.size() >= n) break;
-      std::this_thread::sleep_for(50ms);
-    }
+    eol::testing::WaitUntil(
+        [&] {
+          tests = db::Store::Open(db_path_, db::Store::Role::kReader)->Tests(db::TestQuery{});
+          return tests.size() >= n;
+        },
+        120s, 50ms);
     return tests;
   }
 
@@ -349,9 +350,16 @@ TEST_F(TwoRecipeStation, EachUnitIsTestedAndRecordedWithItsOwnRecipeOverHttp) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 400) << res->body;
 
-  std::this_thread::sleep_for(300ms);  // a refused start that slipped through would store now
-  stored = db::Store::Open(db_path_, db::Store::Role::kReader)->Tests(db::TestQuery{});
-  ASSERT_EQ(stored.size(), 3u) << "a refused start stored a record";
+  // One accepted start behind the refused ones: tests run one at a time in the order they
+  // were accepted, so a refused start that slipped through is stored before this one is.
+  res = Post({{"serial", "ANY-8"}, {"variant", "P8H"}});
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  stored = Stored(4);
+  ASSERT_EQ(stored.size(), 4u) << "a refused start stored a record";
+  std::set<std::string> serials;
+  for (const db::TestRecord& r : stored) serials.insert(r.serial);
+  EXPECT_EQ(serials, (std::set<std::string>{"P8H-0001", "P10-0001", "ANY-7", "ANY-8"}));
   const auto by_serial = [&](const std::string& serial) {
     for (const db::TestRecord& r : stored)
       if (r.serial == serial) return r;
@@ -373,12 +381,18 @@ TEST_F(TwoRecipeStation, EachUnitIsTestedAndRecordedWithItsOwnRecipeOverHttp) {
   EXPECT_EQ(c.recipe_hash, eight.hash);
   EXPECT_EQ(c.conditions["variant_by"], "operator");
 
-  // The API: the verdict names the recipe and variant; the variants with their recipes.
+  // The API: the verdict names the recipe and variant; the variants with their recipes. The
+  // verdict is published just after it is stored: the status shows ANY-8 a moment later.
   httplib::Client http("127.0.0.1", station_->http_port());
-  res = http.Get("/api/status");
-  ASSERT_TRUE(res);
-  const nlohmann::json last = nlohmann::json::parse(res->body)["last"];
-  EXPECT_EQ(last["serial"], "ANY-7");
+  nlohmann::json last;
+  ASSERT_TRUE(eol::testing::WaitUntil(
+      [&] {
+        const auto status = http.Get("/api/status");
+        if (status) last = nlohmann::json::parse(status->body)["last"];
+        return last.is_object() && last.value("serial", "") == "ANY-8";
+      },
+      eol::testing::kGenerousDeadline, 50ms))
+      << last.dump();
   EXPECT_EQ(last["recipe"]["hash"], eight.hash);
   EXPECT_EQ(last["recipe"]["variant"], "P8H");
   res = http.Get("/api/variants");

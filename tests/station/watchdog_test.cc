@@ -12,6 +12,7 @@
 
 #include "../support/child_process.h"
 #include "../support/glitch_proxy.h"
+#include "../support/wait_until.h"
 #include "drivers/emulators/modbus_fixture_server.h"
 #include "drivers/fixture/modbus_fixture.h"
 #include "drivers/sim/sim_bench.h"
@@ -227,11 +228,11 @@ TEST_P(WatchdogModbusTest, SpoiledReplyInExcitationIsErrorWithoutRetryAndTheRela
                 std::make_shared<const Recipe>(
                     LoadRecipe(std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json")),
                 board, o);
-  std::thread arm([&] {  // 200 ms into the excitation
-    const auto end = Clock::now() + 20s;
-    while (!bench->excitation_connected() && Clock::now() < end) std::this_thread::sleep_for(1ms);
-    std::this_thread::sleep_for(200ms);
-    proxy.Arm(GetParam());
+  std::thread arm([&] {  // inside the excitation: after the watchdog's first reads in it
+    using eol::testing::WaitUntil;
+    if (!WaitUntil([&] { return bench->excitation_connected(); })) return;
+    const int before = proxy.requests();
+    if (WaitUntil([&] { return proxy.requests() >= before + 10; })) proxy.Arm(GetParam());
   });
   bench->LoadUnit(analysis::DrawUnit(bench->settings().population, "GLITCH-1", false));
   const db::TestRecord r = seq.RunTest("GLITCH-1");

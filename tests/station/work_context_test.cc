@@ -15,6 +15,7 @@
 #include "station/test_request.h"
 #include "tests/support/child_process.h"
 #include "tests/support/station_ready.h"
+#include "tests/support/wait_until.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -37,20 +38,20 @@ nlohmann::json StationJson(const std::string& db_path) {
 // The stored tests of `serial`, waited for (up to 120 s) until there are `n`.
 std::vector<db::TestRecord> WaitStored(const std::string& db_path, const std::string& serial,
                                        std::size_t n) {
-  const auto deadline = std::chrono::steady_clock::now() + 120s;
   std::vector<db::TestRecord> tests;
-  while (std::chrono::steady_clock::now() < deadline) {
-    // Read-only: a reader that may create would leave an empty file the daemon then refuses
-    // when the test looks before the daemon has made its store (a store still being made is
-    // refused too, and looked at again).
-    try {
-      if (std::filesystem::exists(db_path))
-        tests = db::Store::Open(db_path, db::Store::Role::kReadOnly)->TestsOfSerial(serial);
-    } catch (const db::StoreError&) {
-    }
-    if (tests.size() >= n) break;
-    std::this_thread::sleep_for(50ms);
-  }
+  eol::testing::WaitUntil(
+      [&] {
+        // Read-only: a reader that may create would leave an empty file the daemon then
+        // refuses when the test looks before the daemon has made its store (a store still
+        // being made is refused too, and looked at again).
+        try {
+          if (std::filesystem::exists(db_path))
+            tests = db::Store::Open(db_path, db::Store::Role::kReadOnly)->TestsOfSerial(serial);
+        } catch (const db::StoreError&) {
+        }
+        return tests.size() >= n;
+      },
+      120s, 50ms);
   return tests;
 }
 
