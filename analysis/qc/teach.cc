@@ -704,34 +704,102 @@ static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
   return s;
 }
 
-// Measurements taught on ln(1 + x): chi-square-like statistics with a long right tail, which a
-// normal tolerance bound on x itself cuts too short (second_mode_chi2_drop on the line model:
-// 9 of 1783 good units beyond the bound taught on x, about 1 on ln(1 + x)).
-static bool TaughtOnLogScale(std::string_view name) { return name == names::kSecondModeChi2Drop; }
+// The measurement's distribution (teach.h): measurements not about normal are taught on the
+// scale where they are, ln(1 + x) or x^(1/3), and their limits brought back.
+static bool InDomain(names::GoodSpread g, double x) {
+  switch (g) {
+    case names::GoodSpread::kLogOnePlus:
+      return x > -1.0;
+    case names::GoodSpread::kGamma:
+      return x >= 0.0;
+    case names::GoodSpread::kNormal:
+      break;
+  }
+  return true;
+}
 
-static std::vector<GoldenUnit> ToLogScale(std::vector<GoldenUnit> units) {
+static double ToTeachingScale(names::GoodSpread g, double x) {
+  if (!InDomain(g, x)) return std::nan("");
+  switch (g) {
+    case names::GoodSpread::kLogOnePlus:
+      return std::log1p(x);
+    case names::GoodSpread::kGamma:
+      return std::cbrt(x);
+    case names::GoodSpread::kNormal:
+      break;
+  }
+  return x;
+}
+
+static double FromTeachingScale(names::GoodSpread g, double y) {
+  switch (g) {
+    case names::GoodSpread::kLogOnePlus:
+      return std::expm1(y);
+    case names::GoodSpread::kGamma:
+      return y * y * y;
+    case names::GoodSpread::kNormal:
+      break;
+  }
+  return y;
+}
+
+static const char* TeachingScaleName(names::GoodSpread g) {
+  switch (g) {
+    case names::GoodSpread::kLogOnePlus:
+      return "ln(1 + x)";
+    case names::GoodSpread::kGamma:
+      return "x^(1/3): gamma";
+    case names::GoodSpread::kNormal:
+      break;
+  }
+  return "x";
+}
+
+// "" or the first unit whose value lies outside its measurement's family (a negative chi2).
+static std::string OutsideFamily(const std::vector<MeasurementSpec>& declared,
+                                 const std::vector<GoldenUnit>& units, const char* which) {
+  for (const GoldenUnit& u : units)
+    for (const MeasurementSpec& d : declared) {
+      const names::GoodSpread g = names::GoodSpreadOf(d.name);
+      const auto it = u.values.find(d.name);
+      if (it != u.values.end() && std::isfinite(it->second) && !InDomain(g, it->second))
+        return std::string(which) + " unit " + u.label + ": " + d.name + " = " + Num(it->second) +
+               (g == names::GoodSpread::kGamma ? " is negative" : " is -1 or less") +
+               ", outside the distribution teach learns it in (" + TeachingScaleName(g) +
+               ", analysis/qc/measurement_names.h)";
+    }
+  return "";
+}
+
+static std::vector<GoldenUnit> ToTeachingScale(std::vector<GoldenUnit> units) {
   for (GoldenUnit& u : units)
-    for (auto& [name, v] : u.values)
-      if (TaughtOnLogScale(name)) v = v > -1.0 ? std::log1p(v) : std::nan("");
+    for (auto& [name, v] : u.values) v = ToTeachingScale(names::GoodSpreadOf(name), v);
   return units;
 }
 
-// The limits of log-scale measurements back on their own scale (the marginal band keeps its
-// place below the upper bound).
-static void FromLogScale(TeachSummary& s) {
+// The limits back on the measurement's own scale (the marginal band keeps its place inside the
+// upper bound, or the lower one when there is no upper).
+static void FromTeachingScale(TeachSummary& s) {
   for (MeasurementSpec& m : s.limits) {
-    if (!TaughtOnLogScale(m.name)) continue;
-    const double marginal_log = m.limit.marginal;
+    const names::GoodSpread g = names::GoodSpreadOf(m.name);
+    if (g == names::GoodSpread::kNormal) continue;
+    const double marginal = m.limit.marginal;
+    const auto back = [&](double y) { return FromTeachingScale(g, y); };
     if (m.limit.hi) {
-      m.limit.marginal = Round6(std::expm1(*m.limit.hi) - std::expm1(*m.limit.hi - marginal_log));
-      m.limit.hi = Round6(std::expm1(*m.limit.hi));
+      m.limit.marginal = Round6(back(*m.limit.hi) - back(*m.limit.hi - marginal));
+    } else if (m.limit.lo) {
+      m.limit.marginal = Round6(back(*m.limit.lo + marginal) - back(*m.limit.lo));
     }
-    if (m.limit.lo) m.limit.lo = Round6(std::expm1(*m.limit.lo));
+    if (m.limit.hi) m.limit.hi = Round6(back(*m.limit.hi));
+    if (m.limit.lo) m.limit.lo = Round6(back(*m.limit.lo));
   }
   for (TaughtBound& b : s.taught_bounds)
-    if (TaughtOnLogScale(b.statistic)) b.limit = std::expm1(b.limit);
-  for (TaughtStatistic& t : s.statistics)
-    if (TaughtOnLogScale(t.name)) t.name += " (taught on ln(1 + x))";
+    b.limit = FromTeachingScale(names::GoodSpreadOf(b.statistic), b.limit);
+  for (TaughtStatistic& t : s.statistics) {
+    const names::GoodSpread g = names::GoodSpreadOf(t.name);
+    if (g != names::GoodSpread::kNormal)
+      t.name += std::string(" (taught on ") + TeachingScaleName(g) + ")";
+  }
 }
 
 // The pressure-normalised resonance (f0_pressure.h): fitted when f0 has a lower limit and every
@@ -784,7 +852,7 @@ static F0PressureFit FitF0Pressure(const std::vector<MeasurementSpec>& declared,
 // f0 and residue (bond_index.h), then its value is added to every unit and it is taught as
 // any other measurement. So is the pressure-normalised resonance, when the golden units' f0
 // follows their clamp pressure (FitF0Pressure; a limit on it declared by an earlier teaching is
-// taught afresh or dropped). Log-scale measurements are taught on ln(1 + x) (above).
+// taught afresh or dropped). Measurements not about normal are taught on their own scale (above).
 TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared_in,
                          const std::vector<GoldenUnit>& golden, const TeachOptions& o,
                          const std::vector<GoldenUnit>& known_bad) {
@@ -842,11 +910,17 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared_in,
         if (const auto e = BondIndex(values, *index))
           u.values[std::string(names::kBondIndexPct)] = e->value;
       }
-    return ToLogScale(std::move(units));
+    return ToTeachingScale(std::move(units));
   };
+  for (const auto& [units, which] : {std::pair{&golden, "golden"}, {&known_bad, "known-bad"}})
+    if (std::string why = OutsideFamily(declared, *units, which); !why.empty()) {
+      TeachSummary s;
+      s.units_given = static_cast<int>(golden.size());
+      return Fail(s, why);
+    }
   TeachSummary s =
       TeachOnValues(declared, prepared(golden_p), o, prepared(add_f0_at_ref_pressure(known_bad)));
-  FromLogScale(s);
+  FromTeachingScale(s);
   s.bond_index = index;
   s.f0_pressure = f0_pressure;
   return s;
