@@ -64,4 +64,24 @@ constexpr std::string_view UnitOf(std::string_view name) {
   return "";
 }
 
+// How good units' values of a measurement are distributed: the family `eol teach` learns its
+// bounds in (analysis/qc/teach.h, "The measurement's distribution"), declared here with the
+// measurement's unit.
+enum class GoodSpread {
+  kNormal,      // about normal: a physical quantity of the motor (the default)
+  kLogOnePlus,  // positive with a long right tail: ln(1 + x) about normal
+  kGamma,       // positive and right-skewed, a scaled chi-square: a goodness-of-fit statistic
+};
+
+constexpr GoodSpread GoodSpreadOf(std::string_view name) {
+  // fit_chi2_per_dof: chi2 / dof of the one-mode fit, a scaled chi-square where the model holds;
+  // model error that varies from unit to unit keeps it positive and right-skewed.
+  if (name == kFitChi2PerDof) return GoodSpread::kGamma;
+  // second_mode_chi2_drop: the largest likelihood-ratio drop over a search range; its tail is
+  // longer than a gamma's of the same spread (line model and independent generator: ln(1 + x)
+  // about symmetric, skewness 0.0-0.3 against 1.0-1.8 of x).
+  if (name == kSecondModeChi2Drop) return GoodSpread::kLogOnePlus;
+  return GoodSpread::kNormal;
+}
+
 }  // namespace eol::analysis::names

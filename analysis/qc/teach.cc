@@ -220,34 +220,74 @@ bool TeachOptions::IsValid(std::string* why) const {
   return true;
 }
 
-static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
-                                  const std::vector<GoldenUnit>& golden, const TeachOptions& o,
-                                  const std::vector<GoldenUnit>& known_bad) {
-  TeachSummary s;
-  s.units_given = static_cast<int>(golden.size());
-  std::string why;
-  if (!o.IsValid(&why)) return Fail(s, "teach options: " + why);
-  if (declared.empty()) return Fail(s, "the recipe declares no scalar limit to teach");
-  const bool robust = o.method == TeachMethod::kMad;
-  const bool f0_normalised = std::any_of(
-      declared.begin(), declared.end(),
-      [](const MeasurementSpec& d) { return d.name == names::kResonanceFRefPressureHz; });
+namespace {
 
-  // Every golden (and known-bad) unit must carry every declared measurement, finite.
+// A run of mask lines: outside the band where the good units' resonance may lie.
+struct Run {
+  std::string name;
+  std::size_t a = 0, b = 0;  // [a, b) of the grid's lines
+  std::size_t segments = 0;
+};
+
+// A statistic with its centre, scale and the bounds it gets (declared sides only).
+struct Stat {
+  TaughtStatistic t;
+  bool want_lo = false, want_hi = false;
+  double w_lo = 0.0, w_hi = 0.0;  // design weights ("physics")
+  bool defect_lo = false, defect_hi = false;
+  double k_lo = 0.0, k_hi = 0.0;
+};
+
+// The false-reject budget alpha, shared by the bounds in proportion to their weights.
+struct Budget {
+  double alpha = 0.0;
+  double weight_sum = 0.0;
+  bool even = false;
+  double n_eff = 0.0;
+  double confidence = 0.0;
+  std::map<double, double> factors;  // share -> one-sided factor
+
+  double Share(double weight) const { return alpha * weight / weight_sum; }
+  double Factor(double share) {
+    const auto it = factors.find(share);
+    if (it != factors.end()) return it->second;
+    return factors[share] = ToleranceFactorOneSided(n_eff, 1.0 - share, confidence);
+  }
+  // Where a bound of this weight lies (the statistic's lower or upper side).
+  double Lo(const Stat& st, double weight) {
+    return st.t.centre - Factor(Share(weight)) * st.t.scale;
+  }
+  double Hi(const Stat& st, double weight) {
+    return st.t.centre + Factor(Share(weight)) * st.t.scale;
+  }
+};
+
+// Every golden (and known-bad) unit must carry every declared measurement, finite; the reason
+// when not ("" when the inputs may be taught).
+std::string CheckInputs(const std::vector<MeasurementSpec>& declared,
+                        const std::vector<GoldenUnit>& golden, const TeachOptions& o,
+                        const std::vector<GoldenUnit>& known_bad) {
+  std::string why;
+  if (!o.IsValid(&why)) return "teach options: " + why;
+  if (declared.empty()) return "the recipe declares no scalar limit to teach";
   for (const auto* set : {&golden, &known_bad})
     for (const GoldenUnit& u : *set)
       for (const MeasurementSpec& d : declared) {
         const auto it = u.values.find(d.name);
         if (it == u.values.end() || !std::isfinite(it->second))
-          return Fail(s, std::string(set == &golden ? "golden" : "known-bad") + " unit " + u.label +
-                             " has no finite value of " + d.name);
+          return std::string(set == &golden ? "golden" : "known-bad") + " unit " + u.label +
+                 " has no finite value of " + d.name;
       }
   if (!known_bad.empty() && o.allocation != "physics")
-    return Fail(s,
-                "known-bad units need allocation physics (the even split has no share to "
-                "move)");
+    return "known-bad units need allocation physics (the even split has no share to move)";
+  return "";
+}
 
-  // Outliers: robust z over all given units, any measurement.
+// Outliers: robust z over all given units, any measurement. The units kept; the others named
+// in *rejected.
+std::vector<const GoldenUnit*> DropOutliers(const std::vector<MeasurementSpec>& declared,
+                                            const std::vector<GoldenUnit>& golden, double outlier_z,
+                                            std::vector<std::string>* rejected) {
   std::set<std::size_t> out;
   for (const MeasurementSpec& d : declared) {
     std::vector<double> v;
@@ -258,114 +298,103 @@ static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
     if (!(sc > 0.0)) continue;
     for (std::size_t i = 0; i < v.size(); ++i) {
       const double z = std::abs(v[i] - med) / sc;
-      if (z > o.outlier_z && out.insert(i).second)
-        s.rejected.push_back(golden[i].label + ": " + d.name + " = " + Num(v[i]) +
-                             ", robust z = " + Num(z));
+      if (z > outlier_z && out.insert(i).second)
+        rejected->push_back(golden[i].label + ": " + d.name + " = " + Num(v[i]) +
+                            ", robust z = " + Num(z));
     }
   }
   std::vector<const GoldenUnit*> used;
   for (std::size_t i = 0; i < golden.size(); ++i)
     if (!out.count(i)) used.push_back(&golden[i]);
-  s.units_used = static_cast<int>(used.size());
-  const double n = static_cast<double>(used.size());
-  const double n_eff = robust ? kMadEfficiency * n : n;
-  if (n_eff < 2.0 || used.size() < 3)
-    return Fail(s, "too few golden units: " + std::to_string(used.size()) + " used of " +
-                       std::to_string(golden.size()) +
-                       (robust ? " (method mad needs at least 6)" : " (at least 3 needed)"));
+  return used;
+}
 
-  // Masks only when every used unit has a curve on one grid with enough lines.
-  bool with_mask = o.mask_segments > 0;
-  std::string mask_note;
-  if (with_mask) {
-    if (!CommonGrid(used, &why)) {
-      with_mask = false;
-      mask_note = "; no mask taught: " + why;
-    } else if (used.front()->curve.size() < 2 * static_cast<std::size_t>(o.mask_segments)) {
-      with_mask = false;
-      mask_note = "; no mask taught: fewer than 2 lines per segment";
-    }
+// The band [*lo, *hi] where the good units' resonance may lie (teach.h "Curve masks"); false
+// when a unit carries no resonance_f_hz and positive resonance_q.
+bool ResonanceBand(const std::vector<const GoldenUnit*>& used, double* lo, double* hi) {
+  double ex_lo = INFINITY, ex_hi = -INFINITY;
+  std::vector<double> bandwidths;
+  for (const GoldenUnit* u : used) {
+    const auto f0 = u->values.find("resonance_f_hz"), q = u->values.find("resonance_q");
+    if (f0 == u->values.end() || q == u->values.end() || !(q->second > 0.0)) return false;
+    ex_lo = std::min(ex_lo, f0->second);
+    ex_hi = std::max(ex_hi, f0->second);
+    bandwidths.push_back(f0->second / q->second);
   }
+  const double w = 5.0 * Median(bandwidths) + 0.5 * (ex_hi - ex_lo);
+  *lo = ex_lo - w;
+  *hi = ex_hi + w;
+  return true;
+}
 
-  // Runs of mask lines: outside the band where the good units' resonance may lie.
-  struct Run {
-    std::string name;
-    std::size_t a = 0, b = 0;  // [a, b) of the grid's lines
-    std::size_t segments = 0;
-  };
+// The runs of mask lines, each with its share of the segments; empty when no mask is taught
+// (*note says why, or where the masks leave the resonance out).
+std::vector<Run> MaskRuns(const std::vector<const GoldenUnit*>& used, const TeachOptions& o,
+                          std::string* note) {
   std::vector<Run> runs;
-  if (with_mask) {
-    const Frf& grid = used.front()->curve;
-    double ex_lo = INFINITY, ex_hi = -INFINITY;
-    bool resonance = true;
-    std::vector<double> bandwidths;
-    for (const GoldenUnit* u : used) {
-      const auto f0 = u->values.find("resonance_f_hz"), q = u->values.find("resonance_q");
-      if (f0 == u->values.end() || q == u->values.end() || !(q->second > 0.0)) {
-        resonance = false;
-        break;
-      }
-      ex_lo = std::min(ex_lo, f0->second);
-      ex_hi = std::max(ex_hi, f0->second);
-      bandwidths.push_back(f0->second / q->second);
-    }
-    if (resonance) {
-      const double w = 5.0 * Median(bandwidths) + 0.5 * (ex_hi - ex_lo);
-      ex_lo -= w;
-      ex_hi += w;
-      std::size_t k = 0;
-      while (k < grid.size() && grid.freq_hz[k] < ex_lo) ++k;
-      runs.push_back(Run{"re_z_taught_below", 0, k, 0});
-      std::size_t j = k;
-      while (j < grid.size() && grid.freq_hz[j] <= ex_hi) ++j;
-      runs.push_back(Run{"re_z_taught_above", j, grid.size(), 0});
-      mask_note = "; masks exclude " + Num(ex_lo) + "-" + Num(ex_hi) +
-                  " Hz, where the good units' resonance lies (judged by its scalar limits)";
-    } else {
-      runs.push_back(Run{"re_z_taught", 0, grid.size(), 0});
-    }
-    std::erase_if(runs, [](const Run& r) { return r.b < r.a + 4; });
-    std::size_t total = 0;
-    for (const Run& r : runs) total += r.b - r.a;
-    for (Run& r : runs)
-      r.segments = std::clamp<std::size_t>(
-          static_cast<std::size_t>(
-              std::lround(static_cast<double>(o.mask_segments) * static_cast<double>(r.b - r.a) /
-                          static_cast<double>(total))),
-          1, (r.b - r.a) / 2);
-    if (runs.empty()) {
-      with_mask = false;
-      mask_note = "; no mask taught: the resonance band covers the whole curve";
-    }
+  if (o.mask_segments <= 0) return runs;
+  std::string why;
+  if (!CommonGrid(used, &why)) {
+    *note = "; no mask taught: " + why;
+    return runs;
   }
+  const Frf& grid = used.front()->curve;
+  if (grid.size() < 2 * static_cast<std::size_t>(o.mask_segments)) {
+    *note = "; no mask taught: fewer than 2 lines per segment";
+    return runs;
+  }
+  double ex_lo = 0.0, ex_hi = 0.0;
+  if (ResonanceBand(used, &ex_lo, &ex_hi)) {
+    std::size_t k = 0;
+    while (k < grid.size() && grid.freq_hz[k] < ex_lo) ++k;
+    runs.push_back(Run{"re_z_taught_below", 0, k, 0});
+    std::size_t j = k;
+    while (j < grid.size() && grid.freq_hz[j] <= ex_hi) ++j;
+    runs.push_back(Run{"re_z_taught_above", j, grid.size(), 0});
+    *note = "; masks exclude " + Num(ex_lo) + "-" + Num(ex_hi) +
+            " Hz, where the good units' resonance lies (judged by its scalar limits)";
+  } else {
+    runs.push_back(Run{"re_z_taught", 0, grid.size(), 0});
+  }
+  std::erase_if(runs, [](const Run& r) { return r.b < r.a + 4; });
+  std::size_t total = 0;
+  for (const Run& r : runs) total += r.b - r.a;
+  for (Run& r : runs)
+    r.segments = std::clamp<std::size_t>(
+        static_cast<std::size_t>(
+            std::lround(static_cast<double>(o.mask_segments) * static_cast<double>(r.b - r.a) /
+                        static_cast<double>(total))),
+        1, (r.b - r.a) / 2);
+  if (runs.empty()) *note = "; no mask taught: the resonance band covers the whole curve";
+  return runs;
+}
 
-  // Every statistic with its centre, scale and the bounds it gets (declared sides only).
-  struct Stat {
-    TaughtStatistic t;
-    bool want_lo = false, want_hi = false;
-    double w_lo = 0.0, w_hi = 0.0;  // design weights ("physics")
-    bool defect_lo = false, defect_hi = false;
-    double k_lo = 0.0, k_hi = 0.0;
-  };
-  std::vector<Stat> stats;
+// The declared measurements' statistics; "" or the reason none can be learned.
+std::string ScalarStats(const std::vector<MeasurementSpec>& declared,
+                        const std::vector<const GoldenUnit*>& used, bool robust, bool f0_normalised,
+                        std::vector<Stat>* stats) {
   for (const MeasurementSpec& d : declared) {
     std::vector<double> v;
     for (const GoldenUnit* u : used) v.push_back(u->values.at(d.name));
     const CentreScale cs = CentreAndScale(v, robust);
     if (!(cs.scale > 0.0))
-      return Fail(s, "no spread in " + d.name + " among the golden units (" +
-                         std::to_string(used.size()) +
-                         " units, all equal?): a limit cannot be learned from it");
+      return "no spread in " + d.name + " among the golden units (" + std::to_string(used.size()) +
+             " units, all equal?): a limit cannot be learned from it";
     const SideWeights sw = DesignWeights(d.name, f0_normalised);
-    stats.push_back(Stat{TaughtStatistic{d.name, cs.centre, cs.scale, 0.0, 0.0},
-                         d.limit.lo.has_value(), d.limit.hi.has_value(), sw.lo, sw.hi, sw.defect_lo,
-                         sw.defect_hi});
+    stats->push_back(Stat{TaughtStatistic{d.name, cs.centre, cs.scale, 0.0, 0.0},
+                          d.limit.lo.has_value(), d.limit.hi.has_value(), sw.lo, sw.hi,
+                          sw.defect_lo, sw.defect_hi});
   }
-  const std::size_t scalar_count = stats.size();
-  std::size_t mask_segments_total = 0;
-  for (const Run& r : runs) mask_segments_total += r.segments;
+  return "";
+}
+
+// Per mask segment: the units' max Re Z (an upper bound) and min Re Z (a lower one).
+void AddMaskStats(const std::vector<Run>& runs, const std::vector<const GoldenUnit*>& used,
+                  bool robust, std::vector<Stat>* stats) {
+  std::size_t segments_total = 0;
+  for (const Run& r : runs) segments_total += r.segments;
+  const Frf& grid = used.front()->curve;
   for (const Run& run : runs) {
-    const Frf& grid = used.front()->curve;
     const std::size_t lines = run.b - run.a, segs = run.segments;
     for (std::size_t g = 0; g < segs; ++g) {
       const std::size_t a = run.a + g * lines / segs, b = run.a + (g + 1) * lines / segs;
@@ -381,164 +410,190 @@ static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
       }
       const CentreScale hi = CentreAndScale(maxima, robust), lo = CentreAndScale(minima, robust);
       const std::string band = "[" + Num(grid.freq_hz[a]) + "-" + Num(grid.freq_hz[b - 1]) + " Hz]";
-      const double per = 1.0 / static_cast<double>(mask_segments_total);
-      stats.push_back(Stat{TaughtStatistic{run.name + band + " max", hi.centre, hi.scale, 0, 0},
-                           false, true, 0.0, kMaskMaxWeight * per, false, true});
-      stats.push_back(Stat{TaughtStatistic{run.name + band + " min", lo.centre, lo.scale, 0, 0},
-                           true, false, kMaskMinWeight * per, 0.0, false, false});
+      const double per = 1.0 / static_cast<double>(segments_total);
+      stats->push_back(Stat{TaughtStatistic{run.name + band + " max", hi.centre, hi.scale, 0, 0},
+                            false, true, 0.0, kMaskMaxWeight * per, false, true});
+      stats->push_back(Stat{TaughtStatistic{run.name + band + " min", lo.centre, lo.scale, 0, 0},
+                            true, false, kMaskMinWeight * per, 0.0, false, false});
     }
   }
+}
 
-  // The budget: shares and factors.
-  const double alpha = 1.0 - o.coverage;
+// The budget's shares and factors, and the units needed (teach.h); "" or why the golden units
+// are too few.
+std::string SetBudget(TeachSummary& s, const std::vector<Stat>& stats, const TeachOptions& o,
+                      bool robust, Budget* budget) {
+  budget->alpha = 1.0 - o.coverage;
+  budget->confidence = o.confidence;
+  budget->even = o.allocation == "even";
   s.bounds = 0;
-  double weight_sum = 0.0, largest = 0.0;
+  double largest = 0.0;
   for (const Stat& st : stats) {
     s.bounds += (st.want_lo ? 1 : 0) + (st.want_hi ? 1 : 0);
-    weight_sum += (st.want_lo ? st.w_lo : 0.0) + (st.want_hi ? st.w_hi : 0.0);
+    budget->weight_sum += (st.want_lo ? st.w_lo : 0.0) + (st.want_hi ? st.w_hi : 0.0);
     largest = std::max({largest, st.want_lo ? st.w_lo : 0.0, st.want_hi ? st.w_hi : 0.0});
   }
-  const bool even = o.allocation == "even";
+  const double alpha = budget->alpha;
   int needed = 0;
-  if (even) {
+  if (budget->even) {
     s.p_bound = 1.0 - 2.0 * alpha / s.bounds;
-    s.k_factor = ToleranceFactorTwoSided(n_eff, s.p_bound, o.confidence);
+    s.k_factor = ToleranceFactorTwoSided(budget->n_eff, s.p_bound, o.confidence);
     needed = ToleranceUnitsNeeded(s.p_bound, o.confidence, o.width_margin);
     s.units_needed_distribution_free = WilksUnitsNeeded(s.p_bound, o.confidence);
   } else {
-    s.p_bound = 1.0 - alpha * largest / weight_sum;
-    s.k_factor = ToleranceFactorOneSided(n_eff, s.p_bound, o.confidence);
+    s.p_bound = 1.0 - alpha * largest / budget->weight_sum;
+    s.k_factor = ToleranceFactorOneSided(budget->n_eff, s.p_bound, o.confidence);
     needed = OneSidedUnitsNeeded(s.p_bound, o.confidence, o.width_margin);
     s.units_needed_distribution_free = OneSidedWilksUnitsNeeded(s.p_bound, o.confidence);
   }
   s.units_needed = robust ? static_cast<int>(std::ceil(needed / kMadEfficiency)) : needed;
-  if (s.units_used < s.units_needed) {
-    if (!o.allow_few_units)
-      return Fail(s, "too few golden units: " + std::to_string(s.units_used) + " used, " +
-                         std::to_string(s.units_needed) + " needed for limits within " +
-                         Num(100 * o.width_margin) +
-                         " % of those of a known spread (teach anyway with allow_few_units, "
-                         "`eol teach --allow-few-units`)");
-    s.few_units_forced = true;
-  }
-  std::map<double, double> factor_cache;  // share -> one-sided factor
-  auto factor = [&](double share) {
-    const auto it = factor_cache.find(share);
-    if (it != factor_cache.end()) return it->second;
-    return factor_cache[share] = ToleranceFactorOneSided(n_eff, 1.0 - share, o.confidence);
-  };
-  if (!known_bad.empty()) {
-    // teach.h "Known-bad units": scalar bounds at the current weights; which units pass them.
-    auto escapes = [&](std::vector<bool>* caught_by_lo, std::vector<bool>* caught_by_hi) {
-      std::vector<std::string> out;
-      for (const GoldenUnit& u : known_bad) {
-        bool caught = false;
-        for (std::size_t i = 0; i < scalar_count; ++i) {
-          const Stat& st = stats[i];
-          const double v = u.values.at(st.t.name);
-          const bool lo =
-              st.want_lo && v < st.t.centre - factor(alpha * st.w_lo / weight_sum) * st.t.scale;
-          const bool hi =
-              st.want_hi && v > st.t.centre + factor(alpha * st.w_hi / weight_sum) * st.t.scale;
-          if (caught_by_lo && lo) (*caught_by_lo)[i] = true;
-          if (caught_by_hi && hi) (*caught_by_hi)[i] = true;
-          caught = caught || lo || hi;
-        }
-        if (!caught) out.push_back(u.label);
-      }
-      return out;
-    };
-    // The resonance's lower bound that carries the defect share: the pressure-normalised one
-    // when it is declared.
-    const std::string_view f0_name =
-        f0_normalised ? names::kResonanceFRefPressureHz : names::kResonanceFHz;
-    std::size_t f0 = scalar_count;
-    for (std::size_t i = 0; i < scalar_count; ++i)
-      if (stats[i].t.name == f0_name && stats[i].want_lo) f0 = i;
-    std::vector<bool> by_lo(scalar_count, false), by_hi(scalar_count, false);
-    s.known_bad_units = static_cast<int>(known_bad.size());
-    s.known_bad_escapes_budget = escapes(&by_lo, &by_hi);
-    if (f0 < scalar_count) {
-      Stat& f = stats[f0];
-      auto f0_lo = [&](double w) {
-        return f.t.centre - factor(alpha * w / weight_sum) * f.t.scale;
-      };
-      s.f0_lo_budget_hz = f0_lo(f.w_lo);
-      // Donors: defect-side scalar bounds that catch no known-bad unit, down to plausibility.
-      double movable = 0.0;
-      for (std::size_t i = 0; i < scalar_count; ++i) {
-        const Stat& st = stats[i];
-        if (i != f0 && st.want_lo && st.defect_lo && !by_lo[i])
-          movable += o.known_bad_max_donation * std::max(0.0, st.w_lo - kPlausibilityWeight);
-        if (st.want_hi && st.defect_hi && !by_hi[i])
-          movable += o.known_bad_max_donation * std::max(0.0, st.w_hi - kPlausibilityWeight);
-      }
-      // The highest f0 among the escapes the whole movable share can still catch.
-      double target = -INFINITY;
-      const double reach = f0_lo(f.w_lo + movable);
-      for (const GoldenUnit& u : known_bad)
-        if (std::find(s.known_bad_escapes_budget.begin(), s.known_bad_escapes_budget.end(),
-                      u.label) != s.known_bad_escapes_budget.end()) {
-          // A margin of 1e-5 (relative) keeps the unit caught after Round6 writes the limit.
-          const double v = u.values.at(f.t.name) * (1.0 + 1e-5);
-          if (v < reach) target = std::max(target, v);
-        }
-      if (std::isfinite(target) && movable > 0.0) {
-        double lo = 0.0, hi = movable;  // weight moved: f0_lo(w + hi) > target
-        for (int it = 0; it < 50; ++it) {
-          const double mid = 0.5 * (lo + hi);
-          (f0_lo(f.w_lo + mid) > target ? hi : lo) = mid;
-        }
-        // Each donor gives the same fraction of what it may give.
-        const double moved = hi, scale_down = 1.0 - o.known_bad_max_donation * moved / movable;
-        for (std::size_t i = 0; i < scalar_count; ++i) {
-          Stat& st = stats[i];
-          if (i != f0 && st.want_lo && st.defect_lo && !by_lo[i] && st.w_lo > kPlausibilityWeight) {
-            st.w_lo = kPlausibilityWeight + (st.w_lo - kPlausibilityWeight) * scale_down;
-            s.known_bad_donors.push_back(st.t.name + " lo");
-          }
-          if (st.want_hi && st.defect_hi && !by_hi[i] && st.w_hi > kPlausibilityWeight) {
-            st.w_hi = kPlausibilityWeight + (st.w_hi - kPlausibilityWeight) * scale_down;
-            s.known_bad_donors.push_back(st.t.name + " hi");
-          }
-        }
-        f.w_lo += moved;
-        s.known_bad_moved_share = alpha * moved / weight_sum;
-      }
-      s.f0_lo_hz = f0_lo(f.w_lo);
+  if (s.units_used >= s.units_needed) return "";
+  if (!o.allow_few_units)
+    return "too few golden units: " + std::to_string(s.units_used) + " used, " +
+           std::to_string(s.units_needed) + " needed for limits within " +
+           Num(100 * o.width_margin) +
+           " % of those of a known spread (teach anyway with allow_few_units, "
+           "`eol teach --allow-few-units`)";
+  s.few_units_forced = true;
+  return "";
+}
+
+// The known-bad units that pass every scalar bound at the current weights; which bounds caught
+// the others (by_lo, by_hi per scalar statistic, when given).
+std::vector<std::string> KnownBadEscapes(const std::vector<GoldenUnit>& known_bad,
+                                         const std::vector<Stat>& stats, std::size_t scalar_count,
+                                         Budget& budget, std::vector<bool>* by_lo,
+                                         std::vector<bool>* by_hi) {
+  std::vector<std::string> out;
+  for (const GoldenUnit& u : known_bad) {
+    bool caught = false;
+    for (std::size_t i = 0; i < scalar_count; ++i) {
+      const Stat& st = stats[i];
+      const double v = u.values.at(st.t.name);
+      const bool lo = st.want_lo && v < budget.Lo(st, st.w_lo);
+      const bool hi = st.want_hi && v > budget.Hi(st, st.w_hi);
+      if (by_lo && lo) (*by_lo)[i] = true;
+      if (by_hi && hi) (*by_hi)[i] = true;
+      caught = caught || lo || hi;
     }
-    s.known_bad_escapes = escapes(nullptr, nullptr);
+    if (!caught) out.push_back(u.label);
   }
+  return out;
+}
+
+// The weight the known-bad units' donors may give (teach.h "Known-bad units"): defect-side
+// scalar bounds that catch none of them, down to plausibility. Applies `scale_down` to their
+// weights instead (naming them in *donors) when that is given.
+double DonorWeight(std::vector<Stat>& stats, std::size_t scalar_count, std::size_t f0,
+                   const std::vector<bool>& by_lo, const std::vector<bool>& by_hi,
+                   double max_donation, const double* scale_down,
+                   std::vector<std::string>* donors) {
+  double movable = 0.0;
+  auto give = [&](const Stat& st, double& w, const char* side) {
+    if (!scale_down) {
+      movable += max_donation * std::max(0.0, w - kPlausibilityWeight);
+    } else if (w > kPlausibilityWeight) {
+      w = kPlausibilityWeight + (w - kPlausibilityWeight) * *scale_down;
+      donors->push_back(st.t.name + side);
+    }
+  };
+  for (std::size_t i = 0; i < scalar_count; ++i) {
+    Stat& st = stats[i];
+    if (i != f0 && st.want_lo && st.defect_lo && !by_lo[i]) give(st, st.w_lo, " lo");
+    if (st.want_hi && st.defect_hi && !by_hi[i]) give(st, st.w_hi, " hi");
+  }
+  return movable;
+}
+
+// Known-bad units (teach.h): the f0 lower bound takes as much of the donors' share as makes it
+// catch every escape it can.
+void MoveShareToF0(TeachSummary& s, std::vector<Stat>& stats, std::size_t scalar_count,
+                   const std::vector<GoldenUnit>& known_bad, const TeachOptions& o,
+                   bool f0_normalised, Budget& budget) {
+  // The resonance's lower bound that carries the defect share: the pressure-normalised one
+  // when it is declared.
+  const std::string_view f0_name =
+      f0_normalised ? names::kResonanceFRefPressureHz : names::kResonanceFHz;
+  std::size_t f0 = scalar_count;
+  for (std::size_t i = 0; i < scalar_count; ++i)
+    if (stats[i].t.name == f0_name && stats[i].want_lo) f0 = i;
+  std::vector<bool> by_lo(scalar_count, false), by_hi(scalar_count, false);
+  s.known_bad_units = static_cast<int>(known_bad.size());
+  s.known_bad_escapes_budget =
+      KnownBadEscapes(known_bad, stats, scalar_count, budget, &by_lo, &by_hi);
+  if (f0 < scalar_count) {
+    Stat& f = stats[f0];
+    s.f0_lo_budget_hz = budget.Lo(f, f.w_lo);
+    const double movable = DonorWeight(stats, scalar_count, f0, by_lo, by_hi,
+                                       o.known_bad_max_donation, nullptr, nullptr);
+    // The highest f0 among the escapes the whole movable share can still catch.
+    double target = -INFINITY;
+    const double reach = budget.Lo(f, f.w_lo + movable);
+    for (const GoldenUnit& u : known_bad)
+      if (std::find(s.known_bad_escapes_budget.begin(), s.known_bad_escapes_budget.end(),
+                    u.label) != s.known_bad_escapes_budget.end()) {
+        // A margin of 1e-5 (relative) keeps the unit caught after Round6 writes the limit.
+        const double v = u.values.at(f.t.name) * (1.0 + 1e-5);
+        if (v < reach) target = std::max(target, v);
+      }
+    if (std::isfinite(target) && movable > 0.0) {
+      double lo = 0.0, hi = movable;  // weight moved: Lo(w + hi) > target
+      for (int it = 0; it < 50; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (budget.Lo(f, f.w_lo + mid) > target ? hi : lo) = mid;
+      }
+      // Each donor gives the same fraction of what it may give.
+      const double moved = hi, scale_down = 1.0 - o.known_bad_max_donation * moved / movable;
+      DonorWeight(stats, scalar_count, f0, by_lo, by_hi, o.known_bad_max_donation, &scale_down,
+                  &s.known_bad_donors);
+      f.w_lo += moved;
+      s.known_bad_moved_share = budget.Share(moved);
+    }
+    s.f0_lo_hz = budget.Lo(f, f.w_lo);
+  }
+  s.known_bad_escapes = KnownBadEscapes(known_bad, stats, scalar_count, budget, nullptr, nullptr);
+}
+
+// Every statistic's bounds at its final share, and the bounds taught.
+void SetBounds(TeachSummary& s, std::vector<Stat>& stats, Budget& budget) {
+  const bool even = budget.even;
   for (Stat& st : stats) {
-    const double share_lo = even ? 0.0 : alpha * st.w_lo / weight_sum;
-    const double share_hi = even ? 0.0 : alpha * st.w_hi / weight_sum;
-    st.k_lo = even ? s.k_factor : (st.want_lo ? factor(share_lo) : 0.0);
-    st.k_hi = even ? s.k_factor : (st.want_hi ? factor(share_hi) : 0.0);
+    const double share_lo = even ? 0.0 : budget.Share(st.w_lo);
+    const double share_hi = even ? 0.0 : budget.Share(st.w_hi);
+    st.k_lo = even ? s.k_factor : (st.want_lo ? budget.Factor(share_lo) : 0.0);
+    st.k_hi = even ? s.k_factor : (st.want_hi ? budget.Factor(share_hi) : 0.0);
     st.t.lo = st.t.centre - st.k_lo * st.t.scale;
     st.t.hi = st.t.centre + st.k_hi * st.t.scale;
+    const double even_share = 2.0 * budget.alpha / s.bounds;
     if (st.want_lo)
       s.taught_bounds.push_back(TaughtBound{st.t.name, true, st.defect_lo,
-                                            even ? 2.0 * alpha / s.bounds : share_lo, st.k_lo,
-                                            st.t.lo});
+                                            even ? even_share : share_lo, st.k_lo, st.t.lo});
     if (st.want_hi)
       s.taught_bounds.push_back(TaughtBound{st.t.name, false, st.defect_hi,
-                                            even ? 2.0 * alpha / s.bounds : share_hi, st.k_hi,
-                                            st.t.hi});
+                                            even ? even_share : share_hi, st.k_hi, st.t.hi});
   }
+}
 
-  for (std::size_t i = 0; i < scalar_count; ++i) {
+// The declared limits with the learned bounds (the statistics in *s too).
+void WriteLimits(TeachSummary& s, const std::vector<MeasurementSpec>& declared,
+                 const std::vector<Stat>& stats, double marginal_scales) {
+  for (std::size_t i = 0; i < declared.size(); ++i) {
     const TaughtStatistic& t = stats[i].t;
     MeasurementSpec spec = declared[i];
     if (spec.limit.lo) spec.limit.lo = Round6(t.lo);
     if (spec.limit.hi) spec.limit.hi = Round6(t.hi);
-    spec.limit.marginal = Round6(o.marginal_scales * t.scale);
+    spec.limit.marginal = Round6(marginal_scales * t.scale);
     s.limits.push_back(spec);
   }
   for (const Stat& st : stats) s.statistics.push_back(st.t);
+}
 
+// Each run's mask: two points per segment (its first and last line) with its flat band.
+std::string WriteMasks(TeachSummary& s, const std::vector<Run>& runs, const Frf& grid,
+                       const std::vector<Stat>& stats, std::size_t scalar_count,
+                       const TeachOptions& o) {
   std::size_t next = scalar_count;
   for (const Run& run : runs) {
-    const Frf& grid = used.front()->curve;
     const std::size_t lines = run.b - run.a, segs = run.segments;
     CurveMask mask;
     mask.name = run.name;
@@ -552,76 +607,199 @@ static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
       for (std::size_t k : {a, b - 1})
         mask.points.push_back(MaskPoint{grid.freq_hz[k], lo_v, hi_v});
     }
-    if (!mask.IsValid(&why)) return Fail(s, "taught mask " + mask.name + " is not valid: " + why);
+    std::string why;
+    if (!mask.IsValid(&why)) return "taught mask " + mask.name + " is not valid: " + why;
     s.masks.push_back(mask);
   }
-  ExpectedFalseReject(s, used.size(), o.confidence);
+  return "";
+}
 
-  s.usable = true;
-  const std::string budget = even ? std::to_string(s.bounds) + " bounds (" + Num(s.p_bound) +
-                                        " each): k = " + Num(s.k_factor)
-                                  : std::to_string(s.bounds) +
-                                        " bounds, shared by physics (largest share " +
-                                        Num(1.0 - s.p_bound) + ": k = " + Num(s.k_factor) + ")";
-  s.message = std::string("method ") + ToString(o.method) + ", allocation " + o.allocation + ", " +
-              std::to_string(s.units_used) + " of " + std::to_string(s.units_given) +
-              " golden units used (" + std::to_string(s.rejected.size()) +
-              " rejected as outliers), false-reject target " + Num(100 * alpha) + " % over " +
-              budget + " at confidence " + Num(o.confidence) + "; expected false rejects " +
-              Num(100 * s.expected_false_reject) + " % (" + Num(100 * o.confidence) +
-              " % interval " + Num(100 * s.false_reject_lo) + "-" + Num(100 * s.false_reject_hi) +
-              " %); " + std::to_string(s.units_needed) + " units needed for limits within " +
-              Num(100 * o.width_margin) + " % of a known spread (" +
-              std::to_string(s.units_needed_distribution_free) + " distribution-free)" + mask_note;
+// The summary's sentence: what was used, the budget, the expected false rejects, the units
+// needed, the masks and the known-bad units.
+std::string Message(const TeachSummary& s, const TeachOptions& o, const std::string& mask_note) {
+  const double alpha = 1.0 - o.coverage;
+  const std::string budget = o.allocation == "even"
+                                 ? std::to_string(s.bounds) + " bounds (" + Num(s.p_bound) +
+                                       " each): k = " + Num(s.k_factor)
+                                 : std::to_string(s.bounds) +
+                                       " bounds, shared by physics (largest share " +
+                                       Num(1.0 - s.p_bound) + ": k = " + Num(s.k_factor) + ")";
+  std::string m = std::string("method ") + ToString(o.method) + ", allocation " + o.allocation +
+                  ", " + std::to_string(s.units_used) + " of " + std::to_string(s.units_given) +
+                  " golden units used (" + std::to_string(s.rejected.size()) +
+                  " rejected as outliers), false-reject target " + Num(100 * alpha) + " % over " +
+                  budget + " at confidence " + Num(o.confidence) + "; expected false rejects " +
+                  Num(100 * s.expected_false_reject) + " % (" + Num(100 * o.confidence) +
+                  " % interval " + Num(100 * s.false_reject_lo) + "-" +
+                  Num(100 * s.false_reject_hi) + " %); " + std::to_string(s.units_needed) +
+                  " units needed for limits within " + Num(100 * o.width_margin) +
+                  " % of a known spread (" + std::to_string(s.units_needed_distribution_free) +
+                  " distribution-free)" + mask_note;
   if (s.known_bad_units > 0) {
-    s.message += "; known-bad units: " + std::to_string(s.known_bad_units) + ", " +
-                 std::to_string(s.known_bad_escapes_budget.size()) +
-                 " pass the limits the budget alone sets";
+    m += "; known-bad units: " + std::to_string(s.known_bad_units) + ", " +
+         std::to_string(s.known_bad_escapes_budget.size()) +
+         " pass the limits the budget alone sets";
     if (s.known_bad_moved_share > 0.0)
-      s.message += ", f0 lower bound raised from " + Num(s.f0_lo_budget_hz) + " to " +
-                   Num(s.f0_lo_hz) + " Hz by moving share " + Num(s.known_bad_moved_share) +
-                   " of the budget from bounds that catch none of them (" +
-                   std::to_string(s.known_bad_donors.size()) + ")";
-    s.message += ", " + std::to_string(s.known_bad_escapes.size()) + " pass the taught limits";
+      m += ", f0 lower bound raised from " + Num(s.f0_lo_budget_hz) + " to " + Num(s.f0_lo_hz) +
+           " Hz by moving share " + Num(s.known_bad_moved_share) +
+           " of the budget from bounds that catch none of them (" +
+           std::to_string(s.known_bad_donors.size()) + ")";
+    m += ", " + std::to_string(s.known_bad_escapes.size()) + " pass the taught limits";
     if (!s.known_bad_escapes.empty())
-      s.message += " (no bound within the budget catches them: " + s.known_bad_escapes.front() +
-                   (s.known_bad_escapes.size() > 1 ? ", ..." : "") + ")";
+      m += " (no bound within the budget catches them: " + s.known_bad_escapes.front() +
+           (s.known_bad_escapes.size() > 1 ? ", ..." : "") + ")";
   }
   if (s.few_units_forced)
-    s.message +=
-        "; WARNING: taught from fewer golden units than needed (forced), the limits "
-        "are wide";
+    m += "; WARNING: taught from fewer golden units than needed (forced), the limits are wide";
+  return m;
+}
+
+}  // namespace
+
+static TeachSummary TeachOnValues(const std::vector<MeasurementSpec>& declared,
+                                  const std::vector<GoldenUnit>& golden, const TeachOptions& o,
+                                  const std::vector<GoldenUnit>& known_bad) {
+  TeachSummary s;
+  s.units_given = static_cast<int>(golden.size());
+  if (const std::string why = CheckInputs(declared, golden, o, known_bad); !why.empty())
+    return Fail(s, why);
+  const bool robust = o.method == TeachMethod::kMad;
+  const bool f0_normalised = std::any_of(
+      declared.begin(), declared.end(),
+      [](const MeasurementSpec& d) { return d.name == names::kResonanceFRefPressureHz; });
+
+  const std::vector<const GoldenUnit*> used =
+      DropOutliers(declared, golden, o.outlier_z, &s.rejected);
+  s.units_used = static_cast<int>(used.size());
+  const double n = static_cast<double>(used.size());
+  Budget budget;
+  budget.n_eff = robust ? kMadEfficiency * n : n;
+  if (budget.n_eff < 2.0 || used.size() < 3)
+    return Fail(s, "too few golden units: " + std::to_string(used.size()) + " used of " +
+                       std::to_string(golden.size()) +
+                       (robust ? " (method mad needs at least 6)" : " (at least 3 needed)"));
+
+  std::string mask_note;
+  const std::vector<Run> runs = MaskRuns(used, o, &mask_note);
+  std::vector<Stat> stats;
+  if (const std::string why = ScalarStats(declared, used, robust, f0_normalised, &stats);
+      !why.empty())
+    return Fail(s, why);
+  const std::size_t scalar_count = stats.size();
+  AddMaskStats(runs, used, robust, &stats);
+
+  if (const std::string why = SetBudget(s, stats, o, robust, &budget); !why.empty())
+    return Fail(s, why);
+  if (!known_bad.empty())
+    MoveShareToF0(s, stats, scalar_count, known_bad, o, f0_normalised, budget);
+  SetBounds(s, stats, budget);
+  WriteLimits(s, declared, stats, o.marginal_scales);
+  if (!runs.empty())
+    if (const std::string why = WriteMasks(s, runs, used.front()->curve, stats, scalar_count, o);
+        !why.empty())
+      return Fail(s, why);
+  ExpectedFalseReject(s, used.size(), o.confidence);
+  s.usable = true;
+  s.message = Message(s, o, mask_note);
   return s;
 }
 
-// Measurements taught on ln(1 + x): chi-square-like statistics with a long right tail, which a
-// normal tolerance bound on x itself cuts too short (second_mode_chi2_drop on the line model:
-// 9 of 1783 good units beyond the bound taught on x, about 1 on ln(1 + x)).
-static bool TaughtOnLogScale(std::string_view name) { return name == names::kSecondModeChi2Drop; }
+// The measurement's distribution (teach.h): measurements not about normal are taught on the
+// scale where they are, ln(1 + x) or x^(1/3), and their limits brought back.
+static bool InDomain(names::GoodSpread g, double x) {
+  switch (g) {
+    case names::GoodSpread::kLogOnePlus:
+      return x > -1.0;
+    case names::GoodSpread::kGamma:
+      return x >= 0.0;
+    case names::GoodSpread::kNormal:
+      break;
+  }
+  return true;
+}
 
-static std::vector<GoldenUnit> ToLogScale(std::vector<GoldenUnit> units) {
+static double ToTeachingScale(names::GoodSpread g, double x) {
+  if (!InDomain(g, x)) return std::nan("");
+  switch (g) {
+    case names::GoodSpread::kLogOnePlus:
+      return std::log1p(x);
+    case names::GoodSpread::kGamma:
+      return std::cbrt(x);
+    case names::GoodSpread::kNormal:
+      break;
+  }
+  return x;
+}
+
+static double FromTeachingScale(names::GoodSpread g, double y) {
+  switch (g) {
+    case names::GoodSpread::kLogOnePlus:
+      return std::expm1(y);
+    case names::GoodSpread::kGamma:
+      return y * y * y;
+    case names::GoodSpread::kNormal:
+      break;
+  }
+  return y;
+}
+
+static const char* TeachingScaleName(names::GoodSpread g) {
+  switch (g) {
+    case names::GoodSpread::kLogOnePlus:
+      return "ln(1 + x)";
+    case names::GoodSpread::kGamma:
+      return "x^(1/3): gamma";
+    case names::GoodSpread::kNormal:
+      break;
+  }
+  return "x";
+}
+
+// "" or the first unit whose value lies outside its measurement's family (a negative chi2).
+static std::string OutsideFamily(const std::vector<MeasurementSpec>& declared,
+                                 const std::vector<GoldenUnit>& units, const char* which) {
+  for (const GoldenUnit& u : units)
+    for (const MeasurementSpec& d : declared) {
+      const names::GoodSpread g = names::GoodSpreadOf(d.name);
+      const auto it = u.values.find(d.name);
+      if (it != u.values.end() && std::isfinite(it->second) && !InDomain(g, it->second))
+        return std::string(which) + " unit " + u.label + ": " + d.name + " = " + Num(it->second) +
+               (g == names::GoodSpread::kGamma ? " is negative" : " is -1 or less") +
+               ", outside the distribution teach learns it in (" + TeachingScaleName(g) +
+               ", analysis/qc/measurement_names.h)";
+    }
+  return "";
+}
+
+static std::vector<GoldenUnit> ToTeachingScale(std::vector<GoldenUnit> units) {
   for (GoldenUnit& u : units)
-    for (auto& [name, v] : u.values)
-      if (TaughtOnLogScale(name)) v = v > -1.0 ? std::log1p(v) : std::nan("");
+    for (auto& [name, v] : u.values) v = ToTeachingScale(names::GoodSpreadOf(name), v);
   return units;
 }
 
-// The limits of log-scale measurements back on their own scale (the marginal band keeps its
-// place below the upper bound).
-static void FromLogScale(TeachSummary& s) {
+// The limits back on the measurement's own scale (the marginal band keeps its place inside the
+// upper bound, or the lower one when there is no upper).
+static void FromTeachingScale(TeachSummary& s) {
   for (MeasurementSpec& m : s.limits) {
-    if (!TaughtOnLogScale(m.name)) continue;
-    const double marginal_log = m.limit.marginal;
+    const names::GoodSpread g = names::GoodSpreadOf(m.name);
+    if (g == names::GoodSpread::kNormal) continue;
+    const double marginal = m.limit.marginal;
+    const auto back = [&](double y) { return FromTeachingScale(g, y); };
     if (m.limit.hi) {
-      m.limit.marginal = Round6(std::expm1(*m.limit.hi) - std::expm1(*m.limit.hi - marginal_log));
-      m.limit.hi = Round6(std::expm1(*m.limit.hi));
+      m.limit.marginal = Round6(back(*m.limit.hi) - back(*m.limit.hi - marginal));
+    } else if (m.limit.lo) {
+      m.limit.marginal = Round6(back(*m.limit.lo + marginal) - back(*m.limit.lo));
     }
-    if (m.limit.lo) m.limit.lo = Round6(std::expm1(*m.limit.lo));
+    if (m.limit.hi) m.limit.hi = Round6(back(*m.limit.hi));
+    if (m.limit.lo) m.limit.lo = Round6(back(*m.limit.lo));
   }
   for (TaughtBound& b : s.taught_bounds)
-    if (TaughtOnLogScale(b.statistic)) b.limit = std::expm1(b.limit);
-  for (TaughtStatistic& t : s.statistics)
-    if (TaughtOnLogScale(t.name)) t.name += " (taught on ln(1 + x))";
+    b.limit = FromTeachingScale(names::GoodSpreadOf(b.statistic), b.limit);
+  for (TaughtStatistic& t : s.statistics) {
+    const names::GoodSpread g = names::GoodSpreadOf(t.name);
+    if (g != names::GoodSpread::kNormal)
+      t.name += std::string(" (taught on ") + TeachingScaleName(g) + ")";
+  }
 }
 
 // The pressure-normalised resonance (f0_pressure.h): fitted when f0 has a lower limit and every
@@ -674,7 +852,7 @@ static F0PressureFit FitF0Pressure(const std::vector<MeasurementSpec>& declared,
 // f0 and residue (bond_index.h), then its value is added to every unit and it is taught as
 // any other measurement. So is the pressure-normalised resonance, when the golden units' f0
 // follows their clamp pressure (FitF0Pressure; a limit on it declared by an earlier teaching is
-// taught afresh or dropped). Log-scale measurements are taught on ln(1 + x) (above).
+// taught afresh or dropped). Measurements not about normal are taught on their own scale (above).
 TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared_in,
                          const std::vector<GoldenUnit>& golden, const TeachOptions& o,
                          const std::vector<GoldenUnit>& known_bad) {
@@ -732,11 +910,17 @@ TeachSummary TeachLimits(const std::vector<MeasurementSpec>& declared_in,
         if (const auto e = BondIndex(values, *index))
           u.values[std::string(names::kBondIndexPct)] = e->value;
       }
-    return ToLogScale(std::move(units));
+    return ToTeachingScale(std::move(units));
   };
+  for (const auto& [units, which] : {std::pair{&golden, "golden"}, {&known_bad, "known-bad"}})
+    if (std::string why = OutsideFamily(declared, *units, which); !why.empty()) {
+      TeachSummary s;
+      s.units_given = static_cast<int>(golden.size());
+      return Fail(s, why);
+    }
   TeachSummary s =
       TeachOnValues(declared, prepared(golden_p), o, prepared(add_f0_at_ref_pressure(known_bad)));
-  FromLogScale(s);
+  FromTeachingScale(s);
   s.bond_index = index;
   s.f0_pressure = f0_pressure;
   return s;

@@ -136,10 +136,14 @@ int RunTeach(const TeachArgs& a) {
     auto bound = [](const std::optional<double>& v) {
       return v ? json(*v).dump() : std::string("-");
     };
+    // Centre and scale on the scale it was taught on (" (taught on ln(1 + x))", teach.h).
+    const std::string& stat = s.statistics[i].name;
+    const std::string scale_taught =
+        stat.size() > s.limits[i].name.size() ? stat.substr(s.limits[i].name.size()) : "";
     std::cout << "  " << s.limits[i].name << ": [" << bound(old.lo) << ", " << bound(old.hi)
               << "] -> [" << bound(now.lo) << ", " << bound(now.hi) << "], marginal "
               << now.marginal << " (centre " << s.statistics[i].centre << ", scale "
-              << s.statistics[i].scale << ")\n";
+              << s.statistics[i].scale << scale_taught << ")\n";
   }
   std::cout << "expected false rejects " << 100.0 * s.expected_false_reject << " % ("
             << 100.0 * a.options.confidence << " % interval " << 100.0 * s.false_reject_lo << "-"
