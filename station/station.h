@@ -39,8 +39,10 @@ class Station {
   // With "variants" (station/variants.h) every variant's recipe must load and be approved: one
   // that does not (a proposal) throws io::ConfigError naming the variant and the file, and two
   // variants of one recipe id are refused; there is no last-good fallback for them.
-  // `bench`: a simulated bench shared with a fixture emulator (the demo); normally null.
-  explicit Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench = nullptr);
+  // `drivers`: made by the caller (the demo's share one simulated bench with a fixture
+  // emulator), both or neither; when empty they are made from the config's "fixture" and "daq"
+  // (drivers/factory/factory.h).
+  explicit Station(StationConfig config, drivers::DriverSet drivers = {});
   ~Station();
   Station(const Station&) = delete;
   Station& operator=(const Station&) = delete;
@@ -88,7 +90,6 @@ class Station {
   RecipeChange ChangeRecipe(const nlohmann::json& recipe, const ApiToken& who);
   const StationConfig& config() const { return config_; }
   StatusBoard& board() { return *board_; }
-  drivers::SimBench* bench() { return drivers_.bench.get(); }
   db::Store& store() { return *store_; }
 
   // ---- Plant integration (issue 15) ----

@@ -9,8 +9,8 @@
 #include <thread>
 
 #include "../support/child_process.h"
+#include "station/reports/stats_report.h"
 #include "station/station.h"
-#include "station/stats_report.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -58,7 +58,12 @@ class SelfCheckTest : public ::testing::Test {
 
 TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) {
   {
-    Station s(Config(true));
+    // The bench made here, so the test can see the clamp command never went out.
+    StationConfig config = Config(true);
+    auto bench = std::make_shared<drivers::SimBench>(
+        drivers::ParseSimBenchSettings(io::JsonObject(config.drivers["sim"], "/sim")));
+    drivers::DriverSet drivers = drivers::MakeDrivers(config.drivers, bench);
+    Station s(std::move(config), std::move(drivers));
     ASSERT_TRUE(Lockout(s).at("locked").get<bool>());
     EXPECT_NE(
         Lockout(s)["reason"].get<std::string>().find("no self-check of the good master MASTER-G"),
@@ -70,7 +75,7 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
     EXPECT_EQ(refused.reasons.front().text.rfind("station locked out: no self-check", 0), 0u)
         << Reasons(refused);
     EXPECT_TRUE(s.store().TestsOfSerial("U-1").empty());
-    EXPECT_FALSE(s.bench()->output(drivers::FixtureOutput::kClampCmd));
+    EXPECT_FALSE(bench->output(drivers::FixtureOutput::kClampCmd));
 
     const db::TestRecord good = s.RunTest("MASTER-G");
     EXPECT_EQ(good.outcome, Outcome::kPass) << Reasons(good);
