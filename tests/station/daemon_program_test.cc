@@ -30,12 +30,12 @@ using eol::testing::TempDir;
 
 const std::string kDaemon = (fs::path(EOL_BINARY).parent_path() / "eol-station").string();
 
-struct Run {
+struct ProgramRun {
   int code = -1;
   std::string out;
 };
 
-Run Start(std::vector<std::string> args) {
+ProgramRun Start(std::vector<std::string> args) {
   ChildProcess p(args, /*merge_stderr=*/true);
   return {p.Wait(60s).value_or(-1), p.output()};
 }
@@ -73,15 +73,15 @@ nlohmann::json Config(const TempDir& dir, const std::string& fixture_driver) {
 }
 
 TEST(DaemonProgram, HasTheOptionsOfEolStation) {
-  const Run daemon = Start({kDaemon, "--help"});
-  const Run alias = Start({EOL_BINARY, "station", "--help"});
+  const ProgramRun daemon = Start({kDaemon, "--help"});
+  const ProgramRun alias = Start({EOL_BINARY, "station", "--help"});
   ASSERT_EQ(daemon.code, 0) << daemon.out;
   ASSERT_EQ(alias.code, 0) << alias.out;
   const std::set<std::string> want = {"--config", "--web-root", "--init-store"};
   EXPECT_EQ(Options(daemon.out), want) << daemon.out;
   EXPECT_EQ(Options(alias.out), want) << alias.out;
   EXPECT_EQ(Start({kDaemon}).code, 2);  // --config is required, as for `eol station`
-  const Run version = Start({kDaemon, "--version"});
+  const ProgramRun version = Start({kDaemon, "--version"});
   EXPECT_EQ(version.code, 0);
   EXPECT_EQ(version.out, Start({EOL_BINARY, "--version"}).out);
 }
@@ -91,8 +91,8 @@ TEST(DaemonProgram, AConfigErrorIsExit78AsForEolStation) {
   nlohmann::json config = Config(dir, "modbus-tcp");
   config["recipe"] = dir / "missing.json";
   std::ofstream(dir / "station.json") << config.dump();
-  const Run daemon = Start({kDaemon, "--config", dir / "station.json"});
-  const Run alias = Start({EOL_BINARY, "station", "--config", dir / "station.json"});
+  const ProgramRun daemon = Start({kDaemon, "--config", dir / "station.json"});
+  const ProgramRun alias = Start({EOL_BINARY, "station", "--config", dir / "station.json"});
   EXPECT_EQ(daemon.code, 78) << daemon.out;
   EXPECT_EQ(alias.code, 78) << alias.out;
   const std::string error = LineWith(daemon.out, "eol station: configuration error: ");
@@ -103,7 +103,7 @@ TEST(DaemonProgram, AConfigErrorIsExit78AsForEolStation) {
 TEST(DaemonProgram, RefusesASimulatedDriverNamingWhereTheSimulatorsAre) {
   TempDir dir;
   std::ofstream(dir / "station.json") << Config(dir, "sim").dump();
-  const Run daemon = Start({kDaemon, "--config", dir / "station.json"});
+  const ProgramRun daemon = Start({kDaemon, "--config", dir / "station.json"});
   EXPECT_EQ(daemon.code, 78) << daemon.out;
   EXPECT_NE(daemon.out.find("/fixture/driver: the sim driver is not in this program"),
             std::string::npos)
@@ -117,8 +117,8 @@ TEST(DaemonProgram, TestsAUnitOverModbusWithAReplayedRecording) {
                          "--format", "recording", "--model", "steady_state", "--seed", "1", "--out",
                          dir / "rec.csv"});
   ASSERT_EQ(simulate.Wait(120s).value_or(-1), 0) << simulate.output();
-  ChildProcess fixture(
-      {EOL_BINARY, "fixture-sim", "--port", "0", "--ready-file", dir / "fixture.port"});
+  ChildProcess fixture({EOL_BINARY, "fixture-sim", "--port", "0", "--ready-file",
+                        dir / "fixture.port", "--part", "HW-0001"});
   ASSERT_TRUE(
       fixture.WaitFor([&](const std::string&) { return fs::exists(dir / "fixture.port"); }, 30s))
       << fixture.output();
