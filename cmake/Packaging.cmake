@@ -1,6 +1,7 @@
 # Installation layout and the Debian package (cpack -G DEB, or `cmake --build build --target
 # package`). See deploy/OPERATIONS.md "Installing on a station PC".
-#   /usr/bin/eol                              the program
+#   /usr/bin/eol-station                      the daemon (what the unit runs)
+#   /usr/bin/eol                              the tool: every command, `eol station` too
 #   /usr/share/man/man1/eol.1.gz              its manual page (cmake/ManPage.cmake)
 #   /usr/share/eol/recipes/, /usr/share/eol/web/   shipped recipes, the operator and engineer pages
 #   /usr/share/eol/bench/                     the SciPy peer of `eol fit-bench`
@@ -9,7 +10,7 @@
 #   /var/lib/eol/                             records and the recipes in use (made by postinst)
 include(GNUInstallDirs)
 include(${CMAKE_CURRENT_LIST_DIR}/ManPage.cmake)  # share/man/man1/eol.1.gz
-install(TARGETS eol RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(TARGETS eol eol-station RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/recipes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/eol/recipes)
 install(FILES ${PROJECT_SOURCE_DIR}/station/web/index.html ${PROJECT_SOURCE_DIR}/station/web/app.js
               ${PROJECT_SOURCE_DIR}/station/web/style.css

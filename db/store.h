@@ -172,8 +172,8 @@ struct MeasurementRow {
   std::optional<double> hi;
 };
 
-// What yield counts of each finished (or aborted) test (station/yield.h), without the record
-// JSON: identity, outcome, reasons, the first test's link and the recipe.
+// What yield counts of each finished (or aborted) test (station/reports/yield.h), without the
+// record JSON: identity, outcome, reasons, the first test's link and the recipe.
 struct OutcomeQuery {
   std::optional<std::string> from;  // ISO 8601, inclusive, on started_at
   std::optional<std::string> to;    // exclusive

@@ -7,10 +7,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "db/serial_number.h"
 #include "drivers/io/json_config.h"
 #include "station/plant_urls.h"
 #include "station/reason_cause.h"
-#include "station/serial_number.h"
 #include "station/variants.h"
 
 namespace eol::station {
@@ -142,8 +142,8 @@ static void ParseSelfCheck(const io::JsonObject& sc, StationConfig& c) {
   k.every_n_tests = sc.Integer("every_n_tests", k.every_n_tests);
   k.every_hours = sc.Number("every_hours", k.every_hours);
   std::string why;
-  sc.Require(ValidSerial(k.good_master, &why), "good_master", why);
-  sc.Require(ValidSerial(k.limit_master, &why), "limit_master", why);
+  sc.Require(db::ValidSerial(k.good_master, &why), "good_master", why);
+  sc.Require(db::ValidSerial(k.limit_master, &why), "limit_master", why);
   sc.Require(k.limit_master != k.good_master, "limit_master",
              "must differ from good_master (two different parts)");
   sc.Require(k.every_n_tests >= 0 && k.every_n_tests <= 100000, "every_n_tests",

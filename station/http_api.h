@@ -23,11 +23,12 @@
 //                               operator "instructions" with their defaults written out
 //   GET  /api/stats?from=&to=&recipe_hash=&population=&subgroup=&gauge=&reference=NAME=VALUE
 //        &sigma_span=           capability (Cp/Cpk within, Pp/Ppk overall), run-rule and drift
-//                               alarms, gauge study (station/stats_report.h)
+//                               alarms, gauge study (station/reports/stats_report.h)
 //   GET  /api/charts/<measurement>.svg?chart=imr|xbar_r|histogram&from=&to=&last=&subgroup=
 //        &population=pass|all&recipe_hash=
 //                               a control chart or histogram as image/svg+xml
-//                               (station/spc_charts.h); 404 "unknown_measurement", "no_units"
+//                               (station/reports/spc_charts.h); 404 "unknown_measurement",
+//                               "no_units"
 //   GET  /api/detectability?k_fixture=&limit_sigmas=&required_sigmas=
 //                               where each defect class shows with this recipe and fixture
 //                               (station/qc_service.h; k_fixture from the gap diagnosis)
@@ -46,10 +47,10 @@
 //                               append-only, a correction is a new finding; 404
 //                               "unknown_serial" for a serial this store never tested)
 //   GET  /api/teardown/review?confidence=   hits, misses, false rejects of the current
-//                               findings and the share caught (station/teardown_review.h)
+//                               findings and the share caught (station/reports/teardown_review.h)
 //   GET  /api/units/{serial}/report.pdf?test_id=   the unit's printable report as
-//                               application/pdf (station/unit_report.h); masks drawn when the
-//                               recipe in use is the test's
+//                               application/pdf (station/reports/unit_report.h); masks drawn when
+//                               the recipe in use is the test's
 //   GET  /metrics               Prometheus text: tests by outcome, state, last resonance
 //   GET  /                      the operator page (station/web)
 //   GET  /engineer              the engineer page (station/web/engineer.html)

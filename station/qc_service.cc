@@ -10,7 +10,7 @@
 #include "analysis/qc/measurement_names.h"
 #include "analysis/text.h"
 #include "db/clock.h"
-#include "station/serial_number.h"
+#include "db/serial_number.h"
 
 namespace eol::station {
 
@@ -319,7 +319,7 @@ TeachResult TeachFromStore(db::Store& store, std::mutex& store_mu, const Recipe&
   TeachResult result;
   for (const std::string& serial : serials) {
     std::string why;
-    if (!ValidSerial(serial, &why)) {
+    if (!db::ValidSerial(serial, &why)) {
       result.kind = TeachResult::Kind::kBadSerial;
       result.message = "serials: " + json(serial).dump() + ": " + why;
       return result;

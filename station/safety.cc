@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <random>
+#include <thread>
+#include <vector>
 
 #include "analysis/text.h"
 #include "station/reason_cause.h"
@@ -11,6 +13,7 @@
 namespace eol::station {
 
 using analysis::Fixed;
+using analysis::ReasonCode;
 using drivers::FixtureOutput;
 using Clock = std::chrono::steady_clock;
 
@@ -195,6 +198,72 @@ void ExcitationWatchdog::Trip(const std::string& why) {
   c_.trips.fetch_add(1);
   spdlog::error("watchdog: {}; excitation off{}", why,
                 off.ok() ? "" : " command failed (" + off.message() + ")");
+}
+
+// See safety.h. The steps and their order are the safety contract: excitation off first,
+// whatever state the fixture is in; the clamp opened only when nobody can be hurt by it.
+std::vector<analysis::Reason> DriveToSafeState(drivers::Fixture& fixture,
+                                               const SafetyOptions& safety, bool clamp_commanded,
+                                               const StationClock& clock) {
+  std::vector<analysis::Reason> reasons;
+  const auto give_up = clock.now() + std::chrono::duration_cast<Clock::duration>(
+                                         std::chrono::duration<double>(safety.safe_state_retry_s));
+  const auto pause =
+      std::chrono::duration<double, std::milli>(std::max(safety.poll_period_ms, 50.0));
+  // 1. Excitation off, always first, whatever state the fixture is in.
+  int attempts = 0;
+  drivers::Status off = drivers::Status::Ok();
+  for (;;) {
+    ++attempts;
+    off = fixture.lifecycle() == drivers::Lifecycle::kError
+              ? fixture.Connect()  // a fresh connection drives excitation off first
+              : fixture.Write(FixtureOutput::kExcitationEnable, false);
+    if (off.ok() || clock.now() >= give_up) break;
+    clock.Sleep(pause);
+  }
+  if (!off.ok())
+    reasons.push_back({ReasonCode::kFixture,
+                       "excitation off not confirmed after " + std::to_string(attempts) +
+                           " attempts: " + off.message() +
+                           " (the relay is wired to drop on controller loss)",
+                       std::string(cause::kExcitationOffUnconfirmed)});
+  // 2. Unclamp only when it is safe: the controller answers, nobody is at the door, the
+  //    emergency-stop chain is healthy. Otherwise leave the part clamped and say so.
+  std::string unsafe;
+  ReasonCode code = ReasonCode::kInterlock;
+  for (;;) {
+    if (fixture.lifecycle() == drivers::Lifecycle::kError) (void)fixture.Connect();
+    auto in = fixture.ReadInputs();
+    if (!in.ok()) {
+      unsafe = "fixture not answering (" + in.status().message() + ")";
+      code = ReasonCode::kFixture;
+      if (clock.now() < give_up) {
+        clock.Sleep(pause);
+        continue;
+      }
+    } else if (!in.value().estop_ok) {
+      unsafe = "emergency stop open";
+    } else if (!in.value().door_closed) {
+      unsafe = "door open";
+    } else {
+      unsafe.clear();
+      (void)fixture.Activate();
+      const drivers::Status s = fixture.Write(FixtureOutput::kClampCmd, false);
+      if (!s.ok() && clock.now() < give_up) {
+        clock.Sleep(pause);
+        continue;
+      }
+      if (!s.ok())
+        reasons.push_back({ReasonCode::kFixture, "unclamp not confirmed: " + s.message(),
+                           std::string(cause::kClampLeftClosed)});
+    }
+    break;
+  }
+  if (!unsafe.empty())
+    reasons.push_back({code, "clamp left as it is: " + unsafe,
+                       clamp_commanded ? std::string(cause::kClampLeftClosed) : ""});
+  (void)fixture.Deactivate();
+  return reasons;
 }
 
 }  // namespace eol::station

@@ -1,9 +1,9 @@
 // The station's safety in one short unit, for a safety review to read alone: the
-// interlocks, the controller's heartbeat, the station-alive signal and the excitation
-// watchdog. The sequencer (station/sequencer.h) decides when to excite; this unit decides
-// when excitation must stop, and the fixture controller (drivers/fixture/modbus_map.h,
-// can_map.h: "what the fixture builder must program") stops it by itself when the station
-// cannot.
+// interlocks, the controller's heartbeat, the station-alive signal, the excitation watchdog
+// and the safe state after a fault. The sequencer (station/sequencer.h) decides when to excite;
+// this unit decides when excitation must stop, and the fixture controller
+// (drivers/fixture/modbus_map.h, can_map.h: "what the fixture builder must program") stops it by
+// itself when the station cannot.
 //
 // During excitation, every watchdog_period_ms, the watchdog
 //   1. checks its own loop: a gap between two successful interlock reads longer than the
@@ -32,7 +32,9 @@
 #include <string_view>
 #include <thread>
 #include <utility>
+#include <vector>
 
+#include "analysis/qc/measurement.h"
 #include "drivers/fixture/fixture.h"
 #include "station/config.h"
 #include "station/recipe.h"
@@ -67,6 +69,20 @@ struct InterlockFinding {
 };
 InterlockFinding FindInterlockFault(const drivers::FixtureInputs& in, const Recipe& recipe,
                                     bool require_clamp);
+
+// The safe state, after any fault of a test: excitation off first, whatever state the
+// fixture is in (a controller in error is reconnected: a fresh connection drives excitation
+// off first); then the clamp opened only when that is safe: the controller answers, the
+// emergency-stop chain is healthy and the door is closed; otherwise the part stays clamped.
+// On a communication loss both steps are retried every max(poll_period_ms, 50) ms until
+// confirmed or safe_state_retry_s has passed. Returns what could not be confirmed, as reasons
+// for the record ("excitation off not confirmed after N attempts: ...", "clamp left as it is:
+// door open", ...); `clamp_commanded` (the clamp was commanded closed in this test) marks the
+// latter with the cause clamp_left_closed. Ends with the fixture deactivated. Its deadline
+// and pauses are on `clock` (station/station_clock.h).
+std::vector<analysis::Reason> DriveToSafeState(drivers::Fixture& fixture,
+                                               const SafetyOptions& safety, bool clamp_commanded,
+                                               const StationClock& clock);
 
 // The longest gap between two successful interlock reads the watchdog accepts during
 // excitation: safety.watchdog_reaction_ms, or when that is 0, 4 x watchdog_period_ms and

@@ -541,74 +541,17 @@ bool Sequencer::RefusedForReleaseFault(db::TestRecord& record) {
   return true;
 }
 
-// Excitation off, then the clamp released when that is safe. On a communication loss both
-// are retried (reconnecting; a fresh connection drives excitation off first) until they are
-// confirmed or safety.safe_state_retry_s has passed; what could not be confirmed is named.
+// Excitation off, then the clamp released when that is safe (station/safety.h SafeState).
 void Sequencer::SafeState(db::TestRecord& record) {
   Enter(record, SeqState::kSafeState, record.reasons.empty() ? "" : record.reasons.front().text);
-  const auto give_up =
-      options_.clock.now() + std::chrono::duration_cast<Clock::duration>(
-                                 std::chrono::duration<double>(options_.safety.safe_state_retry_s));
-  const auto pause =
-      std::chrono::duration<double, std::milli>(std::max(options_.safety.poll_period_ms, 50.0));
-  // 1. Excitation off, always first, whatever state the fixture is in.
-  int attempts = 0;
-  drivers::Status off = drivers::Status::Ok();
-  for (;;) {
-    ++attempts;
-    off = fixture_.lifecycle() == drivers::Lifecycle::kError
-              ? fixture_.Connect()  // a fresh connection drives excitation off first
-              : fixture_.Write(FixtureOutput::kExcitationEnable, false);
-    if (off.ok() || options_.clock.now() >= give_up) break;
-    options_.clock.Sleep(pause);
-  }
-  if (!off.ok())
-    record.reasons.push_back({ReasonCode::kFixture,
-                              "excitation off not confirmed after " + std::to_string(attempts) +
-                                  " attempts: " + off.message() +
-                                  " (the relay is wired to drop on controller loss)",
-                              std::string(cause::kExcitationOffUnconfirmed)});
-  // 2. Unclamp only when it is safe: the controller answers, nobody is at the door, the
-  //    emergency-stop chain is healthy. Otherwise leave the part clamped and say so.
-  std::string unsafe;
-  ReasonCode code = ReasonCode::kInterlock;
-  for (;;) {
-    if (fixture_.lifecycle() == drivers::Lifecycle::kError) (void)fixture_.Connect();
-    auto in = fixture_.ReadInputs();
-    if (!in.ok()) {
-      unsafe = "fixture not answering (" + in.status().message() + ")";
-      code = ReasonCode::kFixture;
-      if (options_.clock.now() < give_up) {
-        options_.clock.Sleep(pause);
-        continue;
-      }
-    } else if (!in.value().estop_ok) {
-      unsafe = "emergency stop open";
-    } else if (!in.value().door_closed) {
-      unsafe = "door open";
-    } else {
-      unsafe.clear();
-      (void)fixture_.Activate();
-      const drivers::Status s = fixture_.Write(FixtureOutput::kClampCmd, false);
-      if (!s.ok() && options_.clock.now() < give_up) {
-        options_.clock.Sleep(pause);
-        continue;
-      }
-      if (!s.ok())
-        record.reasons.push_back({ReasonCode::kFixture, "unclamp not confirmed: " + s.message(),
-                                  std::string(cause::kClampLeftClosed)});
-    }
-    break;
-  }
   // Before the clamp state (refused at check_interlocks) the clamp was never commanded closed:
   // the rotor is not clamped and the reason says only why nothing was commanded.
   const bool clamp_commanded =
       std::any_of(record.trace.begin(), record.trace.end(),
                   [](const db::StateEntry& e) { return e.state == ToString(SeqState::kClamp); });
-  if (!unsafe.empty())
-    record.reasons.push_back({code, "clamp left as it is: " + unsafe,
-                              clamp_commanded ? std::string(cause::kClampLeftClosed) : ""});
-  (void)fixture_.Deactivate();
+  for (analysis::Reason& r :
+       DriveToSafeState(fixture_, options_.safety, clamp_commanded, options_.clock))
+    record.reasons.push_back(std::move(r));
 }
 
 void Sequencer::StoreAndPublish(db::TestRecord& record) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
 #include <thread>
 
 #include "analysis/text.h"
@@ -49,8 +50,10 @@ Recipe LoadRecipeOrLastGood(const std::string& path, std::string* problem) {
 
 }  // namespace
 
-Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench, StationClock clock)
+Station::Station(StationConfig config, drivers::DriverSet drivers, StationClock clock)
     : config_(std::move(config)), clock_(std::move(clock)) {
+  if (!drivers.fixture != !drivers.daq)
+    throw std::invalid_argument("Station: a fixture and a DAQ, or neither");
   if (config_.variants.empty()) {
     recipe_ =
         std::make_shared<const Recipe>(LoadRecipeOrLastGood(config_.recipe_path, &recipe_problem_));
@@ -72,7 +75,7 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench,
     spdlog::warn("store {}: {}", config_.db_path, store_->check_on_open());
   if (!store_->loss_on_open().empty())
     spdlog::error("store {}: VERDICTS LOST: {}", config_.db_path, store_->loss_on_open());
-  drivers_ = drivers::MakeDrivers(config_.drivers, std::move(bench));
+  drivers_ = drivers.fixture ? std::move(drivers) : drivers::MakeDrivers(config_.drivers);
   board_ = std::make_unique<StatusBoard>(config_.station_id, recipe_->id, recipe_->hash);
   ConnectDrivers();
   if (!recipe_problem_.empty()) {
@@ -102,10 +105,7 @@ Station::Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench,
   opts.self_check = config_.self_check;
   opts.publish_before_release = config_.publish_before_release;
   opts.clock = clock_;
-  if (drivers_.bench && drivers_.bench->settings().load_part_on_serial) {
-    drivers::SimBench* bench = drivers_.bench.get();
-    opts.on_serial = [bench](const std::string& serial) { bench->LoadPart(serial); };
-  }
+  opts.on_serial = drivers_.on_serial;
   sequencer_ = std::make_unique<Sequencer>(*drivers_.fixture, *drivers_.daq, *store_, recipe_,
                                            *board_, opts);
   sequencer_->PublishLockout();  // a lockout survives a restart: it is read from the store

@@ -40,12 +40,13 @@ class Station {
   // With "variants" (station/variants.h) every variant's recipe must load and be approved: one
   // that does not (a proposal) throws io::ConfigError naming the variant and the file, and two
   // variants of one recipe id are refused; there is no last-good fallback for them.
-  // `bench`: a simulated bench shared with a fixture emulator (the demo); normally null.
+  // `drivers`: made by the caller (the demo's share one simulated bench with a fixture
+  // emulator), both or neither; when empty they are made from the config's "fixture" and "daq"
+  // (drivers/factory/factory.h).
   // `clock`: the time it lives by (station/station_clock.h), handed to the sequencer and read
   // by the idle look and the stuck-test deadline; the real clocks unless a test passes one.
-  // A clock whose sleep advances a manual clock needs the bench on that clock too.
-  explicit Station(StationConfig config, std::shared_ptr<drivers::SimBench> bench = nullptr,
-                   StationClock clock = {});
+  // A clock whose sleep advances a manual clock needs the drivers' bench on that clock too.
+  explicit Station(StationConfig config, drivers::DriverSet drivers = {}, StationClock clock = {});
   ~Station();
   Station(const Station&) = delete;
   Station& operator=(const Station&) = delete;
@@ -93,7 +94,6 @@ class Station {
   RecipeChange ChangeRecipe(const nlohmann::json& recipe, const ApiToken& who);
   const StationConfig& config() const { return config_; }
   StatusBoard& board() { return *board_; }
-  drivers::SimBench* bench() { return drivers_.bench.get(); }
   db::Store& store() { return *store_; }
 
   // ---- Plant integration (issue 15) ----

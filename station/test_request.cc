@@ -2,7 +2,7 @@
 
 #include <sstream>
 
-#include "station/serial_number.h"
+#include "db/serial_number.h"
 
 namespace eol::station {
 namespace {
@@ -65,7 +65,7 @@ std::optional<TestRequest> ParseScannerLine(const std::string& line, std::string
   std::istringstream in(line);
   std::string field;
   std::getline(in, r.serial, '\t');
-  if (!ValidSerial(r.serial, why)) return std::nullopt;
+  if (!db::ValidSerial(r.serial, why)) return std::nullopt;
   bool seen[std::size(kFields)] = {};
   while (std::getline(in, field, '\t')) {
     const std::size_t eq = field.find('=');

@@ -1,7 +1,7 @@
 // A request to test one unit, as it arrives over HTTP, from the line PLC or the scanner: the
 // serial, and who tests it for which order (db::WorkContext, stored with the record).
 //
-// Accepted: the serial as station/serial_number.h says; operator_id and order_number of at
+// Accepted: the serial as db/serial_number.h says; operator_id and order_number of at
 // most 32 characters, shift of at most 16, each printable ASCII (0x20..0x7E) with no space
 // at either end, or empty (not given). The line PLC's registers hold exactly these lengths
 // (station/plc/plc_map.h).

@@ -1,7 +1,7 @@
 // Statistical process control of one measurement over units in test order: control charts
 // (individuals / moving range, X-bar / R), run rules that raise drift alarms, and the
 // capability indices named by the sigma they use. Pure computation: values in, charts out;
-// the station reads the values from the store and draws them (station/stats_report.h).
+// the station reads the values from the store and draws them (station/reports/stats_report.h).
 //
 // Every value is in the measurement's own unit (Hz for resonance_f_hz, 1 for resonance_q);
 // the indices are dimensionless. Constants are the ASTM / Montgomery table for subgroups of

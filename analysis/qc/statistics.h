@@ -1,6 +1,6 @@
 // Statistics of a measurement over many tests, for quality engineering: the sample summary,
 // the drift trend and the type-1 gauge study. Pure computation: values in, summaries out; the
-// station reads the values from the store (station/stats_report.h).
+// station reads the values from the store (station/reports/stats_report.h).
 //
 // Conventions (every figure uses the sample standard deviation s, divisor n - 1):
 //

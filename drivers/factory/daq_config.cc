@@ -92,6 +92,7 @@ ReplayDaqSettings ParseReplayDaqSettings(const io::JsonObject& o) {
   return s;
 }
 
+#if EOL_FACTORY_WITH_SIM
 void ParseSimCalibrationLoad(const io::JsonObject& o, SimDaqSettings& s) {
   const std::string load = o.String("load", ToString(s.load));
   if (load == ToString(SimLoad::kFixturePart)) {
@@ -115,5 +116,7 @@ void ParseSimCalibrationLoad(const io::JsonObject& o, SimDaqSettings& s) {
             "injected_channel_delay_s", "needs the steady_state model (or the reference load)");
   s.calibration = DaqCalibration(o, s.calibration);
 }
+
+#endif
 
 }  // namespace eol::drivers

@@ -3,13 +3,16 @@
 #include "drivers/daq/calibration_file.h"
 #include "drivers/factory/daq_config.h"
 #include "drivers/fixture/modbus_fixture.h"
+#if EOL_FACTORY_WITH_SIM
 #include "drivers/sim/sim_fixture.h"
+#endif
 #if EOL_WITH_SOCKETCAN
 #include "drivers/fixture/can_fixture.h"
 #endif
 
 namespace eol::drivers {
 
+#if EOL_FACTORY_WITH_SIM
 analysis::MotorPopulation ParsePopulation(const io::JsonObject& o) {
   analysis::MotorPopulation p;
   for (const analysis::PopulationNumber& f : analysis::kPopulationNumbers)
@@ -93,6 +96,54 @@ SimDaqSettings ParseSimDaqSettings(const io::JsonObject& o) {
   o.RejectUnknown();
   return s;
 }
+#endif
+
+namespace {
+
+// The hardware fixture drivers; `driver` is none of them: an io::ConfigError.
+std::unique_ptr<Fixture> HardwareFixture(const io::JsonObject& fixture, const std::string& driver) {
+  if (driver == "modbus-tcp")
+    return std::make_unique<ModbusFixture>(
+        ParseModbusFixtureSettings(fixture, ModbusLink::Transport::kTcp));
+  if (driver == "modbus-rtu")
+    return std::make_unique<ModbusFixture>(
+        ParseModbusFixtureSettings(fixture, ModbusLink::Transport::kRtu));
+  if (driver == "socketcan") {
+#if EOL_WITH_SOCKETCAN
+    return std::make_unique<CanFixture>(ParseCanFixtureSettings(fixture));
+#else
+    throw io::ConfigError(fixture.PathOf("driver") +
+                          ": the socketcan fixture driver was not compiled in (build with "
+                          "-DEOL_WITH_SOCKETCAN=ON)");
+#endif
+  }
+  throw io::ConfigError(fixture.PathOf("driver") + ": unknown fixture driver '" + driver +
+                        "' (known: sim, modbus-tcp, modbus-rtu, socketcan)");
+}
+
+// The hardware and file acquisition drivers; `driver` is none of them: an io::ConfigError.
+std::unique_ptr<Daq> HardwareDaq(const io::JsonObject& daq, const std::string& driver) {
+  if (driver == "alsa") {
+    const AlsaDaqSettings alsa = ParseAlsaDaqSettings(daq);
+#if EOL_WITH_ALSA
+    return std::make_unique<AlsaDaq>(alsa);
+#else
+    throw io::ConfigError(
+        daq.PathOf("driver") +
+        ": the alsa driver was not compiled in (configure with -DEOL_WITH_ALSA=ON)");
+#endif
+  }
+  if (driver == "replay") return std::make_unique<ReplayDaq>(ParseReplayDaqSettings(daq));
+  throw io::ConfigError(daq.PathOf("driver") + ": unknown daq driver '" + driver +
+                        "' (known: sim, alsa, replay)");
+}
+
+}  // namespace
+
+#if EOL_FACTORY_WITH_SIM
+DriverSet MakeDrivers(const nlohmann::json& station_config) {
+  return MakeDrivers(station_config, nullptr);
+}
 
 DriverSet MakeDrivers(const nlohmann::json& station_config, std::shared_ptr<SimBench> bench) {
   const io::JsonObject root(station_config, "");
@@ -104,52 +155,41 @@ DriverSet MakeDrivers(const nlohmann::json& station_config, std::shared_ptr<SimB
   DriverSet set;
   if (bench) {
     (void)root.OptionalObject("sim");  // the caller built the bench from it
-    set.bench = std::move(bench);
   } else if (fixture_driver == "sim" || daq_driver == "sim") {
     const auto sim = root.OptionalObject("sim");
-    set.bench = std::make_shared<SimBench>(sim ? ParseSimBenchSettings(*sim) : SimBenchSettings{});
+    bench = std::make_shared<SimBench>(sim ? ParseSimBenchSettings(*sim) : SimBenchSettings{});
   }
-
+  if (bench && bench->settings().load_part_on_serial)
+    set.on_serial = [bench](const std::string& serial) { bench->LoadPart(serial); };
   if (fixture_driver == "sim") {
     fixture.RejectUnknown();
-    set.fixture = std::make_unique<SimFixture>(set.bench);
-  } else if (fixture_driver == "modbus-tcp") {
-    set.fixture = std::make_unique<ModbusFixture>(
-        ParseModbusFixtureSettings(fixture, ModbusLink::Transport::kTcp));
-  } else if (fixture_driver == "modbus-rtu") {
-    set.fixture = std::make_unique<ModbusFixture>(
-        ParseModbusFixtureSettings(fixture, ModbusLink::Transport::kRtu));
-  } else if (fixture_driver == "socketcan") {
-#if EOL_WITH_SOCKETCAN
-    set.fixture = std::make_unique<CanFixture>(ParseCanFixtureSettings(fixture));
-#else
-    throw io::ConfigError(fixture.PathOf("driver") +
-                          ": the socketcan fixture driver was not compiled in (build with "
-                          "-DEOL_WITH_SOCKETCAN=ON)");
-#endif
+    set.fixture = std::make_unique<SimFixture>(bench);
   } else {
-    throw io::ConfigError(fixture.PathOf("driver") + ": unknown fixture driver '" + fixture_driver +
-                          "' (known: sim, modbus-tcp, modbus-rtu, socketcan)");
+    set.fixture = HardwareFixture(fixture, fixture_driver);
   }
-
-  if (daq_driver == "sim") {
-    set.daq = std::make_unique<SimDaq>(set.bench, ParseSimDaqSettings(daq));
-  } else if (daq_driver == "alsa") {
-    const AlsaDaqSettings alsa = ParseAlsaDaqSettings(daq);
-#if EOL_WITH_ALSA
-    set.daq = std::make_unique<AlsaDaq>(alsa);
-#else
-    throw io::ConfigError(
-        daq.PathOf("driver") +
-        ": the alsa driver was not compiled in (configure with -DEOL_WITH_ALSA=ON)");
-#endif
-  } else if (daq_driver == "replay") {
-    set.daq = std::make_unique<ReplayDaq>(ParseReplayDaqSettings(daq));
-  } else {
-    throw io::ConfigError(daq.PathOf("driver") + ": unknown daq driver '" + daq_driver +
-                          "' (known: sim, alsa, replay)");
-  }
+  set.daq = daq_driver == "sim" ? std::make_unique<SimDaq>(bench, ParseSimDaqSettings(daq))
+                                : HardwareDaq(daq, daq_driver);
   return set;
 }
+#else
+DriverSet MakeDrivers(const nlohmann::json& station_config) {
+  const io::JsonObject root(station_config, "");
+  const io::JsonObject fixture = root.Object("fixture");
+  const io::JsonObject daq = root.Object("daq");
+  const std::string fixture_driver = fixture.RequiredString("driver");
+  const std::string daq_driver = daq.RequiredString("driver");
+  // What a config naming a simulated driver is told by a program built without them.
+  for (const io::JsonObject* o : {&fixture, &daq})
+    if (o->RequiredString("driver") == "sim")
+      throw io::ConfigError(o->PathOf("driver") +
+                            ": the sim driver is not in this program (the daemon eol-station "
+                            "has the hardware drivers only; `eol station` and `eol demo` run "
+                            "a simulated station)");
+  DriverSet set;
+  set.fixture = HardwareFixture(fixture, fixture_driver);
+  set.daq = HardwareDaq(daq, daq_driver);
+  return set;
+}
+#endif
 
 }  // namespace eol::drivers

@@ -24,8 +24,10 @@
 // an unknown name, fails with a io::ConfigError naming the path and the known drivers.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "drivers/daq/daq.h"
 #include "drivers/daq/replay_daq.h"
@@ -37,16 +39,22 @@
 namespace eol::drivers {
 
 struct DriverSet {
-  std::shared_ptr<SimBench> bench;  // set when any driver is simulated
   std::unique_ptr<Fixture> fixture;
   std::unique_ptr<Daq> daq;
+  // Called with each serial before its test; set only when a driver is simulated and the
+  // simulated operator loads a part per serial (sim_bench.h load_part_on_serial). The
+  // simulated drivers and this keep the bench alive.
+  std::function<void(const std::string&)> on_serial;
 };
 
 // `station_config` is the whole station config; its "fixture", "daq" and optional "sim"
-// objects are read. Throws io::ConfigError. A given `bench` is used by the sim drivers instead of
-// a new one: the demo shares one bench between the sim DAQ and the Modbus fixture emulator.
-DriverSet MakeDrivers(const nlohmann::json& station_config,
-                      std::shared_ptr<SimBench> bench = nullptr);
+// objects are read. Throws io::ConfigError. Built without the simulators
+// (eol::driver_factory_hardware, the daemon's program) a "sim" driver is such an error.
+DriverSet MakeDrivers(const nlohmann::json& station_config);
+// The same with a given `bench` used by the sim drivers instead of a new one: the demo shares
+// one bench between the sim DAQ and the Modbus fixture emulator. Only in eol::driver_factory
+// (with the simulators), as are the Parse* functions below.
+DriverSet MakeDrivers(const nlohmann::json& station_config, std::shared_ptr<SimBench> bench);
 
 SimBenchSettings ParseSimBenchSettings(const io::JsonObject& sim);
 analysis::MotorPopulation ParsePopulation(const io::JsonObject& population);

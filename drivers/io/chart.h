@@ -109,7 +109,7 @@ std::vector<double> SpreadLabels(const std::vector<double>& desired, double gap,
 std::string RenderChartSvg(const Chart& chart);
 std::string RenderChartPng(const Chart& chart);
 // Draws the chart on a cairo context the caller owns (a page of a PDF report,
-// station/unit_report.h) with its top-left corner at the context's origin, within
+// station/reports/unit_report.h) with its top-left corner at the context's origin, within
 // ChartWidth x ChartHeight units (clipped there, its white background included); returns the
 // strings drawn. Throws as the renderers do.
 std::vector<std::string> DrawChart(_cairo* cr, const Chart& chart);

@@ -12,6 +12,7 @@
 #include "analysis/qc/measurement_names.h"
 #include "analysis/qc/statistics.h"
 #include "analysis/text.h"
+#include "drivers/factory/factory.h"
 #include "station/cycle_time.h"
 #include "station/station.h"
 
@@ -37,7 +38,12 @@ std::map<std::string, UnitResult> RunRecipe(const CycleBenchOptions& o,
       {"fixture", {{"driver", "sim"}}},
       {"daq", {{"driver", "sim"}, {"time_scale", o.time_scale}, {"model", o.sim_model}}},
       {"sim", sim}};
-  Station station(ParseStationConfig(cfg, "cycle-bench", ""));
+  StationConfig config = ParseStationConfig(cfg, "cycle-bench", "");
+  // The bench made here, so the truth of each unit (its part) can be read after its test.
+  auto bench = std::make_shared<drivers::SimBench>(
+      drivers::ParseSimBenchSettings(io::JsonObject(sim, "/sim")));
+  drivers::DriverSet drivers = drivers::MakeDrivers(config.drivers, bench);
+  Station station(std::move(config), std::move(drivers));
   const Recipe& recipe = *station.recipe();
   summary.recipe = recipe.id + " v" + std::to_string(recipe.version);
   summary.excitation = analysis::Fixed(recipe.excitation.line_spacing_hz, 2) + " Hz lines, " +
@@ -50,7 +56,7 @@ std::map<std::string, UnitResult> RunRecipe(const CycleBenchOptions& o,
   for (int i = 1; i <= o.units; ++i) {
     const std::string serial = "CB-" + std::to_string(o.seed) + "-" + std::to_string(i);
     const db::TestRecord r = station.RunTest(serial);
-    const bool defective = station.bench()->part() && station.bench()->part()->defective;
+    const bool defective = bench->part() && bench->part()->defective;
     ++summary.units;
     summary.pass += r.outcome == analysis::Outcome::kPass;
     summary.fail += r.outcome == analysis::Outcome::kFail;

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "drivers/io/json_config.h"
-#include "station/gap_diagnosis.h"
+#include "station/reports/gap_diagnosis.h"
 
 namespace eol::station {
 namespace {

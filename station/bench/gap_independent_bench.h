@@ -2,8 +2,8 @@
 // generators (tests/peers/independent_gap_cases.py, independent_tolerance_cases.py; written
 // from the physics in numpy, no code shared with analysis/). Each case of DIR/truth.json is
 // read and diagnosed as `eol gap --sim case-NNN-sim.csv --measured case-NNN-meas.csv` does
-// (station/gap_diagnosis.h), with the sigma's degrees of freedom the truth states, and scored
-// without the label being seen by the diagnosis:
+// (station/reports/gap_diagnosis.h), with the sigma's degrees of freedom the truth states, and
+// scored without the label being seen by the diagnosis:
 //   class none    (no hidden effect; with calibration offsets: calibration only): right when
 //                 `none`; a pair answered is counted apart (the issue-38 rule: never a pair);
 //   class single  right when the answer is the one effect alone (EXPECTED: a fractional

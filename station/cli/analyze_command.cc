@@ -8,7 +8,7 @@
 // verdict.conditions_not_evaluated instead of being judged.
 // A mobility FRF (f_hz,re,im[,sigma]) is fitted with the two-mass model instead (no verdict).
 // --plot FILE draws |Z| and Re Z with the fitted model and the recipe's resonance window and
-// masks (station/curve_chart.h).
+// masks (station/reports/curve_chart.h).
 // A raw recording whose voltage or current reached the converter's range (its full scale from
 // --voltage-full-scale / --current-full-scale, the CSV's u_full_scale_v / i_full_scale_a
 // columns or a WAV's gains; or samples repeated at a rail) is refused before any fit:
@@ -36,9 +36,9 @@
 #include "drivers/io/measured_input.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/curve_chart.h"
 #include "station/judge.h"
 #include "station/recipe.h"
+#include "station/reports/curve_chart.h"
 
 namespace eol::station::cli {
 namespace {

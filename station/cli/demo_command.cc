@@ -82,7 +82,9 @@ int RunDemo(const DemoArgs& a) {
                       {"port", emulator->port()},
                       {"unit_id", 1}};
   }
-  Station station(ParseStationConfig(cfg, "demo", ""), bench);
+  StationConfig config = ParseStationConfig(cfg, "demo", "");
+  drivers::DriverSet drivers = drivers::MakeDrivers(config.drivers, bench);
+  Station station(std::move(config), std::move(drivers));
   station.StartHttp(DefaultWebRoot());
   std::ostream& out = a.json ? std::cerr : std::cout;
   out << "eol demo: " << a.units << " simulated units, defect share " << a.defect_share
@@ -103,7 +105,7 @@ int RunDemo(const DemoArgs& a) {
     std::snprintf(serial, sizeof serial, "DEMO-%llu-%04d", static_cast<unsigned long long>(a.seed),
                   i);
     const db::TestRecord r = station.RunTest(serial);
-    const bool is_defective = station.bench()->part() && station.bench()->part()->defective;
+    const bool is_defective = bench->part() && bench->part()->defective;
     serials.push_back(serial);
     excitation_s.push_back(CycleStepS(r.cycle_s, "excitation"));
     cycle_s.push_back(CycleStepS(r.cycle_s, "total"));

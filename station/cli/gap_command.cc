@@ -2,8 +2,8 @@
 // measurement leaves the simulation, which unmodelled effect explains it, how far the gap
 // shrinks (also on held-out lines or units), and optionally where a second simulated design
 // would land in the measured set-up (--predict-sim). Inputs: drivers/io/gap_inputs.h;
-// reading, diagnosis and plot: station/gap_diagnosis.h (shared with POST /api/gap.svg); report:
-// station/gap_report.h.
+// reading, diagnosis and plot: station/reports/gap_diagnosis.h (shared with POST /api/gap.svg);
+// report: station/reports/gap_report.h.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -16,9 +16,9 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/data_files.h"
-#include "station/gap_diagnosis.h"
-#include "station/gap_report.h"
 #include "station/recipe.h"
+#include "station/reports/gap_diagnosis.h"
+#include "station/reports/gap_report.h"
 
 namespace eol::station::cli {
 namespace {

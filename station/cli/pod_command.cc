@@ -1,14 +1,13 @@
 // `eol pod --hits FILE [--link logit|probit] [--scale linear|log] [--confidence 0.95]
 // [--pod-svg FILE] [--f0-limit HZ]... [--json]`: probability of detection from hit/miss data
 // (analysis/qc/pod.h, MIL-HDBK-1823A), e.g. the per-unit table of
-// tests/peers/population_rejects.py; the hits CSV and the figure: station/pod_chart.h (shared
-// with POST /api/pod.svg).
-// `eol pod --from-db DB [--confidence 0.95] [--json]`: instead of a hits table, the store's
-// teardown findings (station/teardown_review.h): confirmed-defective units the station failed
-// (hits) and passed (misses), the share caught with its exact lower bound, and the false
-// rejects (failed units teardown found not defective).
-// Exit: 0 every class fitted, 1 a class could not be fitted (the reason is printed) or the
-// store has no confirmed-defective unit with a PASS/FAIL verdict, 2 usage.
+// tests/peers/population_rejects.py; the hits CSV and the figure: station/reports/pod_chart.h
+// (shared with POST /api/pod.svg). `eol pod --from-db DB [--confidence 0.95] [--json]`: instead of
+// a hits table, the store's teardown findings (station/reports/teardown_review.h):
+// confirmed-defective units the station failed (hits) and passed (misses), the share caught with
+// its exact lower bound, and the false rejects (failed units teardown found not defective). Exit: 0
+// every class fitted, 1 a class could not be fitted (the reason is printed) or the store has no
+// confirmed-defective unit with a PASS/FAIL verdict, 2 usage.
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -21,8 +20,8 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/progress.h"
-#include "station/pod_chart.h"
-#include "station/teardown_review.h"
+#include "station/reports/pod_chart.h"
+#include "station/reports/teardown_review.h"
 
 namespace eol::station::cli {
 namespace {

@@ -12,8 +12,8 @@
 #include "station/cli/common.h"
 #include "station/cli/progress.h"
 #include "station/data_files.h"
-#include "station/pod_chart.h"
 #include "station/recipe.h"
+#include "station/reports/pod_chart.h"
 
 namespace eol::station::cli {
 namespace {

@@ -4,21 +4,21 @@
 // (station/central/), with the same record fields. --plot
 // draws the stored curve of its newest test (or --test ID) with the fitted model, the
 // resonance window it was judged against and, given the recipe file of the record's hash,
-// the masks (station/curve_chart.h).
+// the masks (station/reports/curve_chart.h).
 #include <cmath>
 #include <complex>
 #include <cstdio>
 #include <iostream>
 
+#include "db/serial_number.h"
 #include "db/store.h"
 #include "drivers/io/chart.h"
 #include "station/central/central_record.h"
 #include "station/central/pg.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/curve_chart.h"
 #include "station/recipe.h"
-#include "station/serial_number.h"
+#include "station/reports/curve_chart.h"
 
 namespace eol::station::cli {
 namespace {
@@ -113,7 +113,7 @@ std::string AttemptText(const db::TestRecord& t) {
 
 int RunQuery(const QueryArgs& a) {
   std::string why;
-  if (!ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
+  if (!db::ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
   if (a.db.empty() == a.central.empty())
     throw std::runtime_error("give --db FILE (one station) or --central URL (the plant), one");
   const bool curves = a.curves || !a.plot.empty();

@@ -1,5 +1,5 @@
 // `eol report --db DB --serial S --out S.pdf [--test-id N] [--recipe FILE] [--json]`: the printable
-// report of one unit's test (station/unit_report.h), its newest finished test or test N.
+// report of one unit's test (station/reports/unit_report.h), its newest finished test or test N.
 // Exit: 0 written, 1 the serial has no such test, 2 usage or a file that cannot be written.
 #include <cstdio>
 #include <fstream>
@@ -8,12 +8,12 @@
 #include <stdexcept>
 
 #include "db/clock.h"
+#include "db/serial_number.h"
 #include "db/store.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/recipe.h"
-#include "station/serial_number.h"
-#include "station/unit_report.h"
+#include "station/reports/unit_report.h"
 #include "station/version.h"
 
 namespace eol::station::cli {
@@ -30,7 +30,7 @@ struct ReportArgs {
 
 int RunReport(const ReportArgs& a) {
   std::string why;
-  if (!ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
+  if (!db::ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
   std::string hash;
   std::vector<analysis::CurveMask> masks;
   if (!a.recipe.empty()) {

@@ -1,8 +1,10 @@
-// `eol station --config FILE`: the station as a long-running daemon. Serials arrive over
-// HTTP (POST /api/tests), from the line PLC (a "plc" block: station/plc/plc_map.h) or, with
-// "serial_from_stdin", from a scanner typing into stdin.
+// `eol station --config FILE` and `eol-station --config FILE`: the station as a long-running
+// daemon. Serials arrive over HTTP (POST /api/tests), from the line PLC (a "plc" block:
+// station/plc/plc_map.h) or, with "serial_from_stdin", from a scanner typing into stdin.
 // SIGTERM/SIGINT abort the test in flight safely (excitation off, safe state, stored as
 // ABORTED) and stop the daemon.
+#include "station/cli/station_command.h"
+
 #include <signal.h>
 #include <spdlog/spdlog.h>
 
@@ -10,11 +12,11 @@
 #include <memory>
 #include <thread>
 
+#include "db/serial_number.h"
 #include "drivers/io/json_config.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/data_files.h"
-#include "station/serial_number.h"
 #include "station/station.h"
 #include "station/systemd_notify.h"
 #include "station/test_request.h"
@@ -108,23 +110,27 @@ int RunStation(const std::string& config_path, std::string web_root, bool init_s
 
 }  // namespace
 
-void AddStationCommand(CLI::App& app) {
+const char* const kStationDescription =
+    "Run the station as a daemon with the JSON config FILE (see deploy/station.json): serve\n"
+    "the HTTP API and operator page, test each serial that arrives, stop cleanly on SIGTERM.";
+
+void AddStationOptions(CLI::App& cmd) {
   auto config = std::make_shared<std::string>();
   auto web_root = std::make_shared<std::string>();
   auto init_store = std::make_shared<bool>(false);
-  CLI::App* cmd = app.add_subcommand(
-      "station",
-      "Run the station as a daemon with the JSON config FILE (see deploy/station.json): serve\n"
-      "the HTTP API and operator page, test each serial that arrives, stop cleanly on SIGTERM.");
-  cmd->add_option("--config", *config, "Station config JSON")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--web-root", *web_root, "Folder of the operator page (default: built in)");
-  cmd->add_flag("--init-store", *init_store,
-                "Make an existing empty file (0 bytes, or an SQLite file without tables) at the "
-                "config's \"db\" a new store; without it such a file is refused (a missing "
-                "file is always created)");
-  cmd->callback([config, web_root, init_store] {
+  cmd.add_option("--config", *config, "Station config JSON")->required()->check(CLI::ExistingFile);
+  cmd.add_option("--web-root", *web_root, "Folder of the operator page (default: built in)");
+  cmd.add_flag("--init-store", *init_store,
+               "Make an existing empty file (0 bytes, or an SQLite file without tables) at the "
+               "config's \"db\" a new store; without it such a file is refused (a missing "
+               "file is always created)");
+  cmd.callback([config, web_root, init_store] {
     RunGuarded("station", [&] { return RunStation(*config, *web_root, *init_store); });
   });
+}
+
+void AddStationCommand(CLI::App& app) {
+  AddStationOptions(*app.add_subcommand("station", kStationDescription));
 }
 
 }  // namespace eol::station::cli

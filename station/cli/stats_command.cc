@@ -2,11 +2,11 @@
 //  [--subgroup N] [--gauge SERIAL] [--reference NAME=VALUE ...] [--gauge-sigma-span 6|4]
 //  [--drift-t T] [--plot FILE.svg|.png] [--json]`:
 // capability (Cp/Cpk within, Pp/Ppk overall), control-chart run-rule alarms, drift alarms and
-// the type-1 gauge study (station/stats_report.h); --plot draws the control charts and
-// histograms of the resonance and its Q (station/spc_charts.h).
+// the type-1 gauge study (station/reports/stats_report.h); --plot draws the control charts and
+// histograms of the resonance and its Q (station/reports/spc_charts.h).
 // `eol stats --db FILE --yield [--by all|shift|day|recipe] [--shifts A=06:00,...]
 //  [--utc-offset-min M] [--recipe-hash H] [--from T] [--to T] [--plot FILE] [--json]`:
-// first-pass and final yield, retests and the Pareto of reasons (station/yield.h); --plot
+// first-pass and final yield, retests and the Pareto of reasons (station/reports/yield.h); --plot
 // draws the Pareto of the whole window. Exit 0, 2 on usage or file errors.
 // Exit 0 when no drift (trend) alarm fired, 1 when one did, 2 on usage or file errors; run-rule
 // alarms are printed and listed under "spc_alarms" but leave the exit code alone.
@@ -21,9 +21,9 @@
 #include "drivers/io/chart.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/spc_charts.h"
-#include "station/stats_report.h"
-#include "station/yield.h"
+#include "station/reports/spc_charts.h"
+#include "station/reports/stats_report.h"
+#include "station/reports/yield.h"
 
 namespace eol::station::cli {
 namespace {
@@ -179,7 +179,7 @@ bool Given(const StatsArgs& a, const std::string& name) {
   return std::find(a.given.begin(), a.given.end(), name) != a.given.end();
 }
 
-// `--yield`: the yield report (station/yield.h); the capability options do not apply.
+// `--yield`: the yield report (station/reports/yield.h); the capability options do not apply.
 int RunYield(const StatsArgs& a) {
   for (const char* other : {"--gauge", "--reference", "--gauge-sigma-span", "--drift-t",
                             "--population", "--baseline", "--subgroup"})
@@ -258,7 +258,7 @@ void AddStatsCommand(CLI::App& app) {
       "Exit code 1 when a drift (trend) alarm fired; 2 when --gauge names a serial without\n"
       "tests in the window or --reference a measurement its study lacks.\n"
       "With --yield: first-pass and final yield, retests and the Pareto of reasons, in total\n"
-      "and --by shift, day or recipe (station/yield.h defines each figure); --plot draws\n"
+      "and --by shift, day or recipe (station/reports/yield.h defines each figure); --plot draws\n"
       "the Pareto.");
   cmd->add_option("--db", args->db, "SQLite file of the station")
       ->required()
@@ -283,8 +283,9 @@ void AddStatsCommand(CLI::App& app) {
                   "consecutive units, sigma within = Rbar/d2");
   cmd->add_option("--plot", args->plot,
                   "Write the control charts and histograms with the limits (SVG, or PNG for .png)");
-  cmd->add_flag("--json", args->json,
-                "One JSON object (station/stats_report.h; with --yield station/yield.h)");
+  cmd->add_flag(
+      "--json", args->json,
+      "One JSON object (station/reports/stats_report.h; with --yield station/reports/yield.h)");
   cmd->add_flag("--yield", args->yield,
                 "Yield instead of capability: first-pass, first-verdict and final yield,\n"
                 "retested units, tests per unit and the Pareto of reason codes");

@@ -1,18 +1,18 @@
 // `eol teardown --db DB --serial S [--found defective|not-defective --by NAME [--note TEXT]]
 // [--json]`: records what teardown of a unit found (db/store.h TeardownEntry; append-only,
 // a correction is a new finding) or, without --found, lists every finding of the serial
-// with the verdict it judged (station/teardown_review.h).
+// with the verdict it judged (station/reports/teardown_review.h).
 // Exit: 0 recorded / listed, 1 the serial has no finding (listing), 2 usage, an unknown
 // serial or a store that cannot be written.
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "db/clock.h"
+#include "db/serial_number.h"
 #include "db/store.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/serial_number.h"
-#include "station/teardown_review.h"
+#include "station/reports/teardown_review.h"
 
 namespace eol::station::cli {
 namespace {
@@ -94,7 +94,7 @@ int List(const TeardownArgs& a) {
 
 int RunTeardown(const TeardownArgs& a) {
   std::string why;
-  if (!ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
+  if (!db::ValidSerial(a.serial, &why)) throw std::runtime_error("--serial: " + why);
   return a.found.empty() ? List(a) : Record(a);
 }
 

@@ -2,15 +2,15 @@
 //
 //   POST /api/pod.svg  {"hits_csv": "<text>", "name", "link", "scale", "confidence",
 //                       "pod_level", "f0_limits_hz": [...]}
-//       the POD figure of `eol pod --hits FILE --pod-svg OUT` (station/pod_chart.h): the hits
-//       CSV as text, optional name (default "hits.csv"), the fit's options as `eol pod` takes
+//       the POD figure of `eol pod --hits FILE --pod-svg OUT` (station/reports/pod_chart.h): the
+//       hits CSV as text, optional name (default "hits.csv"), the fit's options as `eol pod` takes
 //       them, up to 10 f0 limits (Hz) to draw.
 //   POST /api/gap.svg  {"simulation": {"name", "text"}, "measured": [{"name", "text"}, ...],
 //                       "quantity", "f_lo_hz", "f_hi_hz", "sigma_pool", "inertia_kg_m2",
 //                       "effects": [...], "pairs"}
 //       the plot of `eol gap --sim FILE --measured FILE... --plot OUT`
-//       (station/gap_diagnosis.h): each input is the text of a file `eol gap` reads, its name
-//       giving the format (.zma, .json; otherwise CSV); 1 to 8 measured units; J_r defaults to
+//       (station/reports/gap_diagnosis.h): each input is the text of a file `eol gap` reads, its
+//       name giving the format (.zma, .json; otherwise CSV); 1 to 8 measured units; J_r defaults to
 //       the recipe in use; "pairs": false is --no-pairs.
 //
 // Both answer image/svg+xml. Bodies up to kMaxUploadBytes; an unknown field, a wrong type or
@@ -26,10 +26,10 @@
 #include "drivers/io/chart.h"
 #include "drivers/io/file_error.h"
 #include "drivers/io/json_config.h"
-#include "station/gap_diagnosis.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
-#include "station/pod_chart.h"
+#include "station/reports/gap_diagnosis.h"
+#include "station/reports/pod_chart.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>

@@ -7,9 +7,9 @@
 #include "drivers/io/chart.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
-#include "station/spc_charts.h"
-#include "station/stats_report.h"
-#include "station/yield.h"
+#include "station/reports/spc_charts.h"
+#include "station/reports/stats_report.h"
+#include "station/reports/yield.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -58,7 +58,7 @@ void GetStats(ApiContext& c, const httplib::Request& req, httplib::Response& res
 
 // GET /api/charts/<measurement>.svg?chart=imr|xbar_r|histogram&from=&to=&last=&subgroup=
 //   &population=all|pass&baseline=&recipe_hash=: the chart as image/svg+xml
-//   (station/spc_charts.h).
+//   (station/reports/spc_charts.h).
 // Unknown parameters are refused (a misspelt "subgrup" would otherwise draw the default).
 void GetChart(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   static const std::set<std::string> kKnown = {"chart",    "from",       "to",       "last",
@@ -108,7 +108,7 @@ void GetChart(ApiContext& c, const httplib::Request& req, httplib::Response& res
 }
 
 // The yield request of GET /api/yield and /api/yield/pareto.svg: from, to, recipe_hash, by,
-// shifts, utc_offset_min (station/yield.h), and for the chart `group` (a group's key).
+// shifts, utc_offset_min (station/reports/yield.h), and for the chart `group` (a group's key).
 // Unknown parameters are refused (a misspelt "by" would otherwise give the total).
 std::optional<ApiError> ParseYieldRequest(const httplib::Request& req, bool chart,
                                           YieldRequest* q) {
@@ -138,7 +138,7 @@ std::optional<ApiError> ParseYieldRequest(const httplib::Request& req, bool char
   return std::nullopt;
 }
 
-// GET /api/yield: station/yield.h's JSON.
+// GET /api/yield: station/reports/yield.h's JSON.
 void GetYield(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   YieldRequest q;
   if (const auto e = ParseYieldRequest(req, false, &q)) return Send(res, *e);

@@ -3,11 +3,11 @@
 #include <charconv>
 
 #include "db/clock.h"
+#include "db/serial_number.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
-#include "station/serial_number.h"
-#include "station/teardown_review.h"
-#include "station/unit_report.h"
+#include "station/reports/teardown_review.h"
+#include "station/reports/unit_report.h"
 #include "station/version.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
@@ -30,7 +30,7 @@ nlohmann::json WithVerdict(db::Store& store, const db::TeardownEntry& e) {
 void GetTeardowns(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   const std::string serial = req.matches[1];
   std::string why;
-  if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
+  if (!db::ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
   nlohmann::json list = nlohmann::json::array();
   {
     std::lock_guard<std::mutex> lock(c.db_mu);
@@ -48,7 +48,7 @@ void PostTeardown(ApiContext& c, const httplib::Request& req, httplib::Response&
   if (const ApiError* e = std::get_if<ApiError>(&who)) return Send(res, *e);
   const std::string serial = req.matches[1];
   std::string why;
-  if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
+  if (!db::ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
   const auto body = ParseBody(req);
   if (const ApiError* e = std::get_if<ApiError>(&body)) return Send(res, *e);
   const nlohmann::json& b = std::get<nlohmann::json>(body);
@@ -86,7 +86,7 @@ void GetTeardownReview(ApiContext& c, const httplib::Request& req, httplib::Resp
 void GetReport(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   const std::string serial = req.matches[1];
   std::string why;
-  if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
+  if (!db::ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
   long long test_id = 0;
   if (auto e = IntegerParam(req, "test_id", 1, INT64_MAX, &test_id)) return Send(res, *e);
   const std::shared_ptr<const Recipe> recipe =

@@ -1,11 +1,11 @@
 // Tests: start one, read the stored ones by serial, by id, or by query.
 #include <charconv>
 
+#include "db/serial_number.h"
 #include "station/central/central_record.h"
 #include "station/central/pg.h"
 #include "station/http/request.h"
 #include "station/http/routes.h"
-#include "station/serial_number.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -23,7 +23,7 @@ ApiError BadRequest(std::string code, std::string message) {
 void GetUnit(ApiContext& c, const httplib::Request& req, httplib::Response& res) {
   const std::string serial = req.matches[1];
   std::string why;
-  if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
+  if (!db::ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
   const std::string scope = req.has_param("scope") ? req.get_param_value("scope") : "station";
   if (scope != "station" && scope != "plant")
     return Send(res, BadRequest("bad_scope", "scope must be station or plant"));
@@ -104,7 +104,7 @@ void PostTest(ApiContext& c, const httplib::Request& req, httplib::Response& res
     return Send(res, BadRequest("bad_serial", "body must be {\"serial\": \"...\"}"));
   const std::string serial = body["serial"].get<std::string>();
   std::string why;
-  if (!ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
+  if (!db::ValidSerial(serial, &why)) return Send(res, BadRequest("bad_serial", why));
   TestRequest request{serial, {}, {}};
   if (!ReadWorkContext(body, &request.work, &why)) return Send(res, BadRequest("bad_field", why));
   if (body.contains("variant") && !body["variant"].is_null()) {

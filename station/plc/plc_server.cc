@@ -16,9 +16,9 @@
 #include <utility>
 #include <vector>
 
+#include "db/serial_number.h"
 #include "drivers/fixture/modbus_link.h"
 #include "drivers/fixture/modbus_tcp_server.h"
-#include "station/serial_number.h"
 
 namespace eol::station::plc {
 namespace {
@@ -182,7 +182,7 @@ void PlcServer::TakeStart() {
   };
   if (!text(m.serial, kSerialRegisters, &r.serial)) {
     reply = {PlcRefusal::kBadSerial, "serial registers: " + why, 0};
-  } else if (!ValidSerial(r.serial, &why)) {
+  } else if (!db::ValidSerial(r.serial, &why)) {
     reply = {PlcRefusal::kBadSerial, "serial '" + r.serial + "': " + why, 0};
   } else if (!text(m.operator_id, kOperatorIdRegisters, &r.work.operator_id)) {
     reply = {PlcRefusal::kBadField, "operator_id registers: " + why, 0};

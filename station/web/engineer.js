@@ -166,7 +166,7 @@ async function refresh() {
   }
 }
 
-// --- Yield over the same window (GET /api/yield, station/yield.h defines each figure). ---
+// --- Yield over the same window (GET /api/yield, station/reports/yield.h defines each figure). ---
 
 let yieldWindow = {};  // the window of the last refresh
 

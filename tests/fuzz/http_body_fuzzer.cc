@@ -8,8 +8,8 @@
 #include <string>
 #include <string_view>
 
+#include "db/serial_number.h"
 #include "station/http/request.h"
-#include "station/serial_number.h"
 #include "tests/fuzz/fuzz_support.h"
 
 namespace {
@@ -44,7 +44,7 @@ void CheckParams(const std::string& text) {
     Finding("TimeParam gave '" + from.value_or("(nothing)") + "' for '" + text + "'");
 }
 
-// station/serial_number.h written out again, independently of its implementation: 1 to 64
+// db/serial_number.h written out again, independently of its implementation: 1 to 64
 // characters from A-Z a-z 0-9 and "-_.:#+", starting with a letter or digit.
 bool SerialRule(const std::string& s) {
   auto alnum = [](char c) {
@@ -73,10 +73,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (body.is_object() && body.contains("serial") && body["serial"].is_string()) {
         std::string why;
         const std::string serial = body["serial"].get<std::string>();
-        const bool valid = eol::station::ValidSerial(serial, &why);
+        const bool valid = eol::db::ValidSerial(serial, &why);
         if (valid != SerialRule(serial))
           Finding("ValidSerial " + std::string(valid ? "accepted" : "refused") + " '" + serial +
-                  "' against station/serial_number.h");
+                  "' against db/serial_number.h");
         if (!valid && why.empty()) Finding("ValidSerial refused '" + serial + "' without a reason");
       }
     }

@@ -1,7 +1,7 @@
 // POST /api/pod.svg and POST /api/gap.svg against the real station over HTTP: the figure the
 // API draws from uploaded files is byte for byte the one `eol pod --pod-svg` and `eol gap
-// --plot` write from the same files (one drawing code, station/pod_chart.h and
-// station/gap_diagnosis.h), with the expected series; malformed input is 400 naming the
+// --plot` write from the same files (one drawing code, station/reports/pod_chart.h and
+// station/reports/gap_diagnosis.h), with the expected series; malformed input is 400 naming the
 // cause; with tokens only engineers may ask; bodies are bounded per route.
 #include <gtest/gtest.h>
 

@@ -65,16 +65,20 @@ class JudgeParityTest : public ::testing::Test {
     const Recipe recipe = LoadRecipe(recipe_path);
     const std::string recording = *dir_ / recording_file;
 
+    const nlohmann::json sim = {{"clamp_close_s", 0.02}, {"clamp_open_s", 0.02}};
+    auto bench = std::make_shared<drivers::SimBench>(
+        drivers::ParseSimBenchSettings(io::JsonObject(sim, "/sim")));
     drivers::DriverSet set = drivers::MakeDrivers(
         {{"fixture", {{"driver", "sim"}}},
          {"daq", {{"driver", "replay"}, {"file", recording}, {"repeat", true}}},
-         {"sim", {{"clamp_close_s", 0.02}, {"clamp_open_s", 0.02}}}});
+         {"sim", sim}},
+        bench);
     EXPECT_TRUE(set.fixture->Connect().ok());
     EXPECT_TRUE(set.daq->Connect().ok());
     auto store = db::Store::Open(*dir_ / (name + ".sqlite"));
     StatusBoard board("parity");
     const std::string serial = "PARITY-" + name;
-    set.bench->LoadUnit(analysis::DrawUnit(set.bench->settings().population, serial, false));
+    bench->LoadUnit(analysis::DrawUnit(bench->settings().population, serial, false));
     Sequencer sequencer(*set.fixture, *set.daq, *store, std::make_shared<const Recipe>(recipe),
                         board, SequencerOptions{});
     const db::TestRecord station = sequencer.RunTest(serial);

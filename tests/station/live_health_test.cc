@@ -178,7 +178,9 @@ class IdleStation : public ::testing::Test {
         {"fixture", {{"driver", "modbus-tcp"}, {"host", "127.0.0.1"}, {"port", port_}}},
         {"daq", {{"driver", "sim"}}},
         {"health", {{"period_ms", kPeriodMs}}}};
-    station_ = std::make_unique<Station>(ParseStationConfig(config, "t", ""), bench_);
+    StationConfig parsed = ParseStationConfig(config, "t", "");
+    drivers::DriverSet drivers = drivers::MakeDrivers(parsed.drivers, bench_);
+    station_ = std::make_unique<Station>(std::move(parsed), std::move(drivers));
     serve_ = std::thread([this] { station_->Serve(); });
   }
   void TearDown() override {

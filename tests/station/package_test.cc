@@ -30,11 +30,12 @@ TEST(DebianPackage, HoldsProgramUnitConfigRecipesAndPage) {
 
   eol::testing::ChildProcess contents({"/usr/bin/dpkg-deb", "-c", deb});
   ASSERT_EQ(contents.Wait(60s).value_or(-1), 0);
-  for (const char* f : {"./usr/bin/eol", "./lib/systemd/system/eol-station.service",
-                        "./etc/eol/station.json", "./usr/share/eol/recipes/pmsm-10pole.json",
-                        "./usr/share/eol/web/index.html", "./usr/share/eol/web/app.js",
-                        "./usr/share/eol/web/engineer.html", "./usr/share/eol/web/engineer.js",
-                        "./usr/share/eol/web/i18n/en.json", "./usr/share/eol/web/i18n/ja.json"})
+  for (const char* f :
+       {"./usr/bin/eol", "./usr/bin/eol-station", "./lib/systemd/system/eol-station.service",
+        "./etc/eol/station.json", "./usr/share/eol/recipes/pmsm-10pole.json",
+        "./usr/share/eol/web/index.html", "./usr/share/eol/web/app.js",
+        "./usr/share/eol/web/engineer.html", "./usr/share/eol/web/engineer.js",
+        "./usr/share/eol/web/i18n/en.json", "./usr/share/eol/web/i18n/ja.json"})
     EXPECT_NE(contents.output().find(f), std::string::npos) << f << " missing:\n"
                                                             << contents.output();
   // The manual page, made from the program's help (cmake/ManPage.cmake).
@@ -88,6 +89,9 @@ TEST(DebianPackage, ServiceUnitIsHardened) {
   std::ifstream in(unit);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("SupplementaryGroups=dialout audio"), std::string::npos);
+  // It runs the daemon's own program, which links no bench or emulator (daemon_symbols.sh).
+  EXPECT_NE(text.find("\nExecStart=/usr/bin/eol-station --config /etc/eol/station.json\n"),
+            std::string::npos);
 }
 
 }  // namespace

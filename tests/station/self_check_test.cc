@@ -11,8 +11,8 @@
 
 #include "../support/child_process.h"
 #include "../support/manual_station_clock.h"
+#include "station/reports/stats_report.h"
 #include "station/station.h"
-#include "station/stats_report.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -60,7 +60,12 @@ class SelfCheckTest : public ::testing::Test {
 
 TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) {
   {
-    Station s(Config(true));
+    // The bench made here, so the test can see the clamp command never went out.
+    StationConfig config = Config(true);
+    auto bench = std::make_shared<drivers::SimBench>(
+        drivers::ParseSimBenchSettings(io::JsonObject(config.drivers["sim"], "/sim")));
+    drivers::DriverSet drivers = drivers::MakeDrivers(config.drivers, bench);
+    Station s(std::move(config), std::move(drivers));
     ASSERT_TRUE(Lockout(s).at("locked").get<bool>());
     EXPECT_NE(
         Lockout(s)["reason"].get<std::string>().find("no self-check of the good master MASTER-G"),
@@ -72,7 +77,7 @@ TEST_F(SelfCheckTest, LockoutLifecycleSurvivesRestartAndUnlocksOnAPassingCheck) 
     EXPECT_EQ(refused.reasons.front().text.rfind("station locked out: no self-check", 0), 0u)
         << Reasons(refused);
     EXPECT_TRUE(s.store().TestsOfSerial("U-1").empty());
-    EXPECT_FALSE(s.bench()->output(drivers::FixtureOutput::kClampCmd));
+    EXPECT_FALSE(bench->output(drivers::FixtureOutput::kClampCmd));
 
     const db::TestRecord good = s.RunTest("MASTER-G");
     EXPECT_EQ(good.outcome, Outcome::kPass) << Reasons(good);
@@ -172,7 +177,7 @@ TEST_F(SelfCheckTest, ACheckIsDueAfterEveryNTestsAndAfterEveryHours) {
     // A check valid for 8 h, on a calendar the test moves (the station's wall clock): valid
     // just before the 8 h are over, production refused once they are.
     auto calendar = std::make_shared<drivers::ManualClock>();
-    Station s(Config(true, 0, 8), nullptr, eol::testing::ManualWallClock(calendar));
+    Station s(Config(true, 0, 8), {}, eol::testing::ManualWallClock(calendar));
     EXPECT_EQ(s.RunTest("MASTER-G").outcome, Outcome::kPass);
     EXPECT_EQ(s.RunTest("MASTER-L").outcome, Outcome::kFail);
     calendar->Advance(std::chrono::hours(8) - std::chrono::minutes(1));

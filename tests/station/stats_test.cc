@@ -1,4 +1,4 @@
-// Statistics (station/stats_report.h) end to end: known answers through `eol stats` and
+// Statistics (station/reports/stats_report.h) end to end: known answers through `eol stats` and
 // GET /api/stats on a real store, and the drift alarm on the simulated station with and
 // without fixture wear (fixed seeds).
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 #include "../support/child_process.h"
 #include "db/store.h"
 #include "station/http_api.h"
+#include "station/reports/stats_report.h"
 #include "station/station.h"
-#include "station/stats_report.h"
 #include "tests/support/eol_cli.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.

@@ -12,7 +12,7 @@
 
 #include "db/store.h"
 #include "station/recipe.h"
-#include "station/teardown_review.h"
+#include "station/reports/teardown_review.h"
 #include "tests/support/child_process.h"
 #include "tests/support/eol_cli.h"
 #include "tests/support/pass_records.h"

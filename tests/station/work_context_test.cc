@@ -63,7 +63,7 @@ TEST(ScannerLine, TheSerialAloneOrWithTabSeparatedFields) {
   EXPECT_EQ(r->work, db::WorkContext{});
   r = ParseScannerLine("SN-2\tshift=night\torder_number=PO-4711\toperator_id=op 17", &why);
   ASSERT_TRUE(r) << why;
-  EXPECT_EQ(r->serial, "SN-2");  // serials allow no spaces (station/serial_number.h)
+  EXPECT_EQ(r->serial, "SN-2");  // serials allow no spaces (db/serial_number.h)
   EXPECT_EQ(r->work, (db::WorkContext{"op 17", "night", "PO-4711"}));
 
   EXPECT_FALSE(ParseScannerLine("SN-1\toperator=op-17", &why));

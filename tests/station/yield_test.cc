@@ -1,7 +1,7 @@
-// Yield (station/yield.h): the figures of hand-made tests worked out by hand below, through
+// Yield (station/reports/yield.h): the figures of hand-made tests worked out by hand below, through
 // ComputeYield, `eol stats --yield` on a real store and GET /api/yield (real HTTP on
 // 127.0.0.1); the Pareto chart; retest marking (the attempt each stored test knows).
-#include "station/yield.h"
+#include "station/reports/yield.h"
 
 #include <gtest/gtest.h>
 

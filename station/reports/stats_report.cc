@@ -1,10 +1,10 @@
-#include "station/stats_report.h"
+#include "station/reports/stats_report.h"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "station/serial_number.h"
+#include "db/serial_number.h"
 
 namespace eol::station {
 namespace {
@@ -173,7 +173,7 @@ std::string ValidateStatsRequest(const StatsRequest& r) {
   if (r.subgroup != 1 && !analysis::SpcConstantsFor(r.subgroup))
     return "subgroup must be 1 (I-MR) or 2..10 (X-bar/R)";
   if (!r.rules.IsValid(&why)) return "rules: " + why;
-  if (r.gauge_serial && !ValidSerial(*r.gauge_serial, &why)) return "gauge: " + why;
+  if (r.gauge_serial && !db::ValidSerial(*r.gauge_serial, &why)) return "gauge: " + why;
   if (r.from && r.to && !(*r.from < *r.to)) return "from must be before to";
   if (r.baseline < 2) return "baseline must be at least 2 PASS units";
   return "";

@@ -1,4 +1,4 @@
-#include "station/yield.h"
+#include "station/reports/yield.h"
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "station/gap_report.h"
+#include "station/reports/gap_report.h"
 
 #include <cmath>
 #include <cstdio>

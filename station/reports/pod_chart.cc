@@ -1,4 +1,4 @@
-#include "station/pod_chart.h"
+#include "station/reports/pod_chart.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
-#include "station/serial_number.h"
+#include "db/serial_number.h"
 
 #include <string_view>
 
-namespace eol::station {
+namespace eol::db {
 
 bool ValidSerial(const std::string& s, std::string* why) {
   auto fail = [&](const std::string& m) {
@@ -25,4 +25,4 @@ bool ValidSerial(const std::string& s, std::string* why) {
   return true;
 }
 
-}  // namespace eol::station
+}  // namespace eol::db

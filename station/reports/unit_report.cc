@@ -1,4 +1,4 @@
-#include "station/unit_report.h"
+#include "station/reports/unit_report.h"
 
 #include <cairo-pdf.h>
 #include <cairo.h>
@@ -9,7 +9,7 @@
 #include <stdexcept>
 
 #include "drivers/io/chart.h"
-#include "station/curve_chart.h"
+#include "station/reports/curve_chart.h"
 
 namespace eol::station {
 namespace {

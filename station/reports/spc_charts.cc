@@ -1,4 +1,4 @@
-#include "station/spc_charts.h"
+#include "station/reports/spc_charts.h"
 
 #include <algorithm>
 #include <charconv>

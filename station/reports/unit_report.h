@@ -6,8 +6,8 @@
 //           every measurement with its value, unit, limits and outcome; the teardown findings
 //           of the serial (each with who and when), when there are any;
 //   page 2: the stored impedance curve with the fitted model, the resonance window and, when
-//           the caller has the test's recipe (same hash), its masks (station/curve_chart.h);
-//           a test that stored no curve says so instead.
+//           the caller has the test's recipe (same hash), its masks
+//           (station/reports/curve_chart.h); a test that stored no curve says so instead.
 // Text is drawn as text (cairo's PDF surface embeds the font with its Unicode map), so
 // `pdftotext` or a screen reader finds the serial and the verdict.
 #pragma once

@@ -7,8 +7,8 @@
 
 #include <string>
 
-namespace eol::station {
+namespace eol::db {
 
 bool ValidSerial(const std::string& serial, std::string* why);
 
-}  // namespace eol::station
+}  // namespace eol::db

@@ -9,7 +9,7 @@
 //     overall sd, with a caveat below 30 units;
 //   the control chart (I chart, or X-bar with subgroups): limits from the first `baseline`
 //     PASS units, every unit's point against them, its run-rule alarms (rules 1-3 of
-//     analysis/qc/spc.h), each naming the unit and serial (station/spc_charts.h);
+//     analysis/qc/spc.h), each naming the unit and serial (station/reports/spc_charts.h);
 //   drift (the trend test) over the passing production tests in test order (a rejected
 //     defect is not a trend), with the alarm and its message;
 //   a type-1 gauge study when a serial is given: its PASS/FAIL tests (production or
@@ -41,7 +41,7 @@
 
 #include "analysis/qc/statistics.h"
 #include "db/store.h"
-#include "station/spc_charts.h"
+#include "station/reports/spc_charts.h"
 
 namespace eol::station {
 

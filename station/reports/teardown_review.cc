@@ -1,4 +1,4 @@
-#include "station/teardown_review.h"
+#include "station/reports/teardown_review.h"
 
 #include <algorithm>
 #include <cmath>

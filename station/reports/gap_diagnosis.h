@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "drivers/io/chart.h"
-#include "station/gap_report.h"
+#include "station/reports/gap_report.h"
 
 namespace eol::station {
 

@@ -1,4 +1,4 @@
-#include "station/gap_diagnosis.h"
+#include "station/reports/gap_diagnosis.h"
 
 #include <stdlib.h>  // mkdtemp
 

@@ -1,4 +1,4 @@
-#include "station/curve_chart.h"
+#include "station/reports/curve_chart.h"
 
 #include <charconv>
 #include <cmath>
