@@ -3,10 +3,12 @@
 # corpus (tests/fuzz/corpus/<target>). Exits 1 on any finding (crash, leak, undefined
 # behaviour, timeout, out-of-memory, broken contract), naming the input that reproduces it.
 #
-#   tests/fuzz/run_fuzzers.sh [--build DIR] [--seconds N] [--fork N] [TARGET...]
+#   tests/fuzz/run_fuzzers.sh [--build DIR] [--seconds N] [--fork N] [--build-only] [TARGET...]
 #
 #   --build DIR   the fuzz build tree (default build/fuzz); configured when it is not yet
 #   --seconds N   fuzzing time per target (default 20: the CI-sized run of the test suite)
+#   --build-only  configure and build the tree, fuzz nothing (deploy/run-tests.sh builds it
+#                 with the rest, so the suite's fuzz_readers test only fuzzes)
 #   --fork N      N fuzzing processes per target that go on after a finding, so a long run
 #                 collects every finding instead of stopping at the first (libFuzzer -fork)
 #   TARGET        recipe config frf_csv zma recording_csv wav http_body curve_codec (default: all)
@@ -17,12 +19,14 @@ src="$(cd "$(dirname "$0")/../.." && pwd)"
 build="$src/build/fuzz"
 seconds=20
 fork=0
+build_only=0
 targets=()
 while (($#)); do
   case "$1" in
     --build) build="$2"; shift 2 ;;
     --seconds) seconds="$2"; shift 2 ;;
     --fork) fork="$2"; shift 2 ;;
+    --build-only) build_only=1; shift ;;
     -*) echo "run_fuzzers: unknown option $1" >&2; exit 2 ;;
     *) targets+=("$1"); shift ;;
   esac
@@ -45,6 +49,7 @@ if [[ ! -f "$build/build.ninja" ]]; then
 fi
 # The machine is shared with the rest of the suite: build and fuzz at a lower priority.
 CCACHE_BASEDIR="${CCACHE_BASEDIR:-$src}" nice -n 10 cmake --build "$build" --target eol_fuzzers
+if ((build_only)); then exit 0; fi
 
 findings=0
 for t in "${targets[@]}"; do
