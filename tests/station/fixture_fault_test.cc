@@ -21,6 +21,7 @@
 #include "db/store.h"
 #include "tests/support/child_process.h"
 #include "tests/support/station_ready.h"
+#include "tests/support/stored_test.h"
 #include "tests/support/wait_until.h"
 
 namespace eol {
@@ -56,24 +57,6 @@ int ReadExcitationCoil(int port) {
   modbus_close(ctx);
   modbus_free(ctx);
   return rc == 1 ? bit : -1;
-}
-
-// Waits until the serial's latest test has finished; returns it (null on timeout).
-nlohmann::json WaitForFinishedTest(httplib::Client& http, const std::string& serial,
-                                   std::chrono::seconds timeout) {
-  nlohmann::json test;
-  eol::testing::WaitUntil(
-      [&] {
-        const auto res = http.Get(("/api/units/" + serial).c_str());
-        if (!res || res->status != 200) return false;
-        const auto unit = nlohmann::json::parse(res->body);
-        if (unit["tests"].empty() || unit["tests"].back()["finished_at"].get<std::string>().empty())
-          return false;
-        test = unit["tests"].back();
-        return true;
-      },
-      timeout, 50ms);
-  return test;
 }
 
 // When a fault injected with --fault-on-excitation --fault-after-ms `after` and
@@ -138,7 +121,7 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
   const auto started =
       http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-1"}}.dump(), "application/json");
   ASSERT_TRUE(started && started->status == 202) << (started ? started->body : "no answer");
-  const nlohmann::json faulted = WaitForFinishedTest(http, "FAULT-1", 60s);
+  const nlohmann::json faulted = eol::testing::WaitForStoredTest(http, "FAULT-1", 60s);
   ASSERT_FALSE(faulted.is_null()) << station.output();
   EXPECT_EQ(faulted["outcome"], "ERROR") << faulted.dump();
   const std::string reasons = faulted["reasons"].dump();
@@ -179,7 +162,7 @@ TEST_P(FixtureFault, EndsInErrorWithTheCauseStoredAndTheStationRecovers) {
   const auto again =
       http.Post("/api/tests", nlohmann::json{{"serial", "FAULT-2"}}.dump(), "application/json");
   ASSERT_TRUE(again && again->status == 202) << (again ? again->body : "no answer");
-  const nlohmann::json recovered = WaitForFinishedTest(http, "FAULT-2", 60s);
+  const nlohmann::json recovered = eol::testing::WaitForStoredTest(http, "FAULT-2", 60s);
   ASSERT_FALSE(recovered.is_null()) << station.output();
   EXPECT_TRUE(recovered["outcome"] == "PASS" || recovered["outcome"] == "FAIL")
       << recovered.dump() << "\n"

@@ -18,6 +18,7 @@
 
 #include "tests/support/child_process.h"
 #include "tests/support/station_ready.h"
+#include "tests/support/stored_test.h"
 #include "tests/support/wait_until.h"
 
 namespace eol {
@@ -142,18 +143,8 @@ TEST_F(StationDeath, FrozenInExcitationTheRelayOpensAndTheResumedTestIsErrorStal
   EXPECT_GE(off_ms, 0.0) << "the relay stayed closed through the freeze";
   EXPECT_LE(off_ms, 300.0);
 
-  nlohmann::json test;
-  eol::testing::WaitUntil(
-      [&] {
-        const auto res = http_->Get("/api/units/STOP-1");
-        if (!res || res->status != 200) return false;
-        const auto unit = nlohmann::json::parse(res->body);
-        if (unit["tests"].empty() || unit["tests"].back()["finished_at"].get<std::string>().empty())
-          return false;
-        test = unit["tests"].back();
-        return true;
-      },
-      eol::testing::kGenerousDeadline, 50ms);
+  const nlohmann::json test =
+      eol::testing::WaitForStoredTest(*http_, "STOP-1", eol::testing::kGenerousDeadline);
   ASSERT_FALSE(test.is_null()) << station_->output();
   EXPECT_EQ(test["outcome"], "ERROR") << test.dump();
   EXPECT_NE(test["reasons"].dump().find("watchdog stalled"), std::string::npos) << test.dump();

@@ -13,6 +13,24 @@
 
 namespace eol::testing {
 
+// The serial's newest test (GET /api/units lists newest first) once it has finished_at, polled
+// every 50 ms; null when none has within `timeout`.
+inline nlohmann::json WaitForStoredTest(httplib::Client& http, const std::string& serial,
+                                        std::chrono::milliseconds timeout) {
+  using namespace std::chrono_literals;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  do {
+    const httplib::Result unit = http.Get("/api/units/" + serial);
+    if (unit && unit->status == 200) {
+      const nlohmann::json tests = nlohmann::json::parse(unit->body)["tests"];
+      if (!tests.empty() && !tests.front()["finished_at"].get<std::string>().empty())
+        return tests.front();
+    }
+    std::this_thread::sleep_for(50ms);
+  } while (std::chrono::steady_clock::now() < deadline);
+  return nlohmann::json();
+}
+
 // The stored test's summary (the unit's newest entry), or null with *why set: not started
 // (no answer, or the status and body of the refusal) or not stored within 30 s.
 inline nlohmann::json RunStoredTest(httplib::Client& http, const std::string& serial,
@@ -35,16 +53,8 @@ inline nlohmann::json RunStoredTest(httplib::Client& http, const std::string& se
   if (!res) return fail("not started: no answer");
   if (res->status != 202)
     return fail("not started: " + std::to_string(res->status) + " " + res->body);
-  for (int i = 0; i < 600; ++i) {
-    const httplib::Result unit = http.Get("/api/units/" + serial);
-    if (unit && unit->status == 200) {
-      const nlohmann::json tests = nlohmann::json::parse(unit->body)["tests"];
-      if (!tests.empty() && !tests.front()["finished_at"].get<std::string>().empty())
-        return tests.front();
-    }
-    std::this_thread::sleep_for(50ms);
-  }
-  return fail("timeout");
+  const nlohmann::json test = WaitForStoredTest(http, serial, 30s);
+  return test.is_null() ? fail("timeout") : test;
 }
 
 }  // namespace eol::testing
