@@ -632,6 +632,16 @@ LineMask EffectFitter::Thinned(const LineMask& mask, long step) const {
   return out;
 }
 
+// A plausible, converged optimum beats a lower cost outside the bounds: a fit that runs off to
+// a degenerate corner (a fixture spring of zero stiffness with a second inertia as the
+// support) from one start is no answer when another start settles on a physical one.
+bool EffectFitter::Admissible(const EffectFit& f) const {
+  std::string why;
+  for (const AppliedEffect& e : f.effects)
+    if (!IsPlausible(Spec(e.kind), e, &why)) return false;
+  return f.converged;
+}
+
 std::vector<EffectFitter::Start> EffectFitter::Screened(std::vector<Start> starts,
                                                         const LineMask& coarse,
                                                         int max_iterations) const {
@@ -641,10 +651,7 @@ std::vector<EffectFitter::Start> EffectFitter::Screened(std::vector<Start> start
   for (const auto& [at, s] : starts) {
     EffectFit f = FitFrom(at, mode_, s, coarse, max_iterations);
     if (!std::isfinite(f.cost)) continue;
-    std::string why;
-    bool ok = f.converged;
-    for (const AppliedEffect& e : f.effects) ok = ok && IsPlausible(Spec(e.kind), e, &why);
-    ranked.emplace_back(!ok, f.Evidence(), Start{f.nominal, f.effects});
+    ranked.emplace_back(!Admissible(f), f.Evidence(), Start{f.nominal, f.effects});
   }
   std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
     return std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
@@ -1034,15 +1041,6 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
       }
     }
   }
-  // A plausible, converged optimum beats a lower cost outside the bounds: a fit that runs off
-  // to a degenerate corner (a fixture spring of zero stiffness with a second inertia as the
-  // support) from one start is no answer when another start settles on a physical one.
-  auto admissible = [&](const EffectFit& f) {
-    std::string why;
-    for (const AppliedEffect& e : f.effects)
-      if (!IsPlausible(Spec(e.kind), e, &why)) return false;
-    return f.converged;
-  };
   // Each start's optimum is one basin of the likelihood. The answer is the basin with the best
   // evidence (cost + Occam), which is not always the lowest cost: a narrow basin whose mode
   // fits a few noisy lines pays for pinning its parameters, a broad one that explains the same
@@ -1054,7 +1052,7 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
   for (const auto& [at, s] : starts) {
     EffectFit f = FitFrom(at, mode_, s, mask, max_iterations);
     if (!std::isfinite(f.cost)) continue;
-    ok.push_back(admissible(f));
+    ok.push_back(Admissible(f));
     fits.push_back(std::move(f));
   }
   if (fits.empty()) {

@@ -217,6 +217,7 @@ class EffectFitter {
   static constexpr long kScreenLines = 1500;
   static constexpr std::size_t kRefinedStarts = 3;
   using Start = std::pair<NominalNetwork, std::vector<AppliedEffect>>;  // nominal, effects
+  bool Admissible(const EffectFit& f) const;  // plausible (IsPlausible) and converged
   long SelectedLines(const LineMask& mask) const;
   LineMask Thinned(const LineMask& mask, long step) const;
   std::vector<Start> Screened(std::vector<Start> starts, const LineMask& coarse,
