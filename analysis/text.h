@@ -3,6 +3,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <locale>
 #include <sstream>
 #include <string>
@@ -35,6 +36,20 @@ inline std::string Significant(double v, int digits) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
   return std::string(buf, r.ptr);
+}
+
+// One number in a printf format with one conversion for a double ("%+.1f", "%9.1f", "%.3g %%"),
+// for tables that need widths or signs. The programs set LC_NUMERIC "C" (station/cli/main.cc,
+// eol_station_main.cc), so the decimal point is '.'. Results longer than 63 characters are cut.
+inline std::string Printf(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+// A fraction as a percentage with `digits` decimals: Percent(0.1234, 1) = "12.3 %".
+inline std::string Percent(double fraction, int digits) {
+  return Fixed(100.0 * fraction, digits) + " %";
 }
 
 // n >= 2 log-spaced points from lo to hi inclusive (lo, hi > 0); the last point is exactly hi.

@@ -18,6 +18,7 @@
 #include <optional>
 
 #include "analysis/qc/detectability.h"
+#include "analysis/text.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/golden_inputs.h"
@@ -78,11 +79,7 @@ std::map<std::string, double> SpreadFromGolden(const std::vector<analysis::Golde
   return sd;
 }
 
-std::string G(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
+std::string G(double v) { return analysis::Significant(v, 4); }
 
 int RunDetect(const DetectArgs& a) {
   if (!a.gap.empty() && a.k_fixture > 0.0)

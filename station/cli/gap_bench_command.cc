@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/bench/gap_bench.h"
+#include "analysis/text.h"
 #include "station/bench/gap_independent_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
@@ -26,11 +27,7 @@ struct GapBenchArgs {
   std::vector<std::string> independent;
 };
 
-std::string Pct(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f %%", 100.0 * x);
-  return buf;
-}
+std::string Pct(double x) { return analysis::Percent(x, 1); }
 
 void PrintMatrix(std::ostream& out, const analysis::GapBenchSummary& s) {
   out << "confusion matrix (rows: hidden effect, columns: diagnosis)\n";

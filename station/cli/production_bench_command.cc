@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/bench/production_bench.h"
+#include "analysis/text.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/progress.h"
@@ -27,11 +28,7 @@ struct BenchArgs {
   std::string pod_svg;
 };
 
-std::string Percent(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.2f %%", 100.0 * v);
-  return buf;
-}
+std::string Percent(double v) { return analysis::Percent(v, 2); }
 
 // Units of class c that took more than one look (a sequential recipe).
 int ExtendedOf(const analysis::ProductionBenchSummary& s, analysis::DefectClass c) {

@@ -18,6 +18,7 @@
 #include <set>
 
 #include "analysis/qc/measurement_names.h"
+#include "analysis/text.h"
 #include "drivers/io/chart.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
@@ -52,9 +53,7 @@ struct StatsArgs {
 
 std::string Num(const nlohmann::json& v, const char* fmt = "%.4g") {
   if (!v.is_number()) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v.get<double>());
-  return buf;
+  return analysis::Printf(fmt, v.get<double>());
 }
 
 void PrintText(const nlohmann::json& r) {

@@ -5,9 +5,12 @@
 #include <locale>
 #include <sstream>
 
+#include "analysis/text.h"
+
 namespace eol::station {
 namespace {
 
+using analysis::Printf;
 using nlohmann::json;
 
 const char* QuantityName(analysis::Quantity q) {
@@ -54,15 +57,9 @@ json Offsets(const std::vector<analysis::ToleranceDeviation>& offsets) {
   return j;
 }
 
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
-
 std::string ParamText(const analysis::NamedValue& p) {
-  std::string s = p.name + " = " + Fmt("%.5g", p.value);
-  if (std::isfinite(p.sigma) && p.sigma > 0.0) s += " +- " + Fmt("%.2g", p.sigma);
+  std::string s = p.name + " = " + Printf("%.5g", p.value);
+  if (std::isfinite(p.sigma) && p.sigma > 0.0) s += " +- " + Printf("%.2g", p.sigma);
   return s;
 }
 
@@ -75,10 +72,11 @@ const analysis::RankedEffect* Winner(const analysis::GapSummary& gap) {
   return nullptr;
 }
 
-json GapReportJson(const GapReport& r) {
+namespace {
+
+// The answer: which effect, its rivals, the calibration within and beyond the tolerances.
+void AnswerJson(const GapReport& r, json& j) {
   const analysis::GapSummary& g = r.gap;
-  json j;
-  j["quantity"] = QuantityName(r.quantity);
   j["effect"] = g.effect;
   json names = json::array();
   for (const auto& e : g.winner) names.push_back(analysis::ToString(e.kind));
@@ -105,6 +103,10 @@ json GapReportJson(const GapReport& r) {
                            {"offsets", Offsets(g.beyond.offsets)}};
   const analysis::RankedEffect* w = Winner(g);
   j["params"] = w ? ParamsValue(w->params) : json::object();
+}
+
+// How large the gap is and where, before and after the answer, with the held-out check.
+void GapFiguresJson(const analysis::GapSummary& g, json& j) {
   j["gap_before"] = Num(g.gap_before);
   j["gap_after"] = Num(g.gap_after);
   j["chi2_before"] = Num(g.chi2_before);
@@ -118,18 +120,25 @@ json GapReportJson(const GapReport& r) {
                   {"method", g.heldout.method}};
   j["where"] = Bands(g.where);
   j["where_after"] = Bands(g.where_after);
-  json ranking = json::array();
-  for (const auto& e : g.ranking)
-    ranking.push_back({{"effect", e.effect},
-                       {"params", ParamsValue(e.params)},
-                       {"params_sigma", ParamsSigma(e.params)},
-                       {"score", Num(e.score)},
-                       {"bic", Num(e.bic)},
-                       {"cost", Num(e.cost)},
-                       {"gap_after", Num(e.gap_after)},
-                       {"plausible", e.plausible},
-                       {"rejected", e.rejected}});
-  j["ranking"] = ranking;
+}
+
+json RankingJson(const std::vector<analysis::RankedEffect>& ranking) {
+  json out = json::array();
+  for (const auto& e : ranking)
+    out.push_back({{"effect", e.effect},
+                   {"params", ParamsValue(e.params)},
+                   {"params_sigma", ParamsSigma(e.params)},
+                   {"score", Num(e.score)},
+                   {"bic", Num(e.bic)},
+                   {"cost", Num(e.cost)},
+                   {"gap_after", Num(e.gap_after)},
+                   {"plausible", e.plausible},
+                   {"rejected", e.rejected}});
+  return out;
+}
+
+// Per measured unit: the features of its gap and the refit of the nominal's own parameters.
+void FeaturesJson(const GapReport& r, json& j) {
   json features = json::array();
   json refit = json::array();
   for (std::size_t u = 0; u < r.features.size() && u < r.measured.size(); ++u) {
@@ -150,47 +159,52 @@ json GapReportJson(const GapReport& r) {
   }
   j["features"] = features;
   j["refit"] = refit;
-  const analysis::GapSplit& sp = g.split;
-  if (sp.available) {
-    auto motional = [](const analysis::NominalNetwork& n) {
-      if (n.quantity == analysis::Quantity::kMobility)
-        return json{{"gain_rad_per_s2_per_a", Num(n.rigid.gain_rad_per_s2_per_a)},
-                    {"damping_per_s", Num(n.rigid.damping_per_s)}};
-      const analysis::MotionalImpedance& m = n.motional;
-      return json{{"R_ohm", Num(m.r_ohm)},
-                  {"L_h", Num(m.l_h)},
-                  {"Rp_ohm", Num(m.rp_ohm)},
-                  {"f0_hz", Num(m.f0_hz)},
-                  {"Q", Num(m.q)}};
-    };
-    json eff = json::array();
-    for (const auto& e : sp.effect)
-      eff.push_back({{"effect", analysis::ToString(e.kind)}, {"params", e.params}});
-    j["split"] = {{"g_nominal", Num(sp.g_nominal)},
-                  {"g_within_tolerance", Num(sp.g_within)},
-                  {"g_beyond_tolerance", Num(sp.g_beyond)},
-                  {"g_structure", Num(sp.g_structure)},
-                  {"share_within_tolerance", Num(sp.share_within)},
-                  {"share_beyond_tolerance", Num(sp.share_beyond)},
-                  {"share_structure_within_tolerance", Num(sp.share_structure_within)},
-                  {"share_left_within_tolerance", Num(sp.share_left_within)},
-                  {"heldout_g_within_tolerance", Num(sp.heldout_g_within)},
-                  {"heldout_g_beyond_tolerance", Num(sp.heldout_g_beyond)},
-                  {"heldout_g_structure", Num(sp.heldout_g_structure)},
-                  {"g_refit", Num(sp.g_refit)},
-                  {"g_refit_effect", Num(sp.g_refit_effect)},
-                  {"share_calibration", Num(sp.share_calibration)},
-                  {"share_structure", Num(sp.share_structure)},
-                  {"share_left", Num(sp.share_left)},
-                  {"heldout_g_nominal", Num(sp.heldout_g_nominal)},
-                  {"heldout_g_refit_effect", Num(sp.heldout_g_refit_effect)},
-                  {"heldout_method", sp.heldout_method},
-                  {"refit", motional(sp.refit)},
-                  {"refit_effect", motional(sp.refit_effect)},
-                  {"effect", eff}};
-  } else {
-    j["split"] = {{"message", sp.message}};
-  }
+}
+
+json MotionalJson(const analysis::NominalNetwork& n) {
+  if (n.quantity == analysis::Quantity::kMobility)
+    return json{{"gain_rad_per_s2_per_a", Num(n.rigid.gain_rad_per_s2_per_a)},
+                {"damping_per_s", Num(n.rigid.damping_per_s)}};
+  const analysis::MotionalImpedance& m = n.motional;
+  return json{{"R_ohm", Num(m.r_ohm)},
+              {"L_h", Num(m.l_h)},
+              {"Rp_ohm", Num(m.rp_ohm)},
+              {"f0_hz", Num(m.f0_hz)},
+              {"Q", Num(m.q)}};
+}
+
+// How far the gap shrinks: calibration within the tolerances, beyond them, structure.
+json SplitJson(const analysis::GapSplit& sp) {
+  if (!sp.available) return {{"message", sp.message}};
+  json eff = json::array();
+  for (const auto& e : sp.effect)
+    eff.push_back({{"effect", analysis::ToString(e.kind)}, {"params", e.params}});
+  return {{"g_nominal", Num(sp.g_nominal)},
+          {"g_within_tolerance", Num(sp.g_within)},
+          {"g_beyond_tolerance", Num(sp.g_beyond)},
+          {"g_structure", Num(sp.g_structure)},
+          {"share_within_tolerance", Num(sp.share_within)},
+          {"share_beyond_tolerance", Num(sp.share_beyond)},
+          {"share_structure_within_tolerance", Num(sp.share_structure_within)},
+          {"share_left_within_tolerance", Num(sp.share_left_within)},
+          {"heldout_g_within_tolerance", Num(sp.heldout_g_within)},
+          {"heldout_g_beyond_tolerance", Num(sp.heldout_g_beyond)},
+          {"heldout_g_structure", Num(sp.heldout_g_structure)},
+          {"g_refit", Num(sp.g_refit)},
+          {"g_refit_effect", Num(sp.g_refit_effect)},
+          {"share_calibration", Num(sp.share_calibration)},
+          {"share_structure", Num(sp.share_structure)},
+          {"share_left", Num(sp.share_left)},
+          {"heldout_g_nominal", Num(sp.heldout_g_nominal)},
+          {"heldout_g_refit_effect", Num(sp.heldout_g_refit_effect)},
+          {"heldout_method", sp.heldout_method},
+          {"refit", MotionalJson(sp.refit)},
+          {"refit_effect", MotionalJson(sp.refit_effect)},
+          {"effect", eff}};
+}
+
+// The inputs: the simulation with its calibration, and each measured unit.
+void InputsJson(const GapReport& r, json& j) {
   j["calibration"] = {{"simulation", r.simulation.source},
                       {"kind", r.simulation.kind},
                       {"note", r.simulation.note},
@@ -206,54 +220,73 @@ json GapReportJson(const GapReport& r) {
               {"note", r.measured[u].note},
               {"lines", r.measured[u].frf.size()},
               {"sigma_estimated", r.measured[u].sigma_estimated}};
-    if (u < g.units.size()) {
-      m["gap_before"] = Num(g.units[u].gap_before);
-      m["gap_after"] = Num(g.units[u].gap_after);
+    if (u < r.gap.units.size()) {
+      m["gap_before"] = Num(r.gap.units[u].gap_before);
+      m["gap_after"] = Num(r.gap.units[u].gap_after);
     }
     meas.push_back(m);
   }
   j["measurements"] = meas;
   j["sigma_pool_lines"] = r.sigma_pool;
   j["sigma_dof"] = Num(r.sigma_dof);
-  if (r.prediction) {
-    const auto& p = r.prediction->prediction;
-    json effects = json::array();
-    for (const auto& e : p.effects)
-      effects.push_back({{"effect", analysis::ToString(e.kind)}, {"params", e.params}});
-    j["prediction"] = {{"simulation", r.prediction->simulation.source},
-                       {"usable", p.usable},
-                       {"f0_simulated_hz", Num(p.f0_simulated_hz)},
-                       {"f0_predicted_hz", Num(p.f0_predicted_hz)},
-                       {"sigma_f0_hz", Num(p.sigma_f0_hz)},
-                       {"q_predicted", Num(p.q_predicted)},
-                       {"effects", effects},
-                       {"message", p.message}};
-  }
-  j["score_rule"] =
-      "cost = -2 ln L of the normalised residual (chi2, or the Student t's for sigma on few "
-      "degrees of freedom); every fit calibrates the nominal within the design's tolerances, "
-      "prior = their -2 ln p; an effect is there when its BIC = cost + prior + p ln(2K) is at "
-      "least 10 below the calibrated none's; which one: the lowest score = cost + prior + "
-      "Laplace Occam penalty - 2 ln(the effect's prior odds, analysis/gap/diagnosis.h "
-      "GapOptions::prior_odds)";
+}
+
+json PredictionJson(const GapPrediction& pr) {
+  const auto& p = pr.prediction;
+  json effects = json::array();
+  for (const auto& e : p.effects)
+    effects.push_back({{"effect", analysis::ToString(e.kind)}, {"params", e.params}});
+  return {{"simulation", pr.simulation.source},
+          {"usable", p.usable},
+          {"f0_simulated_hz", Num(p.f0_simulated_hz)},
+          {"f0_predicted_hz", Num(p.f0_predicted_hz)},
+          {"sigma_f0_hz", Num(p.sigma_f0_hz)},
+          {"q_predicted", Num(p.q_predicted)},
+          {"effects", effects},
+          {"message", p.message}};
+}
+
+constexpr const char* kScoreRule =
+    "cost = -2 ln L of the normalised residual (chi2, or the Student t's for sigma on few "
+    "degrees of freedom); every fit calibrates the nominal within the design's tolerances, "
+    "prior = their -2 ln p; an effect is there when its BIC = cost + prior + p ln(2K) is at "
+    "least 10 below the calibrated none's; which one: the lowest score = cost + prior + "
+    "Laplace Occam penalty - 2 ln(the effect's prior odds, analysis/gap/diagnosis.h "
+    "GapOptions::prior_odds)";
+
+}  // namespace
+
+json GapReportJson(const GapReport& r) {
+  const analysis::GapSummary& g = r.gap;
+  json j;
+  j["quantity"] = QuantityName(r.quantity);
+  AnswerJson(r, j);
+  GapFiguresJson(g, j);
+  j["ranking"] = RankingJson(g.ranking);
+  FeaturesJson(r, j);
+  j["split"] = SplitJson(g.split);
+  InputsJson(r, j);
+  if (r.prediction) j["prediction"] = PredictionJson(*r.prediction);
+  j["score_rule"] = kScoreRule;
   j["residual_form"] = g.residual_form;
   j["residual_admittance_hz"] = g.admittance_hz;
   j["message"] = g.message;
   return j;
 }
 
-std::string GapReportText(const GapReport& r) {
+namespace {
+
+// The simulation with its nominal, and each measured unit.
+void InputsText(const GapReport& r, std::ostream& os) {
   const analysis::GapSummary& g = r.gap;
-  std::ostringstream os;
-  os.imbue(std::locale::classic());
   os << "eol gap (" << QuantityName(r.quantity) << ", " << r.measured.size() << " measured unit"
      << (r.measured.size() == 1 ? "" : "s") << ")\n";
   os << "simulation   " << r.simulation.source << ": " << r.simulation.note << "\n";
   os << "  nominal    ";
-  for (const auto& p : r.calibration.params) os << p.name << " " << Fmt("%.5g", p.value) << "  ";
-  os << "(misfit " << Fmt("%.2g", r.calibration.misfit_rel_rms) << " rms relative";
+  for (const auto& p : r.calibration.params) os << p.name << " " << Printf("%.5g", p.value) << "  ";
+  os << "(misfit " << Printf("%.2g", r.calibration.misfit_rel_rms) << " rms relative";
   if (r.calibration.nominal.inertia_kg_m2 > 0.0)
-    os << ", J_r " << Fmt("%.4g", r.calibration.nominal.inertia_kg_m2) << " kg m^2"
+    os << ", J_r " << Printf("%.4g", r.calibration.nominal.inertia_kg_m2) << " kg m^2"
        << (r.inertia_source == "recipe"
                ? " assumed from the recipe's rotor: the simulation names none (--inertia-kg-m2)"
            : r.inertia_source == "given" ? " given"
@@ -262,25 +295,31 @@ std::string GapReportText(const GapReport& r) {
   for (std::size_t u = 0; u < r.measured.size(); ++u) {
     os << "measured     " << r.measured[u].source << ": " << r.measured[u].note << "\n";
     if (u < g.units.size())
-      os << "             g " << Fmt("%.3f", g.units[u].gap_before) << " -> "
-         << Fmt("%.3f", g.units[u].gap_after) << "\n";
+      os << "             g " << Printf("%.3f", g.units[u].gap_before) << " -> "
+         << Printf("%.3f", g.units[u].gap_after) << "\n";
   }
   if (r.sigma_pool > 0)
     os << "             sigma pooled over +-" << r.sigma_pool << " lines (relative variance)\n";
-  os << "\nGAP          g = " << Fmt("%.3f", g.gap_before) << " over " << g.residuals / 2
-     << " lines (1 = within the noise; noise test z = " << Fmt("%.1f", g.noise_z_before)
-     << ", sigma scale " << Fmt("%.3f", g.sigma_scale) << ")\n";
+}
+
+// How large the gap is, where, and the features of the first unit's gap.
+void WhereText(const GapReport& r, std::ostream& os) {
+  const analysis::GapSummary& g = r.gap;
+  os << "\nGAP          g = " << Printf("%.3f", g.gap_before) << " over " << g.residuals / 2
+     << " lines (1 = within the noise; noise test z = " << Printf("%.1f", g.noise_z_before)
+     << ", sigma scale " << Printf("%.3f", g.sigma_scale) << ")\n";
   if (r.sigma_dof > 0.0)
-    os << "             sigma^2 with " << Fmt("%.0f", r.sigma_dof)
+    os << "             sigma^2 with " << Printf("%.0f", r.sigma_dof)
        << " degrees of freedom per line (F test)\n";
   os << "WHERE        ";
   if (g.where.empty()) os << "no band of the residual is significant";
   os << "\n";
   for (std::size_t i = 0; i < g.where.size(); ++i) {
     const auto& b = g.where[i];
-    os << "  " << i + 1 << ". " << Fmt("%.1f", b.band.f_lo_hz) << " - "
-       << Fmt("%.1f", b.band.f_hi_hz) << " Hz   significance " << Fmt("%.1f", b.band.significance)
-       << "   g " << Fmt("%.2f", b.gap_before) << " -> " << Fmt("%.2f", b.gap_after) << "\n";
+    os << "  " << i + 1 << ". " << Printf("%.1f", b.band.f_lo_hz) << " - "
+       << Printf("%.1f", b.band.f_hi_hz) << " Hz   significance "
+       << Printf("%.1f", b.band.significance) << "   g " << Printf("%.2f", b.gap_before) << " -> "
+       << Printf("%.2f", b.gap_after) << "\n";
   }
   if (!r.features.empty()) {
     os << "  features (refit of the nominal to " << r.measured.front().source
@@ -288,87 +327,115 @@ std::string GapReportText(const GapReport& r) {
     const auto& f = r.features.front();
     if (!f.usable) os << "    " << f.message << "\n";
     for (const auto& x : f.features)
-      os << "    " << x.name << ": simulated " << Fmt("%.5g", x.simulated) << ", measured "
-         << Fmt("%.5g", x.measured) << ", gap " << Fmt("%+.4g", x.gap) << " +- "
-         << Fmt("%.2g", x.sigma) << " (" << Fmt("%.1f", x.significance) << " sigma)\n";
+      os << "    " << x.name << ": simulated " << Printf("%.5g", x.simulated) << ", measured "
+         << Printf("%.5g", x.measured) << ", gap " << Printf("%+.4g", x.gap) << " +- "
+         << Printf("%.2g", x.sigma) << " (" << Printf("%.1f", x.significance) << " sigma)\n";
     if (f.usable)
       os << "    a refit of the nominal's own parameters leaves g = "
-         << Fmt("%.3f", f.gap_after_refit) << " (calibration, not an unmodelled effect)\n";
+         << Printf("%.3f", f.gap_after_refit) << " (calibration, not an unmodelled effect)\n";
   }
+}
+
+// The answer with its rivals, calibration and parameters.
+void WhichText(const GapReport& r, std::ostream& os) {
+  const analysis::GapSummary& g = r.gap;
   os << "WHICH        " << g.effect << "\n";
   for (const auto& x : g.rivals)
-    os << "  rival      " << x.effect << ", evidence " << Fmt("%+.1f", x.score_gap)
+    os << "  rival      " << x.effect << ", evidence " << Printf("%+.1f", x.score_gap)
        << " against the answer's: " << x.note << "\n";
   if (!g.calibration.empty()) {
     os << "  calibrated within the tolerances:";
     for (const auto& d : g.calibration)
-      os << " " << d.name << " " << Fmt("%+.1f %%", 100.0 * d.offset) << " ("
-         << Fmt("%+.1f", d.tolerances) << ")";
+      os << " " << d.name << " " << Printf("%+.1f %%", 100.0 * d.offset) << " ("
+         << Printf("%+.1f", d.tolerances) << ")";
     os << "\n";
   }
   if (g.beyond.found) {
     os << "  beyond the tolerances: a calibration with no prior reaches g "
-       << Fmt("%.3f", g.beyond.g_beyond) << " (-2 ln L " << Fmt("%.1f", g.beyond.cost_gain)
+       << Printf("%.3f", g.beyond.g_beyond) << " (-2 ln L " << Printf("%.1f", g.beyond.cost_gain)
        << " lower) with";
     for (const auto& d : g.beyond.offsets)
       if (std::abs(d.tolerances) >= 2.0)
-        os << " " << d.name << " " << Fmt("%+.1f %%", 100.0 * d.offset) << " ("
-           << Fmt("%+.1f", d.tolerances) << " tolerances)";
+        os << " " << d.name << " " << Printf("%+.1f %%", 100.0 * d.offset) << " ("
+           << Printf("%+.1f", d.tolerances) << " tolerances)";
     os << ": " << (g.winner.empty() ? "the finding" : "the alternative to the structure") << "\n";
   }
   if (const analysis::RankedEffect* w = Winner(g)) {
     for (const auto& p : w->params) os << "               " << ParamText(p) << "\n";
   }
+}
+
+// Every effect tried with its evidence.
+void RankingText(const GapReport& r, std::ostream& os) {
+  const analysis::GapSummary& g = r.gap;
   os << "  ranking (score = evidence: cost + Occam - 2 ln prior odds; an effect needs its BIC 10 "
         "below none's; "
      << g.residual_form << " residual):\n";
   int rank = 0;
   for (const auto& e : g.ranking) {
-    os << "  " << Fmt("%3.0f", ++rank) << ". " << e.effect;
+    os << "  " << Printf("%3.0f", ++rank) << ". " << e.effect;
     for (std::size_t pad = e.effect.size(); pad < 36; ++pad) os << ' ';
-    os << Fmt("%12.1f", e.score) << "  BIC " << Fmt("%9.1f", e.bic) << "   g "
-       << Fmt("%.3f", e.gap_after);
+    os << Printf("%12.1f", e.score) << "  BIC " << Printf("%9.1f", e.bic) << "   g "
+       << Printf("%.3f", e.gap_after);
     if (!e.plausible) os << "   rejected: " << e.rejected;
     os << "\n";
   }
-  os << "HOW FAR      g " << Fmt("%.3f", g.gap_before) << " -> " << Fmt("%.3f", g.gap_after)
-     << " overall; held out (" << g.heldout.method << ") " << Fmt("%.3f", g.heldout.gap_before)
-     << " -> " << Fmt("%.3f", g.heldout.gap_after) << "\n";
+}
+
+// How far the gap shrinks: calibration and structure, then the prediction.
+void HowFarText(const GapReport& r, std::ostream& os) {
+  const analysis::GapSummary& g = r.gap;
+  os << "HOW FAR      g " << Printf("%.3f", g.gap_before) << " -> " << Printf("%.3f", g.gap_after)
+     << " overall; held out (" << g.heldout.method << ") " << Printf("%.3f", g.heldout.gap_before)
+     << " -> " << Printf("%.3f", g.heldout.gap_after) << "\n";
   if (g.split.available) {
     const analysis::GapSplit& sp = g.split;
-    auto pct = [](double v) { return std::isfinite(v) ? Fmt("%.1f %%", 100.0 * v) : "n/a"; };
+    auto pct = [](double v) { return std::isfinite(v) ? Printf("%.1f %%", 100.0 * v) : "n/a"; };
     os << "CALIBRATION AND STRUCTURE (share of the excess g^2 - E|r|^2; held out "
        << sp.heldout_method << " in brackets)\n"
-       << "  nominal (simulation)                g " << Fmt("%.3f", sp.g_nominal) << " ("
-       << Fmt("%.3f", sp.heldout_g_nominal) << ")\n"
-       << "  calibrated within the tolerances    g " << Fmt("%.3f", sp.g_within) << " ("
-       << Fmt("%.3f", sp.heldout_g_within) << ")   closes " << pct(sp.share_within) << "\n"
+       << "  nominal (simulation)                g " << Printf("%.3f", sp.g_nominal) << " ("
+       << Printf("%.3f", sp.heldout_g_nominal) << ")\n"
+       << "  calibrated within the tolerances    g " << Printf("%.3f", sp.g_within) << " ("
+       << Printf("%.3f", sp.heldout_g_within) << ")   closes " << pct(sp.share_within) << "\n"
        << "  + " << (g.winner.empty() ? std::string("no effect") : g.effect) << " (structure)   g "
-       << Fmt("%.3f", sp.g_structure) << " (" << Fmt("%.3f", sp.heldout_g_structure)
+       << Printf("%.3f", sp.g_structure) << " (" << Printf("%.3f", sp.heldout_g_structure)
        << ")   closes " << pct(sp.share_structure_within) << "; left " << pct(sp.share_left_within)
        << "\n"
-       << "  or calibrated beyond them (no prior) g " << Fmt("%.3f", sp.g_beyond) << " ("
-       << Fmt("%.3f", sp.heldout_g_beyond) << ")   closes " << pct(sp.share_beyond)
+       << "  or calibrated beyond them (no prior) g " << Printf("%.3f", sp.g_beyond) << " ("
+       << Printf("%.3f", sp.heldout_g_beyond) << ")   closes " << pct(sp.share_beyond)
        << " on top of within\n"
        << "  with no prior from the start:\n"
-       << "  refit of the nominal's parameters   g " << Fmt("%.3f", sp.g_refit) << "   closes "
+       << "  refit of the nominal's parameters   g " << Printf("%.3f", sp.g_refit) << "   closes "
        << pct(sp.share_calibration) << " (calibration)\n"
        << "  + " << (g.winner.empty() ? std::string("no effect") : g.effect)
-       << " fitted together   g " << Fmt("%.3f", sp.g_refit_effect) << "   closes "
+       << " fitted together   g " << Printf("%.3f", sp.g_refit_effect) << "   closes "
        << pct(sp.share_structure) << " (structure); left " << pct(sp.share_left) << "\n"
-       << "  held out (" << sp.heldout_method << "): " << Fmt("%.3f", sp.heldout_g_nominal)
-       << " -> " << Fmt("%.3f", sp.heldout_g_refit_effect) << " (calibration + structure)\n";
+       << "  held out (" << sp.heldout_method << "): " << Printf("%.3f", sp.heldout_g_nominal)
+       << " -> " << Printf("%.3f", sp.heldout_g_refit_effect) << " (calibration + structure)\n";
   } else if (!g.split.message.empty()) {
     os << "CALIBRATION AND STRUCTURE  " << g.split.message << "\n";
   }
   if (!g.where_after.empty())
     os << "  still significant after it: " << g.where_after.size() << " band(s), the first "
-       << Fmt("%.1f", g.where_after.front().band.f_lo_hz) << " - "
-       << Fmt("%.1f", g.where_after.front().band.f_hi_hz) << " Hz\n";
+       << Printf("%.1f", g.where_after.front().band.f_lo_hz) << " - "
+       << Printf("%.1f", g.where_after.front().band.f_hi_hz) << " Hz\n";
   if (r.prediction) {
     os << "PREDICTION   " << r.prediction->simulation.source << ": "
        << r.prediction->prediction.message << "\n";
   }
+}
+
+}  // namespace
+
+std::string GapReportText(const GapReport& r) {
+  const analysis::GapSummary& g = r.gap;
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  InputsText(r, os);
+  WhereText(r, os);
+  WhichText(r, os);
+  RankingText(r, os);
+  HowFarText(r, os);
   os << "\n" << g.message << "\n";
   return os.str();
 }

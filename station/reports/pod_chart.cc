@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "analysis/text.h"
 #include "drivers/io/chart.h"
 #include "drivers/io/file_error.h"
 
@@ -126,9 +127,7 @@ io::ChartSeries Series(const std::string& label, const io::Colour& colour,
 
 std::string Fixed(double v, int digits = 3) {
   if (!std::isfinite(v)) return "none";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
+  return analysis::Fixed(v, digits);
 }
 
 io::ChartPanel PodPanel(const std::vector<PodCurve>& curves) {

@@ -8,6 +8,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "analysis/text.h"
 #include "drivers/io/chart.h"
 #include "station/reports/curve_chart.h"
 
@@ -31,9 +32,7 @@ cairo_status_t Append(void* closure, const unsigned char* data, unsigned int len
 
 std::string Num(double v) {
   if (!std::isfinite(v)) return "-";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.5g", v);
-  return buf;
+  return analysis::Significant(v, 5);
 }
 
 std::string LimitText(const analysis::Limit& l) {

@@ -8,6 +8,8 @@
 #include <set>
 #include <stdexcept>
 
+#include "analysis/text.h"
+
 namespace eol::station {
 namespace {
 
@@ -351,9 +353,7 @@ namespace {
 std::string Percent(const nlohmann::json& v) {
   // "-" where there is nothing to divide by (no unit in the group).
   if (!v.is_number()) return "-";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f %%", 100.0 * v.get<double>());
-  return buf;
+  return analysis::Percent(v.get<double>(), 1);
 }
 
 std::string Row(const nlohmann::json& g) {

@@ -259,6 +259,134 @@ nlohmann::json Catalogue(const std::string& language) {
   return nlohmann::json::parse(in);
 }
 
+// The scanned serials' stored records, as the page showed them; returns SCAN-GOOD-1's.
+nlohmann::json ExpectStoredAsShown(int port, const nlohmann::json& j) {
+  const nlohmann::json& states = j["states"];
+  // What the page shows is what the station stored for the scanned serials, and the page's
+  // start carried the operator and shift typed into it.
+  httplib::Client http("127.0.0.1", port);
+  auto stored = [&](const std::string& serial) {
+    const auto res = http.Get("/api/units/" + serial);
+    EXPECT_TRUE(res && res->status == 200);
+    const auto tests = nlohmann::json::parse(res->body)["tests"];
+    return tests.empty() ? nlohmann::json() : tests[0];
+  };
+  const nlohmann::json good = stored("SCAN-GOOD-1");
+  EXPECT_FALSE(good.is_null()) << "the scanned serial was not tested";
+  EXPECT_EQ(good["outcome"], "PASS");
+  EXPECT_EQ(states["pass"]["verdict"], "PASS");
+  EXPECT_EQ(good["operator_id"], "op-17");
+  EXPECT_EQ(good["shift"], "B");
+  EXPECT_NE(states["pass"]["tested"].get<std::string>().find("operator op-17 · shift B"),
+            std::string::npos)
+      << states["pass"]["tested"];
+  EXPECT_EQ(stored("SCAN-BAD-1")["outcome"], "FAIL");
+  EXPECT_EQ(states["fail"]["verdict"], "FAIL");
+  // Retest marking: nothing on a first test; the serial's second test reads "retest 2 of 3",
+  // as its stored record says.
+  EXPECT_EQ(states["fail"]["attempt"], "");
+  EXPECT_EQ(j["retest"]["attempt"], "retest 2 of 3");
+  EXPECT_EQ(j["retest"]["verdict"], "FAIL");
+  EXPECT_EQ(stored("SCAN-BAD-1")["attempt"], 2);
+  EXPECT_EQ(stored("SCAN-BAD-1")["max_tests"], 3);
+  EXPECT_TRUE(stored("SCAN-LOCKED-1").is_null()) << "a refused serial is not stored";
+  return good;
+}
+
+void ExpectLockoutAndInstructions(const nlohmann::json& j) {
+  const nlohmann::json& states = j["states"];
+  const nlohmann::json instructions = ShippedInstructions();
+  // Lockout: a banner; the refused serial is ERROR with the catalogue's instruction for a
+  // lockout above the reason (the recipe's "error" instruction is its default: not shown);
+  // ERROR's lamp is not FAIL's. FAIL: the catalogue's instruction, then the recipe's own.
+  const nlohmann::json en = Catalogue("en");
+  EXPECT_NE(states["lockout"]["lockout"].get<std::string>().find("LOCKED OUT"), std::string::npos);
+  EXPECT_EQ(states["error"]["sizes"]["1280x800"]["verdict"]["text"], "ERROR");
+  EXPECT_EQ(states["error"]["instruction"], en["do.lockout"]);
+  ASSERT_FALSE(states["error"]["reasons"].empty());
+  EXPECT_NE(states["error"]["reasons"][0].get<std::string>().find("locked out"), std::string::npos);
+  const std::string fail_instruction = states["fail"]["instruction"];
+  EXPECT_EQ(fail_instruction.rfind(en["do.limit"].get<std::string>(), 0), 0u) << fail_instruction;
+  EXPECT_NE(fail_instruction.find(instructions["fail"].get<std::string>()), std::string::npos)
+      << fail_instruction;
+  EXPECT_EQ(states["pass"]["instruction"], "");
+  for (const char* size : {"words_1280x800", "words_1920x1080"}) {
+    const nlohmann::json& w = j[size];
+    EXPECT_NE(w["ERROR"]["background"], w["FAIL"]["background"]) << size;
+    EXPECT_NE(w["ABORTED"]["background"], w["FAIL"]["background"]) << size;
+    // Every word the lamp can show fits its box (scrollWidth <= clientWidth).
+    for (const char* word : {"PASS", "FAIL", "ERROR", "ABORTED", "TESTING"})
+      EXPECT_TRUE(w[word]["fits"].get<bool>()) << size << " " << word << ": " << w[word];
+  }
+}
+
+void ExpectEveryStateFitsAtBothSizes(const nlohmann::json& states) {
+  // Each state at both sizes: the verdict fits and is large; axe finds nothing serious.
+  for (const char* state : {"lockout", "error", "testing", "pass", "fail"}) {
+    for (const char* size : {"1280x800", "1920x1080"}) {
+      const nlohmann::json& s = states[state]["sizes"][size];
+      EXPECT_TRUE(s["verdict"]["fits"].get<bool>()) << state << " " << size << ": " << s["verdict"];
+      // Readable at 3 m: a font of at least 64 px at 1280 and 96 px at 1920.
+      EXPECT_GE(s["verdict"]["font_px"].get<double>(), size == std::string("1280x800") ? 64 : 96)
+          << state << " " << size;
+      if (s.contains("axe")) {
+        EXPECT_TRUE(s["axe"].empty()) << state << " " << size << ": " << s["axe"];
+      }
+    }
+  }
+  EXPECT_EQ(states["testing"]["sizes"]["1280x800"]["verdict"]["text"], "TESTING");
+  EXPECT_EQ(states["testing"]["sizes"]["1920x1080"]["verdict"]["text"], "TESTING");
+  EXPECT_EQ(states["lockout"]["focus"], "scan");
+}
+
+void ExpectChartAndMeasurements(const nlohmann::json& states, const nlohmann::json& good) {
+  // The chart: the resonance window from the limit the verdict used, the mask, the measured
+  // curve, and the fitted model drawn last (on top); each in the legend.
+  const nlohmann::json& chart = states["pass"]["chart"];
+  EXPECT_DOUBLE_EQ(chart["window"]["lo"].get<double>(), 370.0) << chart;
+  EXPECT_DOUBLE_EQ(chart["window"]["hi"].get<double>(), 420.0) << chart;
+  EXPECT_GE(chart["masks"].get<int>(), 1);
+  EXPECT_EQ(chart["measured_points"], ShippedRecipeLines());
+  EXPECT_EQ(chart["model_points"], ShippedRecipeLines());
+  EXPECT_EQ(chart["order"].back(), "model") << chart["order"];
+  std::vector<std::string> legend;
+  for (const auto& k : chart["legend"]) legend.push_back(k[0]);
+  EXPECT_EQ(legend, (std::vector<std::string>{"measured", "model", "window", "mask", "f0"}));
+
+  // Measurements in the operator's words and units, with the stored values.
+  std::map<std::string, nlohmann::json> shown;
+  for (const auto& m : states["pass"]["measurements"]) shown[m["name"]] = m;
+  ASSERT_EQ(shown.size(), good["measurements"].size());
+  EXPECT_EQ(shown["resonance_f_hz"]["label"], "Resonance");
+  EXPECT_EQ(shown["resonance_q"]["label"], "Quality factor Q");
+  EXPECT_EQ(shown["winding_l_h"]["label"], "Winding inductance");
+  EXPECT_EQ(shown["resonance_f_hz"]["limits"], "370 … 420 Hz");
+  EXPECT_EQ(shown["winding_l_h"]["limits"], "1.6 … 2.4 mH");
+  EXPECT_EQ(shown["fit_chi2_per_dof"]["limits"], "≤ 3");
+  for (const auto& m : good["measurements"]) {
+    if (m["name"] != "resonance_f_hz") continue;
+    const double f0 = m["value"].get<double>();
+    std::ostringstream want;
+    want << std::showpoint << std::setprecision(4) << f0 << " Hz";  // as "390.1 Hz"
+    EXPECT_EQ(shown["resonance_f_hz"]["value"], want.str());
+  }
+}
+
+void ExpectLocalTimeWithZone(const nlohmann::json& states) {
+  // Local time with its zone: the browser runs in Asia/Kolkata (UTC+5:30, no summer time).
+  ASSERT_FALSE(states["pass"]["history"].empty());
+  const nlohmann::json& row = states["pass"]["history"][0];
+  EXPECT_EQ(row["serial"], "SCAN-GOOD-1");
+  std::tm utc{};
+  std::istringstream(row["utc"].get<std::string>()) >> std::get_time(&utc, "%Y-%m-%dT%H:%M:%S");
+  const int local_min = (utc.tm_hour * 60 + utc.tm_min + 330) % (24 * 60);
+  char hhmm[8];
+  std::snprintf(hhmm, sizeof hhmm, "%02d:%02d", local_min / 60, local_min % 60);
+  const std::string shown_time = row["shown"];
+  EXPECT_EQ(shown_time.rfind(hhmm, 0), 0u) << shown_time << " for " << row["utc"];
+  EXPECT_NE(shown_time.find("GMT+5:30"), std::string::npos) << shown_time;
+}
+
 // Issue 17: a keyboard-wedge scanner starts tests from the page; the verdict fits its box
 // and stays large at 1280x800 and 1920x1080; ERROR is not dressed as FAIL; the recipe's
 // instruction stands above the reason; the chart draws the model on top and every limit the
@@ -309,7 +437,6 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
   ASSERT_TRUE(code.has_value()) << "browser did not finish";
   ASSERT_EQ(*code, 0) << browser.output() << station.output();
   const auto j = nlohmann::json::parse(browser.output());
-  const nlohmann::json instructions = ShippedInstructions();
   const nlohmann::json& states = j["states"];
 
   // The scanner's field has the focus from the start, after signing in and after a click.
@@ -323,118 +450,12 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
             0u)
       << j["limit_master_instruction"];
 
-  // What the page shows is what the station stored for the scanned serials, and the page's
-  // start carried the operator and shift typed into it.
-  httplib::Client http("127.0.0.1", port);
-  auto stored = [&](const std::string& serial) {
-    const auto res = http.Get("/api/units/" + serial);
-    EXPECT_TRUE(res && res->status == 200);
-    const auto tests = nlohmann::json::parse(res->body)["tests"];
-    return tests.empty() ? nlohmann::json() : tests[0];
-  };
-  const nlohmann::json good = stored("SCAN-GOOD-1");
-  ASSERT_FALSE(good.is_null()) << "the scanned serial was not tested";
-  EXPECT_EQ(good["outcome"], "PASS");
-  EXPECT_EQ(states["pass"]["verdict"], "PASS");
-  EXPECT_EQ(good["operator_id"], "op-17");
-  EXPECT_EQ(good["shift"], "B");
-  EXPECT_NE(states["pass"]["tested"].get<std::string>().find("operator op-17 · shift B"),
-            std::string::npos)
-      << states["pass"]["tested"];
-  EXPECT_EQ(stored("SCAN-BAD-1")["outcome"], "FAIL");
-  EXPECT_EQ(states["fail"]["verdict"], "FAIL");
-  // Retest marking: nothing on a first test; the serial's second test reads "retest 2 of 3",
-  // as its stored record says.
-  EXPECT_EQ(states["fail"]["attempt"], "");
-  EXPECT_EQ(j["retest"]["attempt"], "retest 2 of 3");
-  EXPECT_EQ(j["retest"]["verdict"], "FAIL");
-  EXPECT_EQ(stored("SCAN-BAD-1")["attempt"], 2);
-  EXPECT_EQ(stored("SCAN-BAD-1")["max_tests"], 3);
-  EXPECT_TRUE(stored("SCAN-LOCKED-1").is_null()) << "a refused serial is not stored";
-
-  // Lockout: a banner; the refused serial is ERROR with the catalogue's instruction for a
-  // lockout above the reason (the recipe's "error" instruction is its default: not shown);
-  // ERROR's lamp is not FAIL's. FAIL: the catalogue's instruction, then the recipe's own.
-  const nlohmann::json en = Catalogue("en");
-  EXPECT_NE(states["lockout"]["lockout"].get<std::string>().find("LOCKED OUT"), std::string::npos);
-  EXPECT_EQ(states["error"]["sizes"]["1280x800"]["verdict"]["text"], "ERROR");
-  EXPECT_EQ(states["error"]["instruction"], en["do.lockout"]);
-  ASSERT_FALSE(states["error"]["reasons"].empty());
-  EXPECT_NE(states["error"]["reasons"][0].get<std::string>().find("locked out"), std::string::npos);
-  const std::string fail_instruction = states["fail"]["instruction"];
-  EXPECT_EQ(fail_instruction.rfind(en["do.limit"].get<std::string>(), 0), 0u) << fail_instruction;
-  EXPECT_NE(fail_instruction.find(instructions["fail"].get<std::string>()), std::string::npos)
-      << fail_instruction;
-  EXPECT_EQ(states["pass"]["instruction"], "");
-  for (const char* size : {"words_1280x800", "words_1920x1080"}) {
-    const nlohmann::json& w = j[size];
-    EXPECT_NE(w["ERROR"]["background"], w["FAIL"]["background"]) << size;
-    EXPECT_NE(w["ABORTED"]["background"], w["FAIL"]["background"]) << size;
-    // Every word the lamp can show fits its box (scrollWidth <= clientWidth).
-    for (const char* word : {"PASS", "FAIL", "ERROR", "ABORTED", "TESTING"})
-      EXPECT_TRUE(w[word]["fits"].get<bool>()) << size << " " << word << ": " << w[word];
-  }
-
-  // Each state at both sizes: the verdict fits and is large; axe finds nothing serious.
-  for (const char* state : {"lockout", "error", "testing", "pass", "fail"}) {
-    for (const char* size : {"1280x800", "1920x1080"}) {
-      const nlohmann::json& s = states[state]["sizes"][size];
-      EXPECT_TRUE(s["verdict"]["fits"].get<bool>()) << state << " " << size << ": " << s["verdict"];
-      // Readable at 3 m: a font of at least 64 px at 1280 and 96 px at 1920.
-      EXPECT_GE(s["verdict"]["font_px"].get<double>(), size == std::string("1280x800") ? 64 : 96)
-          << state << " " << size;
-      if (s.contains("axe")) {
-        EXPECT_TRUE(s["axe"].empty()) << state << " " << size << ": " << s["axe"];
-      }
-    }
-  }
-  EXPECT_EQ(states["testing"]["sizes"]["1280x800"]["verdict"]["text"], "TESTING");
-  EXPECT_EQ(states["testing"]["sizes"]["1920x1080"]["verdict"]["text"], "TESTING");
-  EXPECT_EQ(states["lockout"]["focus"], "scan");
-
-  // The chart: the resonance window from the limit the verdict used, the mask, the measured
-  // curve, and the fitted model drawn last (on top); each in the legend.
-  const nlohmann::json& chart = states["pass"]["chart"];
-  EXPECT_DOUBLE_EQ(chart["window"]["lo"].get<double>(), 370.0) << chart;
-  EXPECT_DOUBLE_EQ(chart["window"]["hi"].get<double>(), 420.0) << chart;
-  EXPECT_GE(chart["masks"].get<int>(), 1);
-  EXPECT_EQ(chart["measured_points"], ShippedRecipeLines());
-  EXPECT_EQ(chart["model_points"], ShippedRecipeLines());
-  EXPECT_EQ(chart["order"].back(), "model") << chart["order"];
-  std::vector<std::string> legend;
-  for (const auto& k : chart["legend"]) legend.push_back(k[0]);
-  EXPECT_EQ(legend, (std::vector<std::string>{"measured", "model", "window", "mask", "f0"}));
-
-  // Measurements in the operator's words and units, with the stored values.
-  std::map<std::string, nlohmann::json> shown;
-  for (const auto& m : states["pass"]["measurements"]) shown[m["name"]] = m;
-  ASSERT_EQ(shown.size(), good["measurements"].size());
-  EXPECT_EQ(shown["resonance_f_hz"]["label"], "Resonance");
-  EXPECT_EQ(shown["resonance_q"]["label"], "Quality factor Q");
-  EXPECT_EQ(shown["winding_l_h"]["label"], "Winding inductance");
-  EXPECT_EQ(shown["resonance_f_hz"]["limits"], "370 … 420 Hz");
-  EXPECT_EQ(shown["winding_l_h"]["limits"], "1.6 … 2.4 mH");
-  EXPECT_EQ(shown["fit_chi2_per_dof"]["limits"], "≤ 3");
-  for (const auto& m : good["measurements"]) {
-    if (m["name"] != "resonance_f_hz") continue;
-    const double f0 = m["value"].get<double>();
-    std::ostringstream want;
-    want << std::showpoint << std::setprecision(4) << f0 << " Hz";  // as "390.1 Hz"
-    EXPECT_EQ(shown["resonance_f_hz"]["value"], want.str());
-  }
-
-  // Local time with its zone: the browser runs in Asia/Kolkata (UTC+5:30, no summer time).
-  ASSERT_FALSE(states["pass"]["history"].empty());
-  const nlohmann::json& row = states["pass"]["history"][0];
-  EXPECT_EQ(row["serial"], "SCAN-GOOD-1");
-  std::tm utc{};
-  std::istringstream(row["utc"].get<std::string>()) >> std::get_time(&utc, "%Y-%m-%dT%H:%M:%S");
-  const int local_min = (utc.tm_hour * 60 + utc.tm_min + 330) % (24 * 60);
-  char hhmm[8];
-  std::snprintf(hhmm, sizeof hhmm, "%02d:%02d", local_min / 60, local_min % 60);
-  const std::string shown_time = row["shown"];
-  EXPECT_EQ(shown_time.rfind(hhmm, 0), 0u) << shown_time << " for " << row["utc"];
-  EXPECT_NE(shown_time.find("GMT+5:30"), std::string::npos) << shown_time;
+  const nlohmann::json good = ExpectStoredAsShown(port, j);
+  ASSERT_FALSE(good.is_null());
+  ExpectLockoutAndInstructions(j);
+  ExpectEveryStateFitsAtBothSizes(states);
+  ExpectChartAndMeasurements(states, good);
+  ExpectLocalTimeWithZone(states);
 
   EXPECT_TRUE(j["outside_requests"].empty()) << j["outside_requests"];
   EXPECT_TRUE(j["page_errors"].empty()) << j["page_errors"];
