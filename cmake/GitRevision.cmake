@@ -1,6 +1,6 @@
 # Writes OUT (a header) with EOL_GIT_REVISION, the checkout's `git describe --always --dirty`
 # ("unknown" outside a git checkout), only when it changed, so the build re-runs each time
-# but recompiles only after a commit. Used by station/version.cc.
+# but recompiles only after a commit. Used by station/daemon/version.cc.
 #   cmake -DSOURCE_DIR=<repo> -DOUT=<header> -P GitRevision.cmake
 set(rev "unknown")
 find_program(GIT git)

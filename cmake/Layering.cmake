@@ -33,7 +33,7 @@ set(EOL_ALLOW_eol_driver_factory_hardware ${EOL_ALLOW_eol_driver_factory})
 set(EOL_ALLOW_eol_db ${EOL_LAYER_ANALYSIS} db/)
 set(EOL_ALLOW_eol_station_reports ${EOL_LAYER_ANALYSIS} drivers/io/ db/ station/reports/)
 set(EOL_ALLOW_eol_station ${EOL_LAYER_DRIVERS} drivers/factory/ db/ station/reports/
-    station/ station/http/ station/plc/ station/central/ eol_revision.h)
+    station/daemon/ station/daemon/http/ station/daemon/plc/ station/daemon/central/ eol_revision.h)
 set(EOL_ALLOW_eol_station_command ${EOL_ALLOW_eol_station} station/cli/)
 set(EOL_ALLOW_eol_station_bench ${EOL_ALLOW_eol_station}
     analysis/sim/ analysis/bench/ drivers/sim/ drivers/emulators/ station/bench/)

@@ -96,7 +96,7 @@ CREATE INDEX recipe_audit_at ON recipe_audit (at);
 //   version 3 are production tests.
 // self_checks: one row per master test, written in the same transaction as its test: which
 //   master ('good' must PASS, 'limit' must FAIL on the resonance), whether the check passed,
-//   and why. The station's lockout is derived from this table (station/self_check.h), so it
+//   and why. The station's lockout is derived from this table (station/daemon/self_check.h), so it
 //   survives a restart.
 inline constexpr const char kSchemaV3[] = R"sql(
 ALTER TABLE tests ADD COLUMN kind TEXT NOT NULL DEFAULT 'production'

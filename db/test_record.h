@@ -47,7 +47,7 @@ struct StateEntry {
 };
 
 // Who tested the unit and for which order (schema v4), as given with the serial over HTTP,
-// by the line PLC or the scanner (station/test_request.h says what is accepted). Each is
+// by the line PLC or the scanner (station/daemon/test_request.h says what is accepted). Each is
 // empty when not given. In the record's JSON they are the top-level keys "operator_id",
 // "shift" and "order_number".
 struct WorkContext {
@@ -92,7 +92,7 @@ struct TestRecord {
   nlohmann::json fit = nlohmann::json::object();  // the fit summary
   std::vector<Curve> curves;
   std::vector<StateEntry> trace;
-  // Where the test's time went, seconds per step (station/cycle_time.h: "interlocks",
+  // Where the test's time went, seconds per step (station/daemon/cycle_time.h: "interlocks",
   // "clamp", "excitation", "analysis", ..., and "total"), summed from the trace. The stored
   // record has the steps up to the store (its own store and publish cannot be in it); the
   // record RunTest returns has them all, "total" being serial received -> verdict published.

@@ -63,7 +63,7 @@ Outcome JudgeWith(const std::vector<MeasurementSpec>& limits, const std::vector<
   return VerdictWith(limits, masks, bond_index, m).outcome;
 }
 
-// The station's sequential decision (station/recipe.h SequentialPolicy) under the limits in
+// The station's sequential decision (station/daemon/recipe.h SequentialPolicy) under the limits in
 // force (the taught ones): while a measurement is undecided, a further look of
 // o.extend_periods periods with its own noise, combined by inverse variance and analysed
 // again. Returns the looks taken.

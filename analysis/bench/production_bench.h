@@ -47,7 +47,7 @@ struct ProductionBenchOptions {
   std::size_t periods = 4;
   double voltage_noise_v = 2.0e-3;  // the simulated DAQ's, rms per sample
   double current_noise_a = 1.0e-3;
-  // The recipe's sequential decision (station/recipe.h SequentialPolicy; max_extensions 0:
+  // The recipe's sequential decision (station/daemon/recipe.h SequentialPolicy; max_extensions 0:
   // none), judged against the taught limits: production units and POD sweeps take further looks
   // of extend_periods periods while a measurement is undecided at confidence_z.
   int max_extensions = 0;

@@ -1,6 +1,6 @@
 // What a motor's own torsional chain predicts for its end-of-line test, so that a
 // recipe for a new motor type is derived from its design data (`eol recipe-new`,
-// station/recipe_design.h) instead of from the ten-pole motor's constants:
+// station/daemon/recipe_design.h) instead of from the ten-pole motor's constants:
 //   - the mode the test fits: of the good rotor, and of rotors with half and with all of their
 //     magnets poorly bonded (the chain's bond_poor; rotor_chain.h SoftMagnetsForDefect), each
 //     the chain's mode the torque excites most (largest Rp, motor_model.h);

@@ -14,11 +14,12 @@
 // good rotors, seed 5), slope 0.114, the good units' f0 spread 1.06 % -> 0.85 %, all ten bonds
 // at a loss of 0.92 from z -2.56 to -3.20.
 //
-// The station computes it in the one judge (station/judge.h) from conditions.clamp_pressure_bar;
-// `eol analyze --clamp-pressure-bar P` gives the pressure for a file judged offline. Without a
-// pressure the measurement is missing, and a declared limit on it makes the verdict ERROR,
-// never PASS. Its sigma is f0's scaled (the pressure reading's own error is neglected: a 0.01
-// bar resolution moves f0 by 2e-4 relative at m = 0.11, far below the good units' spread).
+// The station computes it in the one judge (station/daemon/judge.h) from
+// conditions.clamp_pressure_bar; `eol analyze --clamp-pressure-bar P` gives the pressure for a file
+// judged offline. Without a pressure the measurement is missing, and a declared limit on it makes
+// the verdict ERROR, never PASS. Its sigma is f0's scaled (the pressure reading's own error is
+// neglected: a 0.01 bar resolution moves f0 by 2e-4 relative at m = 0.11, far below the good units'
+// spread).
 #pragma once
 
 #include <map>

@@ -62,7 +62,7 @@ std::optional<ReasonCode> ParseReasonCode(const std::string& s);
 
 // `cause`: a finer stable key under the code where one code covers several causes an operator
 // acts on differently ("interlock.door_open", "fixture.clamp_not_released"; the station's keys
-// are station/reason_cause.h). Empty when the code says it all, and on every record stored
+// are station/daemon/reason_cause.h). Empty when the code says it all, and on every record stored
 // before causes existed (never guessed from the text). The operator page's catalogue
 // (station/web/i18n/) has the operator's words for every code and every cause.
 struct Reason {
@@ -123,7 +123,7 @@ struct Verdict {
 // not measure; reason code kAnalysis). Otherwise any measurement out of limits makes it
 // FAIL, with one reason each coded `out_of_limits` (kLimit for scalar limits, kMask when the
 // specs are mask counts). The station's whole verdict (masks, conditions, phase pairs) is
-// station/judge.h, which calls this.
+// station/daemon/judge.h, which calls this.
 Verdict Judge(const std::vector<MeasurementSpec>& specs,
               const std::map<std::string, Estimate>& values,
               ReasonCode out_of_limits = ReasonCode::kLimit);

@@ -44,7 +44,7 @@ inline constexpr std::array<std::string_view, 10> kAll = {kResonanceFHz,
 
 // The unit each measurement is produced in ("1": dimensionless), as the analysis writes it;
 // "" for a name the analysis does not produce. A recipe's limit states values in this unit
-// and nothing else (station/recipe.h refuses another).
+// and nothing else (station/daemon/recipe.h refuses another).
 constexpr std::string_view UnitOf(std::string_view name) {
   constexpr std::array<std::pair<std::string_view, std::string_view>, 11> kUnits = {{
       {kResonanceFHz, "Hz"},

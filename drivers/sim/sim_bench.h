@@ -24,7 +24,7 @@
 namespace eol::drivers {
 
 // A reference part kept at the station for self-checks: the population's nominal unit (no
-// production spread), good or with the soft magnet bond (station/self_check.h).
+// production spread), good or with the soft magnet bond (station/daemon/self_check.h).
 struct SimMaster {
   std::string serial;
   bool defective = false;

@@ -13,8 +13,8 @@
 #include "analysis/qc/statistics.h"
 #include "analysis/text.h"
 #include "drivers/factory/factory.h"
-#include "station/cycle_time.h"
-#include "station/station.h"
+#include "station/daemon/cycle_time.h"
+#include "station/daemon/station.h"
 
 namespace eol::station {
 namespace {

@@ -7,7 +7,7 @@
 // the motor integrated in the time domain FROM REST (start transient included;
 // drivers/sim/sim_daq.h time_domain), paced at time_scale (1: real time), a fresh SQLite file
 // per recipe. Per recipe it reports the medians per unit of the excitation (all phase pairs),
-// serial-to-verdict time and station overhead (station/cycle_time.h), the median reported
+// serial-to-verdict time and station overhead (station/daemon/cycle_time.h), the median reported
 // sigma of f0, the verdicts against the simulator's truth (defective caught, good rejected),
 // and across the two: the share of units with the same outcome, the rms of the f0 difference,
 // and the ratios recipe / reference of excitation, cycle and sigma(f0).

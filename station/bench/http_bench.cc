@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "db/store.h"
-#include "station/http_api.h"
+#include "station/daemon/http_api.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>

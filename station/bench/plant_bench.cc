@@ -17,9 +17,9 @@
 
 #include "db/clock.h"
 #include "db/store.h"
-#include "station/central/central_replicator.h"
-#include "station/central/pg.h"
-#include "station/mqtt_publisher.h"
+#include "station/daemon/central/central_replicator.h"
+#include "station/daemon/central/pg.h"
+#include "station/daemon/mqtt_publisher.h"
 
 namespace eol::station {
 namespace {

@@ -12,8 +12,8 @@
 #include "drivers/fixture/modbus_fixture.h"
 #include "drivers/sim/sim_daq.h"
 #include "drivers/sim/sim_fixture.h"
-#include "station/safety.h"
-#include "station/sequencer.h"
+#include "station/daemon/safety.h"
+#include "station/daemon/sequencer.h"
 
 namespace eol::station {
 namespace {

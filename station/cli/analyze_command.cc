@@ -1,7 +1,7 @@
 // `eol analyze --measured FILE`: the station's analysis on a measured FRF or raw recording,
 // offline. Reads the file (drivers/io/measured_input.h), estimates Z(f) with sigma for a
 // periodic recording, fits the clamped motor (analysis::AnalyzeImpedance / AnalyzeRecording)
-// and, with --recipe, judges the unit with the station's own judge (station/judge.h: limits,
+// and, with --recipe, judges the unit with the station's own judge (station/daemon/judge.h: limits,
 // masks, conditions), so a recording gets the verdict and reasons the station gives it. An FRF
 // file has no recording, and a noise recording (Welch) was not excited with the recipe's
 // multisine: for both the excitation-level conditions are listed under
@@ -36,8 +36,8 @@
 #include "drivers/io/measured_input.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/judge.h"
-#include "station/recipe.h"
+#include "station/daemon/judge.h"
+#include "station/daemon/recipe.h"
 #include "station/reports/curve_chart.h"
 
 namespace eol::station::cli {
@@ -195,7 +195,7 @@ json VerdictJson(const Judgement& v) {
           {"conditions_not_evaluated", v.conditions_not_evaluated}};
 }
 
-// The station's verdict (station/judge.h) of the recipe's first phase pair; `recording` is
+// The station's verdict (station/daemon/judge.h) of the recipe's first phase pair; `recording` is
 // null for an FRF file. The conditions the judge evaluates go to out["conditions"].
 json JudgeJson(const Recipe& recipe, const analysis::ImpedanceAnalysis& result,
                const analysis::Recording* recording, json& out, Judgement* judgement = nullptr) {

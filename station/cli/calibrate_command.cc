@@ -20,9 +20,9 @@
 #include "drivers/io/recording_files.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/config.h"
-#include "station/recipe.h"
-#include "station/safety.h"
+#include "station/daemon/config.h"
+#include "station/daemon/recipe.h"
+#include "station/daemon/safety.h"
 
 namespace eol::station::cli {
 namespace {

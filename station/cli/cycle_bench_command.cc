@@ -9,7 +9,7 @@
 #include "station/bench/cycle_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/data_files.h"
+#include "station/daemon/data_files.h"
 
 namespace eol::station::cli {
 namespace {

@@ -14,10 +14,10 @@
 #include "drivers/emulators/modbus_fixture_server.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/cycle_time.h"
-#include "station/data_files.h"
-#include "station/station.h"
-#include "station/status_board.h"
+#include "station/daemon/cycle_time.h"
+#include "station/daemon/data_files.h"
+#include "station/daemon/station.h"
+#include "station/daemon/status_board.h"
 
 namespace eol::station::cli {
 namespace {
@@ -97,7 +97,7 @@ int RunDemo(const DemoArgs& a) {
   VerdictCounts counts;  // the demo reports an ABORTED unit with the ERRORs
   int defective = 0, detected = 0, false_rejects = 0;
   nlohmann::json serials = nlohmann::json::array();
-  // Cycle time per unit (station/cycle_time.h): excitation of all phase pairs, serial
+  // Cycle time per unit (station/daemon/cycle_time.h): excitation of all phase pairs, serial
   // received -> verdict published, and the station's own overhead.
   std::vector<double> excitation_s, cycle_s, overhead_s;
   for (int i = 1; i <= a.units; ++i) {

@@ -16,8 +16,8 @@
 #include "drivers/io/json_config.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/recipe.h"
-#include "station/recipe_design.h"
+#include "station/daemon/recipe.h"
+#include "station/daemon/recipe_design.h"
 
 namespace eol::station::cli {
 namespace {
@@ -87,7 +87,7 @@ int RunDesign(const DesignArgs& a) {
     throw std::runtime_error(a.recipe +
                              ": has no \"excitation_design\" block (the required std(f0), the "
                              "nominal motor, the DAQ's noise and the amplitude limits; "
-                             "station/recipe.h)");
+                             "station/daemon/recipe.h)");
   analysis::ExcitationRequirement requirement = *recipe.excitation_design;
   if (a.sigma_f0_hz > 0.0) requirement.sigma_f0_hz = a.sigma_f0_hz;
   const analysis::ExcitationDesign d =

@@ -22,9 +22,9 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/golden_inputs.h"
-#include "station/data_files.h"
-#include "station/qc_service.h"
-#include "station/recipe.h"
+#include "station/daemon/data_files.h"
+#include "station/daemon/qc_service.h"
+#include "station/daemon/recipe.h"
 
 namespace eol::station::cli {
 namespace {

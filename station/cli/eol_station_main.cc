@@ -10,7 +10,7 @@
 
 #include "station/cli/station_command.h"
 #include "station/cli/usage_errors.h"
-#include "station/version.h"
+#include "station/daemon/version.h"
 
 int main(int argc, char** argv) {
   std::setlocale(LC_ALL, "C");  // numbers in files and JSON never depend on the locale

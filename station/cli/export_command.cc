@@ -14,8 +14,8 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/progress.h"
-#include "station/judge.h"
-#include "station/recipe.h"
+#include "station/daemon/judge.h"
+#include "station/daemon/recipe.h"
 
 namespace eol::station::cli {
 namespace {

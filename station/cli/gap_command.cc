@@ -15,8 +15,8 @@
 #include "drivers/io/file_error.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/data_files.h"
-#include "station/recipe.h"
+#include "station/daemon/data_files.h"
+#include "station/daemon/recipe.h"
 #include "station/reports/gap_diagnosis.h"
 #include "station/reports/gap_report.h"
 

@@ -11,7 +11,7 @@
 #include "db/store.h"
 #include "db/test_record.h"
 #include "drivers/io/measured_input.h"
-#include "station/qc_service.h"
+#include "station/daemon/qc_service.h"
 
 namespace eol::station::cli {
 namespace {

@@ -23,7 +23,7 @@
 
 #include "analysis/progress.h"
 #include "analysis/qc/teach.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 
 namespace eol::station::cli {
 

@@ -8,8 +8,8 @@
 
 #include "station/cli/commands.h"
 #include "station/cli/usage_errors.h"
-#include "station/data_files.h"
-#include "station/version.h"
+#include "station/daemon/data_files.h"
+#include "station/daemon/version.h"
 
 int main(int argc, char** argv) {
   std::setlocale(LC_ALL, "C");  // numbers in files and JSON never depend on the locale

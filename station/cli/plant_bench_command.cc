@@ -10,7 +10,7 @@
 #include "station/bench/plant_bench.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/mqtt_publisher.h"
+#include "station/daemon/mqtt_publisher.h"
 
 namespace eol::station::cli {
 

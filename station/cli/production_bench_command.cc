@@ -12,8 +12,8 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/progress.h"
-#include "station/data_files.h"
-#include "station/recipe.h"
+#include "station/daemon/data_files.h"
+#include "station/daemon/recipe.h"
 #include "station/reports/pod_chart.h"
 
 namespace eol::station::cli {

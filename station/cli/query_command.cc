@@ -1,7 +1,7 @@
 // `eol query --db FILE | --central URL --serial SN [--json] [--plot FILE [--test ID]
 // [--recipe FILE]]`: the traceable history of one serial number, with who tested it and for
 // which order; from one station's file, or plant-wide from the central PostgreSQL record
-// (station/central/), with the same record fields. --plot
+// (station/daemon/central/), with the same record fields. --plot
 // draws the stored curve of its newest test (or --test ID) with the fitted model, the
 // resonance window it was judged against and, given the recipe file of the record's hash,
 // the masks (station/reports/curve_chart.h).
@@ -13,11 +13,11 @@
 #include "db/serial_number.h"
 #include "db/store.h"
 #include "drivers/io/chart.h"
-#include "station/central/central_record.h"
-#include "station/central/pg.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/recipe.h"
+#include "station/daemon/central/central_record.h"
+#include "station/daemon/central/pg.h"
+#include "station/daemon/recipe.h"
 #include "station/reports/curve_chart.h"
 
 namespace eol::station::cli {

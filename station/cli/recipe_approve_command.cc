@@ -1,5 +1,5 @@
 // `eol recipe-approve --recipe FILE --by NAME --db DB [--note TEXT] [--out FILE]`: an engineer
-// approves a recipe `eol teach` proposed (station/recipe.h, RecipeApproval). The file gets
+// approves a recipe `eol teach` proposed (station/daemon/recipe.h, RecipeApproval). The file gets
 // "approval": {"state": "approved", "by", "at", "note"}, is validated, and is written
 // atomically (over --recipe unless --out); the approval is appended to the station
 // database's recipe audit log (GET /api/recipe/audit) with the proposal's and the approved
@@ -14,7 +14,7 @@
 #include "db/store.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 
 namespace eol::station::cli {
 namespace {

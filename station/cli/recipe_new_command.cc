@@ -1,6 +1,6 @@
 // `eol recipe-new --motor MOTOR.json --out RECIPE.json [--golden FILES...]`: a recipe proposed
-// from a motor's design data (station/recipe_design.h: band, windows, excitation designed for
-// time from a stated requirement, conditions' references, design limits, no masks, the bond
+// from a motor's design data (station/daemon/recipe_design.h: band, windows, excitation designed
+// for time from a stated requirement, conditions' references, design limits, no masks, the bond
 // index's direction from the motor's chain). With --golden the design is first calibrated to
 // the measured good units (files as `eol teach` reads them, analysed with the design's
 // recipe), saying where design and units disagree and by how much. Writes a proposal (never
@@ -15,7 +15,7 @@
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
 #include "station/cli/golden_inputs.h"
-#include "station/recipe_design.h"
+#include "station/daemon/recipe_design.h"
 
 namespace eol::station::cli {
 namespace {

@@ -12,9 +12,9 @@
 #include "db/store.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
+#include "station/daemon/version.h"
 #include "station/reports/unit_report.h"
-#include "station/version.h"
 
 namespace eol::station::cli {
 namespace {

@@ -24,8 +24,8 @@
 #include "drivers/io/recording_files.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/data_files.h"
-#include "station/recipe.h"
+#include "station/daemon/data_files.h"
+#include "station/daemon/recipe.h"
 
 namespace eol::station::cli {
 namespace {

@@ -1,6 +1,6 @@
 // `eol station --config FILE` and `eol-station --config FILE`: the station as a long-running
 // daemon. Serials arrive over HTTP (POST /api/tests), from the line PLC (a "plc" block:
-// station/plc/plc_map.h) or, with "serial_from_stdin", from a scanner typing into stdin.
+// station/daemon/plc/plc_map.h) or, with "serial_from_stdin", from a scanner typing into stdin.
 // SIGTERM/SIGINT abort the test in flight safely (excitation off, safe state, stored as
 // ABORTED) and stop the daemon.
 #include "station/cli/station_command.h"
@@ -16,10 +16,10 @@
 #include "drivers/io/json_config.h"
 #include "station/cli/commands.h"
 #include "station/cli/common.h"
-#include "station/data_files.h"
-#include "station/station.h"
-#include "station/systemd_notify.h"
-#include "station/test_request.h"
+#include "station/daemon/data_files.h"
+#include "station/daemon/station.h"
+#include "station/daemon/systemd_notify.h"
+#include "station/daemon/test_request.h"
 
 namespace eol::station::cli {
 namespace {
@@ -93,7 +93,7 @@ int RunStation(const std::string& config_path, std::string web_root, bool init_s
       while (std::getline(std::cin, line)) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
         // The scanner's line: the serial, then TAB-separated key=value fields
-        // (station/test_request.h).
+        // (station/daemon/test_request.h).
         std::string why;
         const std::optional<TestRequest> request = ParseScannerLine(line, &why);
         if (!request || !station.Enqueue(*request, &why))

@@ -4,12 +4,12 @@
 // marginal band replaced by the learned ones, its masks replaced by the learned Re Z mask
 // (kept when no curve was given), version + 1 and a note in the description. It is validated
 // (ParseRecipe) before it is written, and an existing file is never overwritten without
-// --force. Golden units of another motor (station/qc_service.h ForeignGoldenUnits) are refused
-// naming each quantity that disagrees and by how much, unless --force-foreign (then recorded in
-// the taught recipe). The winding-temperature reference is relearned from the golden units
-// (RelearnWindingReference), with a warning when the old one read them as implausible.
-// Exit: 0 written, 1 nothing could be learned or the golden units are another motor's (reason
-// on stderr), 2 usage/file error.
+// --force. Golden units of another motor (station/daemon/qc_service.h ForeignGoldenUnits) are
+// refused naming each quantity that disagrees and by how much, unless --force-foreign (then
+// recorded in the taught recipe). The winding-temperature reference is relearned from the golden
+// units (RelearnWindingReference), with a warning when the old one read them as implausible. Exit:
+// 0 written, 1 nothing could be learned or the golden units are another motor's (reason on stderr),
+// 2 usage/file error.
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -19,8 +19,8 @@
 #include "station/cli/common.h"
 #include "station/cli/golden_inputs.h"
 #include "station/cli/progress.h"
-#include "station/qc_service.h"
-#include "station/recipe.h"
+#include "station/daemon/qc_service.h"
+#include "station/daemon/recipe.h"
 
 namespace eol::station::cli {
 namespace {

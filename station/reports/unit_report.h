@@ -26,7 +26,7 @@ struct UnitReport {
   std::vector<analysis::CurveMask> masks;    // the test's recipe's masks; empty: not drawn
   std::string masks_note;                    // why masks are not drawn (empty when they are)
   std::string printed_at;                    // ISO 8601 UTC
-  std::string printed_by_software;           // station/version.h SoftwareVersion()
+  std::string printed_by_software;           // station/daemon/version.h SoftwareVersion()
 };
 
 // The PDF's bytes. Throws std::runtime_error when cairo fails.

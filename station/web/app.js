@@ -122,7 +122,7 @@ function renderStates(current) {
 
 // A reason is {code, text, cause?} (analysis/qc/measurement.h); a plain string is one stored
 // before reasons had codes. Its operator words are the catalogue's "what.<key>" and "do.<key>",
-// the key being its cause (station/reason_cause.h) where it has one, else its code.
+// the key being its cause (station/daemon/reason_cause.h) where it has one, else its code.
 function asReason(r) {
   return typeof r === "string" ? {code: "legacy", text: r} : {code: "legacy", text: "", ...r};
 }
@@ -134,7 +134,7 @@ function reasonKey(r) {
 const DO_NOT_TOUCH = ["fixture.clamp_left_closed", "fixture.excitation_off_unconfirmed",
                       "fixture.clamp_not_released"];
 
-// The recipe's defaults (station/recipe.h OperatorInstructions): the page shows the catalogue's
+// The recipe's defaults (station/daemon/recipe.h OperatorInstructions): the page shows the catalogue's
 // instruction per cause instead, and the recipe's own only where the plant changed it.
 const RECIPE_DEFAULTS = {fail: "Put the rotor in the red reject bin",
                          error: "Test the rotor again; if ERROR repeats, call maintenance",
@@ -260,7 +260,7 @@ function clearPlot(note) {
   renderLegend([]);
 }
 
-// The recorder's phase-pair names (station/judge.cc PairName), by conditions.phase_pair.
+// The recorder's phase-pair names (station/daemon/judge.cc PairName), by conditions.phase_pair.
 const PAIR_NAMES = ["U-V", "V-W", "W-U"];
 
 // Every phase pair the record measured, the recipe's first pair first: its curves are
@@ -462,7 +462,7 @@ function renderSimulation(why) {
   b.textContent = why ? t("ui.simulation", {why}) : "";
 }
 
-// Readiness (station/health.h): what the operator does in large type, the technical reason
+// Readiness (station/daemon/health.h): what the operator does in large type, the technical reason
 // under it, the cause's code in data-code. `r` is /api/status or a "readiness" event.
 function renderReadiness(r) {
   const b = $("not-ready");
@@ -634,7 +634,7 @@ function verdictCue(outcome) {
 }
 
 // POST /api/tests as any client does: no token while the station has none configured (the
-// API then opens operator routes, station/http/request.h); with tokens, the operator's.
+// API then opens operator routes, station/daemon/http/request.h); with tokens, the operator's.
 async function startTest(serial) {
   const body = {serial};
   if ($("variant").value) body.variant = $("variant").value;  // else the serial's rule picks
@@ -676,7 +676,7 @@ function refuseScanWhileOffline(e) {
 }
 
 // A station of several motor types (GET /api/variants) lets the operator name the unit's
-// type; left at "from the serial", the station's prefix rules pick it (station/variants.h).
+// type; left at "from the serial", the station's prefix rules pick it (station/daemon/variants.h).
 async function loadVariants() {
   const answer = await getJson("/api/variants").catch(() => null);
   const list = (answer && answer.variants) || [];

@@ -4,7 +4,7 @@
 Scans the repository's text files (md, h, cc, json, py, sh, txt, cmake, CMakeLists.txt) for
   - markdown links [text](target) and [text](target#anchor): the target must exist relative to
     the linking file, and an anchor must be a heading of the target (GitHub's slugs);
-  - paths rooted at a top-level folder (`station/judge.h`, `tests/data/x/`, `station/files`):
+  - paths rooted at a top-level folder (`station/daemon/judge.h`, `tests/data/x/`, `station/files`):
     the file or folder must exist;
   - bare markdown names (`NOTES.md`): some file of that name must exist in the repository;
   - references out of the checkout (`../shared/...`, `/work/...`): a user's clone has none.

@@ -461,7 +461,7 @@ TEST_F(ModbusFixtureTest, LoadsAPartWhenTheClampClosesOnAnEmptyFixture) {
 }
 
 // The simulator's clamp_sticks fault reaches the station as a released sensor that stays off
-// after the open command (the sequencer's release time-out, station/sequencer.h).
+// after the open command (the sequencer's release time-out, station/daemon/sequencer.h).
 TEST_F(ModbusFixtureTest, StuckClampNeverReadsReleasedUntilTheFaultClears) {
   ModbusFixture& f = Connected();
   ASSERT_TRUE(f.Activate().ok());

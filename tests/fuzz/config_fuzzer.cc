@@ -1,8 +1,8 @@
-// station::ParseStationConfig (station/config.h) on JSON text as LoadStationConfig gives it:
+// station::ParseStationConfig (station/daemon/config.h) on JSON text as LoadStationConfig gives it:
 // a StationConfig or io::ConfigError. Whole numbers must be kept as given and the safety
 // options stay in their documented ranges.
 #include "drivers/io/json_config.h"
-#include "station/config.h"
+#include "station/daemon/config.h"
 #include "tests/fuzz/json_check.h"
 
 namespace {

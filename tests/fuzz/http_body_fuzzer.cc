@@ -1,5 +1,5 @@
 // What the HTTP API does with a request's bytes before the station sees them
-// (station/http/request.h): ParseBody gives JSON or a 400/413 ApiError, never an exception;
+// (station/daemon/http/request.h): ParseBody gives JSON or a 400/413 ApiError, never an exception;
 // a body's "serial" goes through ValidSerial (POST /api/tests); the same bytes as a query
 // value go through IntegerParam, NumberParam and TimeParam, which either refuse with
 // 400 "bad_<name>" or give a value inside the range (a time in the store's fixed format).
@@ -9,7 +9,7 @@
 #include <string_view>
 
 #include "db/serial_number.h"
-#include "station/http/request.h"
+#include "station/daemon/http/request.h"
 #include "tests/fuzz/fuzz_support.h"
 
 namespace {
@@ -65,7 +65,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     req.body = text;
     const auto parsed = eol::station::http::ParseBody(req);
     if (const ApiError* e = std::get_if<ApiError>(&parsed)) {
-      // too_deep: nesting beyond station/http/request.h's depth limit.
+      // too_deep: nesting beyond station/daemon/http/request.h's depth limit.
       if (e->code != "bad_json" && e->code != "too_large" && e->code != "too_deep")
         Finding("ParseBody refused with " + e->code);
     } else {

@@ -1,8 +1,8 @@
-// station::ParseRecipe (station/recipe.h) on JSON text as LoadRecipe and PUT /api/recipe give
-// it: a Recipe or io::ConfigError. A Recipe must survive its own round trip (RecipeToJson,
+// station::ParseRecipe (station/daemon/recipe.h) on JSON text as LoadRecipe and PUT /api/recipe
+// give it: a Recipe or io::ConfigError. A Recipe must survive its own round trip (RecipeToJson,
 // then ParseRecipe) and keep every whole number as given.
 #include "drivers/io/json_config.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 #include "tests/fuzz/json_check.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -48,7 +48,7 @@ from soak_station import Fixture, Station, free_port, rss_mib, wait_verdict  # n
 EXCITATION_COIL = 1  # drivers/fixture/modbus_map.h: coil 1 excitation_enable
 FIXTURE_UNIT = 1
 PLC_UNIT = 1
-PLC_SERIAL_REGISTER = 100  # station/plc/plc_map.h: holding registers 100.. serial
+PLC_SERIAL_REGISTER = 100  # station/daemon/plc/plc_map.h: holding registers 100.. serial
 
 
 # --- Modbus TCP by hand ---------------------------------------------------------------------

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Capacity of the station's HTTP API, as stated in station/http/README.md ("Capacity").
+"""Capacity of the station's HTTP API, as stated in station/daemon/http/README.md ("Capacity").
 
 Starts `eol station` (simulated fixture and DAQ, its own temporary directory), then
   1. holds N live event streams (GET /api/events, drained as they arrive) and runs

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The plant's MES, played by an independent MQTT client (Debian's python3-paho-mqtt 1.6),
-for the tests of the station's MQTT results (station/mqtt_publisher.h).
+for the tests of the station's MQTT results (station/daemon/mqtt_publisher.h).
 
 Subscribes to TOPIC with QoS 1 in a persistent session (clean_session False, a fixed client
 id), so that the broker keeps what arrives while this client is away; reconnects by itself

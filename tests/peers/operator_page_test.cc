@@ -26,7 +26,7 @@
 #include "analysis/qc/measurement.h"
 #include "db/store.h"
 #include "drivers/io/frf_files.h"
-#include "station/reason_cause.h"
+#include "station/daemon/reason_cause.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>
@@ -611,7 +611,7 @@ TEST(OperatorPage, AsksForTheOperatorsTokenWhenTheStationHasTokens) {
   station.Stop(SIGTERM, 20s);
 }
 
-// A station of two motor types (station/variants.h): the page lists them, and a serial no
+// A station of two motor types (station/daemon/variants.h): the page lists them, and a serial no
 // prefix rule claims starts with the type the operator picks, recorded with the unit.
 TEST(OperatorPage, OffersTheStationsMotorTypesAndStartsWithThePickedOne) {
   ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"));

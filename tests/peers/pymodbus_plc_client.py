@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The line PLC, played by an independent Modbus client (pymodbus 3.0), for the tests of the
-station's PLC handshake (station/plc/plc_map.h).
+station's PLC handshake (station/daemon/plc/plc_map.h).
 
 The operations of pymodbus_fixture_client.py (read_coils, read_di, read_hr, read_ir,
 write_coil, write_hr, write_coils, write_hrs, sleep), plus what a PLC program does:

@@ -1,11 +1,12 @@
 // `eol teach` relearns the excitation design's nominal motor from the golden units
-// (station/qc_service.h RelearnNominal). Golden units of tests/peers/independent_population.py
-// (the ten-pole motor written apart from analysis/, Q about 41 where the design says 50) taught
-// on recipes/pmsm-10pole-fast.json: the taught limits put Q 50 outside them, so keeping the
-// design's nominal made the proposal refuse itself. Relearned, the nominal is the units' own,
-// and the fast excitation is then short of its sigma_f0 requirement at that lower Q: teach
-// writes the proposal saying so, nothing loads it (a unit analysed with it is refused, never
-// judged), and `eol design-excitation` redesigns it into a recipe that passes good units.
+// (station/daemon/qc_service.h RelearnNominal). Golden units of
+// tests/peers/independent_population.py (the ten-pole motor written apart from analysis/, Q about
+// 41 where the design says 50) taught on recipes/pmsm-10pole-fast.json: the taught limits put Q 50
+// outside them, so keeping the design's nominal made the proposal refuse itself. Relearned, the
+// nominal is the units' own, and the fast excitation is then short of its sigma_f0 requirement at
+// that lower Q: teach writes the proposal saying so, nothing loads it (a unit analysed with it is
+// refused, never judged), and `eol design-excitation` redesigns it into a recipe that passes good
+// units.
 #include <gtest/gtest.h>
 
 #include <chrono>

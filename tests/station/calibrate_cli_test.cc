@@ -11,8 +11,8 @@
 #include "../support/child_process.h"
 #include "drivers/daq/calibration_file.h"
 #include "drivers/factory/factory.h"
-#include "station/config.h"
-#include "station/station.h"
+#include "station/daemon/config.h"
+#include "station/daemon/station.h"
 #include "tests/support/eol_cli.h"
 
 namespace eol {

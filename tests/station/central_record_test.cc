@@ -1,11 +1,11 @@
-// The plant's central record (station/central/) against a real PostgreSQL 15 server started by
-// the test in a temporary directory (tests/support/postgres_server.h): eight stations write at
+// The plant's central record (station/daemon/central/) against a real PostgreSQL 15 server started
+// by the test in a temporary directory (tests/support/postgres_server.h): eight stations write at
 // once, the server is stopped (as `pg_ctl stop -m immediate`) in the middle of the run and
 // started again, and every record of every station's SQLite is in `tests` exactly once; a
 // station stopped mid-replication, or one that lost its cursor after the COMMIT, resumes
 // without a duplicate; `eol query --central` and GET /api/units/{serial}?scope=plant answer
 // plant-wide with the fields of their station-local forms.
-#include "station/central/central_record.h"
+#include "station/daemon/central/central_record.h"
 
 #include <gtest/gtest.h>
 
@@ -20,10 +20,10 @@
 
 #include "db/clock.h"
 #include "db/store.h"
-#include "station/central/central_replicator.h"
-#include "station/central/pg.h"
-#include "station/config.h"
-#include "station/station.h"
+#include "station/daemon/central/central_replicator.h"
+#include "station/daemon/central/pg.h"
+#include "station/daemon/config.h"
+#include "station/daemon/station.h"
 #include "tests/support/central_counts.h"
 #include "tests/support/child_process.h"
 #include "tests/support/free_port.h"

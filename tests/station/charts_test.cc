@@ -17,8 +17,8 @@
 #include "analysis/model/motor_model.h"
 #include "db/store.h"
 #include "drivers/io/frf_files.h"
-#include "station/http_api.h"
-#include "station/station.h"
+#include "station/daemon/http_api.h"
+#include "station/daemon/station.h"
 #include "tests/support/child_process.h"
 #include "tests/support/eol_cli.h"
 

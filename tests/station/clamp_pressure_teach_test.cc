@@ -13,9 +13,9 @@
 
 #include "../support/child_process.h"
 #include "db/store.h"
-#include "station/qc_service.h"
-#include "station/recipe.h"
-#include "station/station.h"
+#include "station/daemon/qc_service.h"
+#include "station/daemon/recipe.h"
+#include "station/daemon/station.h"
 
 namespace eol::station {
 namespace {

@@ -1,4 +1,4 @@
-// Test conditions (station/conditions.h) through the real sequencer on the simulated bench
+// Test conditions (station/daemon/conditions.h) through the real sequencer on the simulated bench
 // with a real SQLite file: recorded on every test, and a condition out of the recipe's window
 // ends the test as ERROR "condition out of window: ..." (never PASS, never FAIL), unless the
 // recipe's policy is "record".
@@ -11,7 +11,7 @@
 #include "drivers/io/json_config.h"
 #include "drivers/sim/sim_daq.h"
 #include "drivers/sim/sim_fixture.h"
-#include "station/sequencer.h"
+#include "station/daemon/sequencer.h"
 
 namespace eol::station {
 namespace {

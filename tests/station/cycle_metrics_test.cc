@@ -1,5 +1,5 @@
-// Issue 16/17: where a test's time goes (station/cycle_time.h), stored in every record, and
-// the station's Prometheus metrics over its real HTTP server (station/station_metrics.h):
+// Issue 16/17: where a test's time goes (station/daemon/cycle_time.h), stored in every record, and
+// the station's Prometheus metrics over its real HTTP server (station/daemon/station_metrics.h):
 // a real SQLite file, the simulated bench, and an unreachable Modbus fixture for the errors.
 #include <gtest/gtest.h>
 
@@ -7,8 +7,8 @@
 #include <regex>
 #include <string>
 
-#include "station/cycle_time.h"
-#include "station/station.h"
+#include "station/daemon/cycle_time.h"
+#include "station/daemon/station.h"
 #include "tests/support/child_process.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.

@@ -1,6 +1,6 @@
-// The recipe's "excitation_design" requirement (station/recipe.h) and `eol design-excitation`:
-// a recipe whose excitation misses the precision it states is refused, naming the field; the
-// command writes the shortest excitation that meets it as a proposal that loads.
+// The recipe's "excitation_design" requirement (station/daemon/recipe.h) and `eol
+// design-excitation`: a recipe whose excitation misses the precision it states is refused, naming
+// the field; the command writes the shortest excitation that meets it as a proposal that loads.
 #include <gtest/gtest.h>
 
 #include <complex>
@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drivers/io/json_config.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 #include "tests/support/child_process.h"
 #include "tests/support/recipe_error.h"
 

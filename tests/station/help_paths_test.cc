@@ -1,5 +1,5 @@
 // No `--help` shows a path of the machine the program was built on: defaults come from the
-// working directory or the installed program's prefix (station/data_files.h), and the
+// working directory or the installed program's prefix (station/daemon/data_files.h), and the
 // help says where they are looked for. Every `--help` names only options that exist (its
 // command's, or those of a command it cites as `eol NAME`), files of the source tree that exist,
 // Markdown headings that exist, and `eol gap --help` the whole effect catalogue.

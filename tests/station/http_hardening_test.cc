@@ -15,7 +15,7 @@
 #include <thread>
 
 #include "db/store.h"
-#include "station/http_api.h"
+#include "station/daemon/http_api.h"
 #include "tests/support/child_process.h"
 #include "tests/support/raw_client.h"
 #include "tests/support/station_ready.h"

@@ -17,8 +17,8 @@
 #include <thread>
 
 #include "db/store.h"
-#include "station/http/request.h"
-#include "station/http_api.h"
+#include "station/daemon/http/request.h"
+#include "station/daemon/http_api.h"
 #include "tests/support/child_process.h"
 #include "tests/support/raw_client.h"
 

@@ -1,4 +1,4 @@
-// The HTTP layer alone (station/http/): who may call a route (RequireRole), reading a body
+// The HTTP layer alone (station/daemon/http/): who may call a route (RequireRole), reading a body
 // (ParseBody), and the mapping of the station's typed results (RecipeChange, TeachResult) to
 // statuses and JSON, first as functions and then through a real server on 127.0.0.1 with a
 // real SQLite store.
@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "db/store.h"
-#include "station/http/request.h"
-#include "station/http/routes.h"
-#include "station/http_api.h"
+#include "station/daemon/http/request.h"
+#include "station/daemon/http/routes.h"
+#include "station/daemon/http_api.h"
 #include "tests/support/child_process.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.

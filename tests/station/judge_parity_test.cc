@@ -1,4 +1,4 @@
-// One judge (station/judge.h): a recording judged by the running station (the real sequencer
+// One judge (station/daemon/judge.h): a recording judged by the running station (the real sequencer
 // on the simulated fixture, the recording replayed by the replay DAQ, a real SQLite file) and
 // the same recording judged offline by `eol analyze --recipe R --measured FILE --json` get the
 // same outcome, the same measurements with the same values, and the same reasons (code and
@@ -18,8 +18,8 @@
 #include "drivers/factory/factory.h"
 #include "drivers/io/json_config.h"
 #include "drivers/io/recording_files.h"
-#include "station/recipe.h"
-#include "station/sequencer.h"
+#include "station/daemon/recipe.h"
+#include "station/daemon/sequencer.h"
 
 namespace eol::station {
 namespace {

@@ -16,9 +16,9 @@
 #include "drivers/fixture/modbus_fixture.h"
 #include "drivers/sim/sim_clock.h"
 #include "drivers/sim/sim_fixture.h"
-#include "station/health.h"
-#include "station/station.h"
-#include "station/status_board.h"
+#include "station/daemon/health.h"
+#include "station/daemon/station.h"
+#include "station/daemon/status_board.h"
 #include "tests/support/child_process.h"
 #include "tests/support/wait_until.h"
 

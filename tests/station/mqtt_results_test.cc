@@ -1,4 +1,4 @@
-// Results over MQTT from the store's outbox (station/mqtt_publisher.h) against a real
+// Results over MQTT from the store's outbox (station/daemon/mqtt_publisher.h) against a real
 // mosquitto broker started by the test on a free port, and an independent subscriber (Debian's
 // python3-paho-mqtt, tests/peers/mqtt_subscriber.py) in a persistent session. The broker is
 // stopped and restarted in the middle of a run: nothing is lost, the order is kept, and a
@@ -18,7 +18,7 @@
 #include <thread>
 
 #include "db/store.h"
-#include "station/station.h"
+#include "station/daemon/station.h"
 #include "tests/support/child_process.h"
 #include "tests/support/free_port.h"
 #include "tests/support/mosquitto_broker.h"

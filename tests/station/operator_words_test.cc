@@ -1,7 +1,7 @@
 // The operator page's words (issue 36): every catalogue in station/web/i18n/ has every key of
 // the English one, and English has operator words for everything the C++ can put in front of
-// an operator: every reason code and cause (station/reason_cause.h), every not-ready cause
-// (station/health.h), every measurement the analysis names, every step of the sequence. The
+// an operator: every reason code and cause (station/daemon/reason_cause.h), every not-ready cause
+// (station/daemon/health.h), every measurement the analysis names, every step of the sequence. The
 // lists are enumerated here from the C++, so a code added without its words fails this test.
 #include <gtest/gtest.h>
 
@@ -17,11 +17,11 @@
 #include "analysis/qc/measurement_json.h"
 #include "analysis/qc/measurement_names.h"
 #include "drivers/io/json_config.h"
-#include "station/config.h"
-#include "station/health.h"
-#include "station/reason_cause.h"
-#include "station/recipe.h"
-#include "station/sequencer.h"
+#include "station/daemon/config.h"
+#include "station/daemon/health.h"
+#include "station/daemon/reason_cause.h"
+#include "station/daemon/recipe.h"
+#include "station/daemon/sequencer.h"
 
 namespace eol::station {
 namespace {

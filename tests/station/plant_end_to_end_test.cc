@@ -24,8 +24,8 @@
 #include <vector>
 
 #include "db/store.h"
-#include "station/config.h"
-#include "station/station.h"
+#include "station/daemon/config.h"
+#include "station/daemon/station.h"
 #include "tests/support/central_counts.h"
 #include "tests/support/child_process.h"
 #include "tests/support/free_port.h"

@@ -1,4 +1,4 @@
-// The line PLC's Modbus server (station/plc/plc_server.h) under a crowd on 127.0.0.1: idle,
+// The line PLC's Modbus server (station/daemon/plc/plc_server.h) under a crowd on 127.0.0.1: idle,
 // slow, malformed and connect-and-close clients around one well-behaved PLC, with a station
 // backend of the test's own. Issue 34: four idle connections killed the daemon; a PLC
 // sending a byte every 0.4 s stalled every other for 4.4 s per frame.
@@ -6,8 +6,8 @@
 
 #include <iostream>
 
-#include "station/config.h"
-#include "station/plc/plc_server.h"
+#include "station/daemon/config.h"
+#include "station/daemon/plc/plc_server.h"
 #include "tests/support/modbus_crowd.h"
 
 namespace eol::station::plc {

@@ -1,4 +1,4 @@
-// The line PLC's handshake (station/plc/plc_map.h) against an independent PLC: Debian's
+// The line PLC's handshake (station/daemon/plc/plc_map.h) against an independent PLC: Debian's
 // pymodbus (tests/peers/pymodbus_plc_client.py) on 127.0.0.1, talking to a station that
 // serves its queue in-process with the sim bench, a real SQLite file and the real PLC server
 // on a free port. Each client run is one connection that ends when its operations do.
@@ -13,8 +13,8 @@
 
 #include "db/store.h"
 #include "drivers/io/json_config.h"
-#include "station/plc/plc_map.h"
-#include "station/station.h"
+#include "station/daemon/plc/plc_map.h"
+#include "station/daemon/station.h"
 #include "tests/peers/modbus_peer_support.h"
 #include "tests/support/child_process.h"
 #include "tests/support/wait_until.h"

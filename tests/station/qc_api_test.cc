@@ -140,7 +140,7 @@ class QcApiForeignMotor : public QcApi {
 };
 
 // Issue 37: POST /api/teach refuses golden units of another motor as `eol teach` does (the
-// same finding and sentence, station/qc_service.h ForeignGoldenRefusal), naming the quantity
+// same finding and sentence, station/daemon/qc_service.h ForeignGoldenRefusal), naming the quantity
 // and by how much; "force_foreign": true teaches from them and the proposal records it.
 TEST_F(QcApiForeignMotor, TeachRefusesGoldenUnitsOfAnotherMotorUnlessForced) {
   nlohmann::json serials = nlohmann::json::array();

@@ -1,4 +1,4 @@
-// A taught recipe is a proposal until an engineer approves it (issue 12; station/recipe.h,
+// A taught recipe is a proposal until an engineer approves it (issue 12; station/daemon/recipe.h,
 // RecipeApproval): eol teach writes "approval": {"state": "proposed"}; the station refuses to
 // test with a proposal, at start and on PUT /api/recipe; an engineer approves it over the API
 // (POST /api/recipe/approve, installed and audited under the token's name) or with
@@ -13,14 +13,15 @@
 #include "db/store.h"
 #include "db/test_record.h"
 #include "drivers/io/json_config.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 #include "tests/support/child_process.h"
 #include "tests/support/eol_cli.h"
 #include "tests/support/pass_records.h"
 #include "tests/support/station_ready.h"
 #include "tests/support/token_station.h"
 
-// After Eigen (through station/recipe.h): <resolv.h> defines _res, a parameter name in Eigen.
+// After Eigen (through station/daemon/recipe.h): <resolv.h> defines _res, a parameter name in
+// Eigen.
 #include <httplib.h>
 
 namespace eol {

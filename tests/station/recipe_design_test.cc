@@ -1,6 +1,6 @@
-// station/recipe_design.h: recipes proposed from the shipped motor files (the ten-pole motor
+// station/daemon/recipe_design.h: recipes proposed from the shipped motor files (the ten-pole motor
 // and the eight-pole second type), their calibration to good units, and every refusal.
-#include "station/recipe_design.h"
+#include "station/daemon/recipe_design.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <iostream>
 
 #include "analysis/qc/measurement_names.h"
-#include "station/qc_service.h"
+#include "station/daemon/qc_service.h"
 
 namespace eol::station {
 namespace {
@@ -140,7 +140,7 @@ TEST(RecipeDesign, BadInputsAreRefusedNamingTheCause) {
             std::string::npos);
 }
 
-// The detectability model must be the recipe's motor (station/qc_service.h): the built-in
+// The detectability model must be the recipe's motor (station/daemon/qc_service.h): the built-in
 // chain is refused for the eight-pole recipe (what GET /api/detectability answers 422
 // model_mismatch with), the recipe's own motor JSON is accepted, and so is the ten-pole
 // recipe on the built-in chain.

@@ -1,6 +1,6 @@
 // Recipes: the shipped recipe loads; every malformed recipe is refused with a message that
 // names the JSON path and the rule; the hash ignores formatting but not content.
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 
 #include <gtest/gtest.h>
 

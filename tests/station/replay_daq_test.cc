@@ -12,7 +12,7 @@
 #include "analysis/impedance_analysis.h"
 #include "drivers/factory/factory.h"
 #include "drivers/io/recording_files.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 
 namespace eol {
 namespace {

@@ -1,8 +1,8 @@
-// Self-checks with master parts and the lockout (station/self_check.h), on the whole station
+// Self-checks with master parts and the lockout (station/daemon/self_check.h), on the whole station
 // (config, sim bench with its masters, real SQLite file, real HTTP on 127.0.0.1): production
 // is refused with ERROR and the reason until both masters check out; a limit master that
 // PASSes locks the station; the lockout survives a restart; a passing check unlocks.
-#include "station/self_check.h"
+#include "station/daemon/self_check.h"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 
 #include "../support/child_process.h"
 #include "../support/manual_station_clock.h"
+#include "station/daemon/station.h"
 #include "station/reports/stats_report.h"
-#include "station/station.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.
 #include <httplib.h>

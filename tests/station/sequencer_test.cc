@@ -1,7 +1,7 @@
 // The sequencer on the simulated bench with a real SQLite file: verdicts match the truth,
 // every fault ends as ERROR (never PASS) with the cause stored and the excitation off, and
 // the station recovers by itself once the fault clears.
-#include "station/sequencer.h"
+#include "station/daemon/sequencer.h"
 
 #include <gtest/gtest.h>
 
@@ -15,8 +15,8 @@
 #include "analysis/qc/measurement_names.h"
 #include "drivers/sim/sim_daq.h"
 #include "drivers/sim/sim_fixture.h"
-#include "station/cycle_time.h"
-#include "station/reason_cause.h"
+#include "station/daemon/cycle_time.h"
+#include "station/daemon/reason_cause.h"
 
 namespace eol::station {
 namespace {
@@ -470,8 +470,8 @@ TEST_F(SequencerTest, DoorOpenBeforeTestNeverExcites) {
   EXPECT_EQ(r.outcome, Outcome::kError);
   EXPECT_TRUE(HasReason(r, "interlock: door open"));
   EXPECT_TRUE(HasReason(r, "clamp left as it is: door open"));
-  // The finer causes the operator page words (station/reason_cause.h), stored with the record:
-  // the door, and no clamp left closed (refused before the clamp was ever commanded).
+  // The finer causes the operator page words (station/daemon/reason_cause.h), stored with the
+  // record: the door, and no clamp left closed (refused before the clamp was ever commanded).
   EXPECT_EQ(r.reasons.front().cause, cause::kDoorOpen);
   EXPECT_EQ(CauseOf(r, "clamp left as it is"), "");
   EXPECT_FALSE(bench_->last_excitation_off().has_value()) << "the relay was closed at some point";

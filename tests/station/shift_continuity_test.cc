@@ -6,7 +6,7 @@
 #include <chrono>
 #include <string>
 
-#include "station/station.h"
+#include "station/daemon/station.h"
 #include "tests/support/child_process.h"
 
 namespace eol::station {

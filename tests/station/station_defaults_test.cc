@@ -8,7 +8,7 @@
 #include <string>
 
 #include "drivers/io/json_config.h"
-#include "station/station.h"
+#include "station/daemon/station.h"
 #include "tests/support/child_process.h"
 
 namespace eol::station {

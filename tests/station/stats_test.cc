@@ -9,9 +9,9 @@
 
 #include "../support/child_process.h"
 #include "db/store.h"
-#include "station/http_api.h"
+#include "station/daemon/http_api.h"
+#include "station/daemon/station.h"
 #include "station/reports/stats_report.h"
-#include "station/station.h"
 #include "tests/support/eol_cli.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.

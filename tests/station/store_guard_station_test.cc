@@ -14,7 +14,7 @@
 
 #include "db/last_verdict.h"
 #include "db/store.h"
-#include "station/station.h"
+#include "station/daemon/station.h"
 #include "tests/support/child_process.h"
 #include "tests/support/eol_cli.h"
 

@@ -11,7 +11,7 @@
 
 #include "../support/child_process.h"
 #include "db/test_record.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 #include "tests/support/eol_cli.h"
 #include "tests/support/pass_records.h"
 

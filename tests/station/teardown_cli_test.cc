@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "db/store.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 #include "station/reports/teardown_review.h"
 #include "tests/support/child_process.h"
 #include "tests/support/eol_cli.h"

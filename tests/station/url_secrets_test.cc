@@ -10,9 +10,9 @@
 #include <thread>
 
 #include "db/store.h"
-#include "station/config.h"
-#include "station/mqtt_publisher.h"
-#include "station/plant_urls.h"
+#include "station/daemon/config.h"
+#include "station/daemon/mqtt_publisher.h"
+#include "station/daemon/plant_urls.h"
 #include "tests/support/child_process.h"
 #include "tests/support/free_port.h"
 #include "tests/support/wait_until.h"

@@ -1,10 +1,10 @@
-// Variants (issue 36, station/variants.h): the config's "variants" parsed naming the JSON
+// Variants (issue 36, station/daemon/variants.h): the config's "variants" parsed naming the JSON
 // path; the selection rules one by one; a proposal refused at start naming it; and end to end
 // through the daemon's HTTP start and through the line PLC's variant register (pymodbus on
 // 127.0.0.1 against the real PLC server), with two recipes: the shipped pmsm-10pole and a
 // copy of the shipped pmsm-8pole-heavy proposal approved by `eol recipe-approve`. Real SQLite
 // file, the sim bench.
-#include "station/variants.h"
+#include "station/daemon/variants.h"
 
 #include <gtest/gtest.h>
 
@@ -17,10 +17,10 @@
 
 #include "db/store.h"
 #include "drivers/io/json_config.h"
-#include "station/config.h"
-#include "station/plc/plc_map.h"
-#include "station/recipe.h"
-#include "station/station.h"
+#include "station/daemon/config.h"
+#include "station/daemon/plc/plc_map.h"
+#include "station/daemon/recipe.h"
+#include "station/daemon/station.h"
 #include "tests/peers/modbus_peer_support.h"
 #include "tests/support/child_process.h"
 #include "tests/support/eol_cli.h"
@@ -408,7 +408,7 @@ TEST_F(TwoRecipeStation, EachUnitIsTestedAndRecordedWithItsOwnRecipeOverHttp) {
 TEST_F(TwoRecipeStation, ThePlcsVariantRegisterPicksTheRecipeAndAnUnknownOneStartsNothing) {
   ASSERT_TRUE(peers::PymodbusAvailable());
   Start();
-  const plc::PlcMap map;  // the addresses the station serves (station/plc/plc_map.h)
+  const plc::PlcMap map;  // the addresses the station serves (station/daemon/plc/plc_map.h)
   // One start: serial and variant register written, start set, then the refusal read, and
   // for an accepted start the wait for done.
   const auto start = [&](const std::string& serial, int code, bool accepted) {

@@ -1,4 +1,4 @@
-// The excitation watchdog (station/safety.h) through the sequencer, on the simulated bench
+// The excitation watchdog (station/daemon/safety.h) through the sequencer, on the simulated bench
 // with its controller rules (station_alive, latched interlocks) and a real SQLite file: a
 // stall of the watchdog's loop ends ERROR "watchdog stalled" and leaves its gap in the
 // record, never PASS; the controller opens the relay by itself while the station is stuck;
@@ -17,8 +17,8 @@
 #include "drivers/fixture/modbus_fixture.h"
 #include "drivers/sim/sim_bench.h"
 #include "drivers/sim/sim_daq.h"
-#include "station/safety.h"
-#include "station/sequencer.h"
+#include "station/daemon/safety.h"
+#include "station/daemon/sequencer.h"
 
 namespace eol::station {
 namespace {

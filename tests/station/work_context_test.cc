@@ -1,4 +1,4 @@
-// Who and what with the serial (station/test_request.h): the operator id, shift and order
+// Who and what with the serial (station/daemon/test_request.h): the operator id, shift and order
 // number arrive over HTTP (POST /api/tests), from the scanner's line on stdin (through the
 // `eol station` binary) and are stored with the record; bad fields are refused naming the
 // field. Real SQLite file, real HTTP on 127.0.0.1, the sim bench. (The line PLC's blocks
@@ -11,8 +11,8 @@
 #include <thread>
 
 #include "db/store.h"
-#include "station/station.h"
-#include "station/test_request.h"
+#include "station/daemon/station.h"
+#include "station/daemon/test_request.h"
 #include "tests/support/child_process.h"
 #include "tests/support/station_ready.h"
 #include "tests/support/wait_until.h"

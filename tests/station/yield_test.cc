@@ -14,8 +14,8 @@
 
 #include "../support/child_process.h"
 #include "db/store.h"
-#include "station/http_api.h"
-#include "station/status_board.h"
+#include "station/daemon/http_api.h"
+#include "station/daemon/status_board.h"
 #include "tests/support/eol_cli.h"
 
 // After Eigen: <resolv.h> (through httplib) defines _res, a parameter name in Eigen.

@@ -1,5 +1,5 @@
 // Test support: what the plant's central record and a station's SQLite hold, for checking
-// exactly-once replication (station/central/central_replicator.h).
+// exactly-once replication (station/daemon/central/central_replicator.h).
 #pragma once
 
 #include <cstdint>
@@ -9,7 +9,7 @@
 #include <utility>
 
 #include "db/store.h"
-#include "station/central/pg.h"
+#include "station/daemon/central/pg.h"
 
 namespace eol::testing {
 

@@ -1,4 +1,4 @@
-// Test support: station clocks (station/station_clock.h) that run on a drivers::ManualClock,
+// Test support: station clocks (station/daemon/station_clock.h) that run on a drivers::ManualClock,
 // so a test states the time that passes instead of sleeping through it.
 //
 //   ManualStationClock  everything on the manual clock. The sequencer's pause between two
@@ -18,7 +18,7 @@
 #include <thread>
 
 #include "drivers/sim/sim_clock.h"
-#include "station/station_clock.h"
+#include "station/daemon/station_clock.h"
 
 namespace eol::testing {
 

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "drivers/io/json_config.h"
-#include "station/recipe.h"
+#include "station/daemon/recipe.h"
 
 namespace eol::testing {
 

@@ -25,6 +25,6 @@ endfunction()
 run_check(good "#include \"analysis/frf.h\"\n#include \"analysis/fit/rational_fit.h\"\n#include <vector>\n" FALSE)
 set(deep "analysis/fit")
 string(APPEND deep "/deep")  # a subfolder of an allowed folder
-run_check(bad "#include \"analysis/frf.h\"\n#include \"station/judge.h\"\n#include \"${deep}/x.h\"\n  #  include \"newfolder/y.h\"\n" TRUE
-          station/judge.h ${deep}/x.h newfolder/y.h)
+run_check(bad "#include \"analysis/frf.h\"\n#include \"station/daemon/judge.h\"\n#include \"${deep}/x.h\"\n  #  include \"newfolder/y.h\"\n" TRUE
+          station/daemon/judge.h ${deep}/x.h newfolder/y.h)
 message(STATUS "layering self-test: the allowed file passed, the three bad includes were named")
