@@ -41,8 +41,9 @@ InterlockFinding FindInterlockFault(const drivers::FixtureInputs& in, const Reci
   if (!in.part_present) return {cause::kNoPart, "no part present"};
   if (require_clamp) {
     if (!in.clamped) return {cause::kClampNotConfirmed, "clamp not confirmed (clamped sensor off)"};
-    if (in.clamp_pressure_bar < r.clamp_pressure_lo_bar ||
-        in.clamp_pressure_bar > r.clamp_pressure_hi_bar)
+    // Written as "not inside" so that a pressure that is not a number is a fault too.
+    if (!(in.clamp_pressure_bar >= r.clamp_pressure_lo_bar &&
+          in.clamp_pressure_bar <= r.clamp_pressure_hi_bar))
       return {cause::kClampPressure, "clamp pressure " + Fixed(in.clamp_pressure_bar, 2) +
                                          " bar outside " + Fixed(r.clamp_pressure_lo_bar, 2) +
                                          ".." + Fixed(r.clamp_pressure_hi_bar, 2) + " bar"};

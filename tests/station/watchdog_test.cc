@@ -7,6 +7,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <thread>
 
@@ -28,6 +30,22 @@ using drivers::FixtureOutput;
 using drivers::SimFault;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
+
+// The interlock rule on the clamp pressure holds the pressure inside its window: a reading
+// that is not a number (a failed conversion, a broken sensor model) is a fault, never a pass.
+TEST(InterlockRules, APressureThatIsNotANumberIsAFault) {
+  Recipe recipe;  // window 4.5..6.5 bar
+  drivers::FixtureInputs in;
+  in.estop_ok = in.door_closed = in.part_present = in.clamped = true;
+  in.clamp_pressure_bar = 5.0;
+  EXPECT_TRUE(FindInterlockFault(in, recipe, true).text.empty());
+  for (double p : {std::nan(""), 1.0, 7.0, std::numeric_limits<double>::infinity()}) {
+    in.clamp_pressure_bar = p;
+    const InterlockFinding f = FindInterlockFault(in, recipe, true);
+    EXPECT_EQ(f.cause, cause::kClampPressure) << p;
+    EXPECT_NE(f.text.find("clamp pressure"), std::string::npos) << f.text;
+  }
+}
 
 // The sim fixture with a hook that holds one read during excitation, as a frozen station
 // (or a stuck bus) would: the read blocks for `stall` under the fixture's lock, so nothing
