@@ -214,9 +214,11 @@ int Store::CountTestsSince(RecordKind kind, const std::string& since) {
 
 std::vector<OutcomeRow> Store::OutcomeRows(const OutcomeQuery& q) {
   // Only fixed clauses are appended; every value is a bound parameter.
+  static const internal::TestColumnSet kColumns{
+      "id",        "serial",         "started_at",  "outcome", "retest_of",
+      "recipe_id", "recipe_version", "recipe_hash", "reasons"};
   std::string sql =
-      "SELECT id, serial, started_at, outcome, retest_of, recipe_id, recipe_version, "
-      "recipe_hash, reasons FROM tests WHERE outcome <> 'RUNNING' AND kind = ?1";
+      "SELECT " + kColumns.List() + " FROM tests WHERE outcome <> 'RUNNING' AND kind = ?1";
   int n = 1;
   const int from_i = q.from ? ++n : 0;
   if (from_i) sql += " AND started_at >= ?" + std::to_string(from_i);
@@ -231,36 +233,24 @@ std::vector<OutcomeRow> Store::OutcomeRows(const OutcomeQuery& q) {
   if (to_i) s.BindText(to_i, *q.to);
   if (hash_i) s.BindText(hash_i, *q.recipe_hash);
   std::vector<OutcomeRow> out;
+  TestRecord t;  // the columns' fields, overwritten by each row
   while (s.Step()) {
-    OutcomeRow r;
-    r.test_id = s.Int(0);
-    const std::string op = "read the outcome of test " + std::to_string(r.test_id);
-    r.serial = s.Text(1);
-    r.started_at = s.Text(2);
-    const std::optional<analysis::Outcome> o = analysis::ParseOutcome(s.Text(3));
-    if (!o) throw StoreError(Message(path_, op, "unknown outcome '" + s.Text(3) + "'"));
-    r.outcome = *o;
-    r.retest_of = s.OptInt(4);
-    r.recipe_id = s.Text(5);
-    r.recipe_version = static_cast<int>(s.Int(6));
-    r.recipe_hash = s.Text(7);
-    try {
-      r.reasons = nlohmann::json::parse(s.Text(8)).get<std::vector<analysis::Reason>>();
-    } catch (const nlohmann::json::exception& e) {
-      throw StoreError(Message(path_, op, std::string("stored reasons: ") + e.what()));
-    }
-    out.push_back(std::move(r));
+    kColumns.Read(s, 0, path_, "read the outcome of test " + std::to_string(s.Int(0)), t);
+    out.push_back({t.id, std::move(t.serial), std::move(t.started_at), t.outcome, t.retest_of,
+                   std::move(t.recipe_id), t.recipe_version, std::move(t.recipe_hash),
+                   std::move(t.reasons)});
   }
   return out;
 }
 
 std::vector<MeasurementRow> Store::MeasurementRows(const MeasurementQuery& q) {
   // Only fixed clauses are appended; every value is a bound parameter.
-  std::string sql =
-      "SELECT t.id, t.serial, t.started_at, t.outcome, t.recipe_id, t.recipe_version, "
-      "t.recipe_hash, m.name, m.unit, m.value, m.lo, m.hi FROM measurements m "
-      "JOIN tests t ON t.id = m.test_id WHERE t.outcome IN ('PASS', 'FAIL', 'ERROR') "
-      "AND t.kind = ?1";
+  static const internal::TestColumnSet kColumns{
+      "id", "serial", "started_at", "outcome", "recipe_id", "recipe_version", "recipe_hash"};
+  std::string sql = "SELECT " + kColumns.List("t.") +
+                    ", m.name, m.unit, m.value, m.lo, m.hi FROM measurements m "
+                    "JOIN tests t ON t.id = m.test_id WHERE t.outcome IN ('PASS', 'FAIL', 'ERROR') "
+                    "AND t.kind = ?1";
   int n = 1;
   const int from_i = q.from ? ++n : 0;
   if (from_i) sql += " AND t.started_at >= ?" + std::to_string(from_i);
@@ -278,23 +268,14 @@ std::vector<MeasurementRow> Store::MeasurementRows(const MeasurementQuery& q) {
   if (hash_i) s.BindText(hash_i, *q.recipe_hash);
   if (serial_i) s.BindText(serial_i, *q.serial);
   std::vector<MeasurementRow> out;
+  TestRecord t;  // the columns' fields, overwritten by each row
+  const int m = kColumns.size();
+  const std::string op = "read measurements for statistics";
   while (s.Step()) {
-    MeasurementRow r;
-    r.test_id = s.Int(0);
-    r.serial = s.Text(1);
-    r.started_at = s.Text(2);
-    const std::optional<analysis::Outcome> o = analysis::ParseOutcome(s.Text(3));
-    if (!o) throw StoreError(Message(path_, "read measurements", "unknown outcome " + s.Text(3)));
-    r.outcome = *o;
-    r.recipe_id = s.Text(4);
-    r.recipe_version = static_cast<int>(s.Int(5));
-    r.recipe_hash = s.Text(6);
-    r.name = s.Text(7);
-    r.unit = s.Text(8);
-    r.value = s.OptReal(9);
-    r.lo = s.OptReal(10);
-    r.hi = s.OptReal(11);
-    out.push_back(std::move(r));
+    kColumns.Read(s, 0, path_, op, t);
+    out.push_back({t.id, std::move(t.serial), std::move(t.started_at), t.outcome,
+                   std::move(t.recipe_id), t.recipe_version, std::move(t.recipe_hash), s.Text(m),
+                   s.Text(m + 1), s.OptReal(m + 2), s.OptReal(m + 3), s.OptReal(m + 4)});
   }
   return out;
 }

@@ -138,4 +138,20 @@ TestRecord ReadTestRow(const Statement& s, const std::string& path) {
   return r;
 }
 
+TestColumnSet::TestColumnSet(std::initializer_list<const char*> names) {
+  for (const char* name : names) columns_.push_back(Stored()[IndexOf(name)]);
+}
+
+std::string TestColumnSet::List(const std::string& prefix) const {
+  std::string list;
+  for (const TestColumn* c : columns_) list += (list.empty() ? "" : ", ") + prefix + c->name;
+  return list;
+}
+
+void TestColumnSet::Read(const Statement& s, int first, const std::string& path,
+                         const std::string& op, TestRecord& r) const {
+  for (std::size_t i = 0; i < columns_.size(); ++i)
+    Apply(s, first + static_cast<int>(i), *columns_[i], path, op, r);
+}
+
 }  // namespace eol::db::internal

@@ -3,7 +3,9 @@
 // Internal to eol::db (db/store*.cc only).
 #pragma once
 
+#include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "db/sqlite_statement.h"
 #include "db/test_columns.h"
@@ -30,5 +32,23 @@ const std::string& TestsSelectSql();
 // column first, then every other column over it. StoreError naming the test and the column
 // for a value that is not a record's.
 TestRecord ReadTestRow(const Statement& s, const std::string& path);
+
+// A projection of the tests table for a query that needs only some columns (yield,
+// statistics): the named stored columns, in the given order.
+class TestColumnSet {
+ public:
+  // std::logic_error naming a name that is not a column of the store's tests table.
+  explicit TestColumnSet(std::initializer_list<const char*> names);
+  // "a, b, c", each name after `prefix` ("t." for a join).
+  std::string List(const std::string& prefix = "") const;
+  int size() const { return static_cast<int>(columns_.size()); }
+  // Sets the fields of `r` the columns hold from columns first, first + 1, ... of the current
+  // row of `s`; StoreError naming `op` and the column for a value that is not a record's.
+  void Read(const Statement& s, int first, const std::string& path, const std::string& op,
+            TestRecord& r) const;
+
+ private:
+  std::vector<const TestColumn*> columns_;
+};
 
 }  // namespace eol::db::internal
