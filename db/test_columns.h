@@ -2,18 +2,20 @@
 // is derived from it, so a new column is one entry here.
 //
 // Derived from it: the store's INSERT at BeginTest, its UPDATE at FinishTest, its SELECT and
-// row reader of the tests table (db/store_columns.h); the export's base columns
-// (db/export_schema.h: its `meaning` is `doc`); the plant's central INSERT
-// (station/central/central_record.cc).
+// row reader of the tests table, the column lists and parsing of its yield and statistics
+// readers (db/store_columns.h); the export's base columns (db/export_schema.h: its `meaning` is
+// `doc`); the plant's central INSERT (station/central/central_record.cc); db-bench's copy of
+// the tests table (station/bench/db_replicate.cc).
 //
-// Not derived (each must say the new column too): the store's schema (db/schema.h, a new
-// migration step: ALTER TABLE tests ADD COLUMN) and the central schema
-// (station/central/central_schema.h). tests/db/test_columns_test.cc checks this list against
-// the tests table of a real store file (PRAGMA table_info), and
-// tests/station/central_record_test.cc against the central table of a real PostgreSQL, so
-// neither can drift from it. The export's stability promise (db/export_schema.h) holds for the
-// exported entries: an entry's export name, type and doc never change, and a new exported
-// entry comes after every column of the current export schema version (export_since).
+// Not derived, so a new column also needs: the field in TestRecord and its JSON
+// (db/test_record.h), a new migration step of the store's schema (db/schema.h: ALTER TABLE
+// tests ADD COLUMN) and, when replicated, the central schema (station/central/central_schema.h).
+// tests/db/test_columns_test.cc checks this list against the tests table of a real store file
+// (PRAGMA table_info) and round-trips every stored column; tests/station/central_record_test.cc
+// checks it against the central table of a real PostgreSQL. The export's stability promise
+// (db/export_schema.h) holds for the exported entries: an entry's export name, type and doc
+// never change, and a new exported entry comes after every column of the current export
+// schema version (export_since).
 #pragma once
 
 #include <cstdint>
