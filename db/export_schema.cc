@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "analysis/qc/measurement_names.h"
+#include "db/test_columns.h"
 
 namespace eol::db {
 namespace {
@@ -34,7 +35,28 @@ ExportColumn Base(const char* key, ExportType type, const char* unit, const char
   return {key, "", key, type, unit, meaning, std::move(get)};
 }
 
-// The base columns of schema version 1, in row order. Append only (export_schema.h).
+ExportValue ToExport(const ColumnValue& v, const char* name) {
+  if (const auto* i = std::get_if<std::int64_t>(&v)) return *i;
+  if (const auto* t = std::get_if<std::string>(&v)) return *t;
+  if (std::holds_alternative<nlohmann::json>(v))
+    throw std::logic_error(std::string("export: test column ") + name + " is JSON");
+  return std::monostate{};
+}
+
+// The exported test columns (db/test_columns.h) whose export_since passes `pick`, in order.
+template <typename Pick>
+void AddTestColumns(std::vector<ExportColumn>& c, Pick pick) {
+  for (const TestColumn& t : TestColumns()) {
+    if (t.export_since == 0 || !pick(t.export_since)) continue;
+    c.push_back(
+        Base(t.name, t.export_type, t.unit, t.doc,
+             [get = t.get, name = t.name](const TestRecord& r) { return ToExport(get(r), name); }));
+  }
+}
+
+// The base columns, in row order: the schema version, the test columns of version 1
+// (db/test_columns.h), the key conditions, then test columns added in later versions. Append
+// only (export_schema.h).
 static_assert(kExportSchemaVersion == 5, "say the new version in schema_version's meaning");
 
 std::vector<ExportColumn> BaseColumns() {
@@ -43,61 +65,7 @@ std::vector<ExportColumn> BaseColumns() {
   c.push_back(
       Base("schema_version", T::kInteger, "", "Version of this export schema (5)",
            [](const TestRecord&) -> ExportValue { return std::int64_t{kExportSchemaVersion}; }));
-  c.push_back(Base("id", T::kInteger, "", "Test id in the station's database",
-                   [](const TestRecord& r) -> ExportValue { return r.id; }));
-  c.push_back(Base("serial", T::kText, "", "Serial number of the unit",
-                   [](const TestRecord& r) { return Text(r.serial); }));
-  c.push_back(Base("station_id", T::kText, "", "Station that ran the test",
-                   [](const TestRecord& r) { return Text(r.station_id); }));
-  c.push_back(Base("started_at", T::kTime, "", "Start, ISO 8601 UTC with milliseconds",
-                   [](const TestRecord& r) { return Text(r.started_at); }));
-  c.push_back(Base("finished_at", T::kTime, "", "End, ISO 8601 UTC with milliseconds",
-                   [](const TestRecord& r) { return Text(r.finished_at); }));
-  c.push_back(Base("outcome", T::kText, "",
-                   "PASS, FAIL (the motor is out of limits), ERROR (the station could not "
-                   "measure) or ABORTED",
-                   [](const TestRecord& r) { return Text(analysis::ToString(r.outcome)); }));
-  c.push_back(Base("reason_code", T::kText, "",
-                   "Code of the decisive (first) reason: limit, mask, condition, interlock, "
-                   "fixture, ...; empty for a clean PASS",
-                   [](const TestRecord& r) -> ExportValue {
-                     if (r.reasons.empty()) return std::monostate{};
-                     return Text(analysis::ToString(r.reasons.front().code));
-                   }));
-  c.push_back(Base("reason_text", T::kText, "", "Text of the decisive (first) reason",
-                   [](const TestRecord& r) -> ExportValue {
-                     if (r.reasons.empty()) return std::monostate{};
-                     return Text(r.reasons.front().text);
-                   }));
-  c.push_back(Base("reason_count", T::kInteger, "", "Number of reasons the record carries",
-                   [](const TestRecord& r) -> ExportValue {
-                     return static_cast<std::int64_t>(r.reasons.size());
-                   }));
-  c.push_back(Base("kind", T::kText, "",
-                   "production, or self_check (a master part checking the station; never "
-                   "production statistics)",
-                   [](const TestRecord& r) { return Text(ToString(r.kind)); }));
-  c.push_back(Base("recipe_id", T::kText, "", "Recipe the unit was tested with",
-                   [](const TestRecord& r) { return Text(r.recipe_id); }));
-  c.push_back(Base("recipe_version", T::kInteger, "", "Its version",
-                   [](const TestRecord& r) -> ExportValue {
-                     return static_cast<std::int64_t>(r.recipe_version);
-                   }));
-  c.push_back(Base("recipe_hash", T::kText, "", "SHA-256 of the recipe's canonical JSON",
-                   [](const TestRecord& r) { return Text(r.recipe_hash); }));
-  c.push_back(Base("software_version", T::kText, "", "Station software version and revision",
-                   [](const TestRecord& r) { return Text(r.software_version); }));
-  c.push_back(Base("retest_of", T::kInteger, "", "Id of the serial's first test, for a retest",
-                   [](const TestRecord& r) -> ExportValue {
-                     if (!r.retest_of) return std::monostate{};
-                     return *r.retest_of;
-                   }));
-  c.push_back(Base("operator_id", T::kText, "", "Operator's badge or login, when given",
-                   [](const TestRecord& r) { return Text(r.work.operator_id); }));
-  c.push_back(Base("shift", T::kText, "", "Shift name, when given",
-                   [](const TestRecord& r) { return Text(r.work.shift); }));
-  c.push_back(Base("order_number", T::kText, "", "Production order or batch, when given",
-                   [](const TestRecord& r) { return Text(r.work.order_number); }));
+  AddTestColumns(c, [](int since) { return since == 1; });
   c.push_back(Base("winding_temperature_c", T::kNumber, "degC",
                    "Winding temperature estimated from the fitted resistance",
                    Condition("winding_temperature_c")));
@@ -129,6 +97,7 @@ std::vector<ExportColumn> BaseColumns() {
                      if (it == r.conditions.end() || !it->is_string()) return std::monostate{};
                      return it->get<std::string>();
                    }));
+  AddTestColumns(c, [](int since) { return since > 1; });
   return c;
 }
 

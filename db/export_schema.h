@@ -5,7 +5,9 @@
 //
 // Row layout (schema version kExportSchemaVersion):
 //   1. the base columns (kind of test, identity, times, outcome, first reason, recipe, who,
-//      order and the key conditions), always the same, in the same order;
+//      order and the key conditions), always the same, in the same order; a test's own
+//      columns (identity to order) are the exported entries of the one column list that the
+//      store and the central record share (db/test_columns.h), the key conditions are here;
 //   2. for each declared measurement name N, in the order declared, six columns
 //      N_value, N_sigma, N_lo, N_hi, N_unit, N_outcome.
 // The declared list is the standard names (analysis/qc/measurement_names.h) followed by what

@@ -12,66 +12,22 @@
 
 #include "db/curve_codec.h"
 #include "db/sqlite_statement.h"
+#include "db/store_columns.h"
 
 namespace eol::db {
 namespace {
 
 using internal::Message;
 using internal::PragmaInt;
+using internal::ReadTestRow;
 using internal::Statement;
+using internal::TestsSelectSql;
 
 constexpr int kMaxQueryLimit = 10000;
 // A curve's JSON beyond this size is a corrupt raw_size, not data (100k points are ~10 MB).
 constexpr sqlite3_int64 kMaxCurveJsonBytes = sqlite3_int64{1} << 30;
 
 // ---- Reading -----------------------------------------------------------------------------
-
-constexpr std::string_view kSelectTests =
-    "SELECT id, serial, station_id, recipe_id, recipe_version, recipe_hash, software_version, "
-    "started_at, finished_at, outcome, retest_of, reasons, record, kind, operator_id, shift, "
-    "order_number, "
-    "(SELECT count(*) FROM tests p WHERE p.serial = tests.serial AND p.id <= tests.id) "
-    "FROM tests ";
-
-TestRecord RowToRecord(const Statement& s, const std::string& path) {
-  const std::int64_t id = s.Int(0);
-  const std::string op = "read test " + std::to_string(id);
-  TestRecord r;
-  try {
-    // An aborted test has no record JSON: its columns are all there is.
-    if (!s.IsNull(12)) r = nlohmann::json::parse(s.Text(12)).get<TestRecord>();
-    r.reasons = nlohmann::json::parse(s.Text(11)).get<std::vector<analysis::Reason>>();
-  } catch (const nlohmann::json::exception& e) {
-    throw StoreError(Message(path, op, std::string("stored JSON is not a record: ") + e.what()));
-  } catch (const std::invalid_argument& e) {  // an unknown enum string (test_record.h)
-    throw StoreError(Message(path, op, std::string("stored record: ") + e.what()));
-  }
-  r.id = id;
-  r.serial = s.Text(1);
-  r.station_id = s.Text(2);
-  r.recipe_id = s.Text(3);
-  r.recipe_version = static_cast<int>(s.Int(4));
-  r.recipe_hash = s.Text(5);
-  r.software_version = s.Text(6);
-  r.started_at = s.Text(7);
-  r.finished_at = s.Text(8);
-  const std::string outcome = s.Text(9);
-  const std::optional<analysis::Outcome> parsed = analysis::ParseOutcome(outcome);
-  if (!parsed) throw StoreError(Message(path, op, "unknown outcome '" + outcome + "'"));
-  r.outcome = *parsed;
-  r.retest_of = s.OptInt(10);
-  try {
-    r.kind = ParseRecordKind(s.Text(13));
-  } catch (const std::invalid_argument& e) {
-    throw StoreError(Message(path, op, e.what()));
-  }
-  r.work.operator_id = s.Text(14);
-  r.work.shift = s.Text(15);
-  r.work.order_number = s.Text(16);
-  r.attempt = static_cast<int>(s.Int(17));
-  r.curves.clear();
-  return r;
-}
 
 std::string Decompress(std::string_view packed, std::int64_t raw_size, const std::string& path,
                        const std::string& op) {
@@ -114,11 +70,11 @@ void LoadCurves(Statement& c, const std::string& path, TestRecord& r) {
   }
 }
 
-// Steps `s` (a kSelectTests query with its parameters bound) to the end.
+// Steps `s` (a TestsSelectSql() query with its parameters bound) to the end.
 std::vector<TestRecord> ReadTests(sqlite3* db, const std::string& path, Statement& s,
                                   bool with_curves) {
   std::vector<TestRecord> out;
-  while (s.Step()) out.push_back(RowToRecord(s, path));
+  while (s.Step()) out.push_back(ReadTestRow(s, path));
   if (with_curves && !out.empty()) {
     Statement c(db, path,
                 "SELECT name, raw_size, data, encoding FROM curves WHERE test_id = ?1 ORDER BY id",
@@ -132,7 +88,7 @@ std::vector<TestRecord> ReadTests(sqlite3* db, const std::string& path, Statemen
 
 std::vector<TestRecord> Store::TestsOfSerial(const std::string& serial, bool with_curves) {
   Statement s(db_, path_,
-              std::string(kSelectTests) +
+              TestsSelectSql() +
                   "WHERE serial = ?1 AND outcome <> 'RUNNING' ORDER BY started_at DESC, id DESC",
               "tests of serial '" + serial + "'");
   s.BindText(1, serial);
@@ -141,7 +97,7 @@ std::vector<TestRecord> Store::TestsOfSerial(const std::string& serial, bool wit
 
 std::optional<TestRecord> Store::LatestOfSerial(const std::string& serial) {
   Statement s(db_, path_,
-              std::string(kSelectTests) +
+              TestsSelectSql() +
                   "WHERE serial = ?1 AND outcome <> 'RUNNING' "
                   "ORDER BY started_at DESC, id DESC LIMIT 1",
               "latest test of serial '" + serial + "'");
@@ -152,7 +108,7 @@ std::optional<TestRecord> Store::LatestOfSerial(const std::string& serial) {
 }
 
 std::optional<TestRecord> Store::Test(std::int64_t id, bool with_curves) {
-  Statement s(db_, path_, std::string(kSelectTests) + "WHERE id = ?1 AND outcome <> 'RUNNING'",
+  Statement s(db_, path_, TestsSelectSql() + "WHERE id = ?1 AND outcome <> 'RUNNING'",
               "read test " + std::to_string(id));
   s.BindInt(1, id);
   std::vector<TestRecord> found = ReadTests(db_, path_, s, with_curves);
@@ -162,7 +118,7 @@ std::optional<TestRecord> Store::Test(std::int64_t id, bool with_curves) {
 
 std::vector<TestRecord> Store::Tests(const TestQuery& query) {
   // Only fixed clauses are appended; every value is a bound parameter.
-  std::string sql = std::string(kSelectTests) + "WHERE outcome <> 'RUNNING'";
+  std::string sql = TestsSelectSql() + "WHERE outcome <> 'RUNNING'";
   int n = 0;
   const int from_i = query.from ? ++n : 0;
   if (from_i) sql += " AND started_at >= ?" + std::to_string(from_i);
@@ -258,9 +214,11 @@ int Store::CountTestsSince(RecordKind kind, const std::string& since) {
 
 std::vector<OutcomeRow> Store::OutcomeRows(const OutcomeQuery& q) {
   // Only fixed clauses are appended; every value is a bound parameter.
+  static const internal::TestColumnSet kColumns{
+      "id",        "serial",         "started_at",  "outcome", "retest_of",
+      "recipe_id", "recipe_version", "recipe_hash", "reasons"};
   std::string sql =
-      "SELECT id, serial, started_at, outcome, retest_of, recipe_id, recipe_version, "
-      "recipe_hash, reasons FROM tests WHERE outcome <> 'RUNNING' AND kind = ?1";
+      "SELECT " + kColumns.List() + " FROM tests WHERE outcome <> 'RUNNING' AND kind = ?1";
   int n = 1;
   const int from_i = q.from ? ++n : 0;
   if (from_i) sql += " AND started_at >= ?" + std::to_string(from_i);
@@ -275,36 +233,24 @@ std::vector<OutcomeRow> Store::OutcomeRows(const OutcomeQuery& q) {
   if (to_i) s.BindText(to_i, *q.to);
   if (hash_i) s.BindText(hash_i, *q.recipe_hash);
   std::vector<OutcomeRow> out;
+  TestRecord t;  // the columns' fields, overwritten by each row
   while (s.Step()) {
-    OutcomeRow r;
-    r.test_id = s.Int(0);
-    const std::string op = "read the outcome of test " + std::to_string(r.test_id);
-    r.serial = s.Text(1);
-    r.started_at = s.Text(2);
-    const std::optional<analysis::Outcome> o = analysis::ParseOutcome(s.Text(3));
-    if (!o) throw StoreError(Message(path_, op, "unknown outcome '" + s.Text(3) + "'"));
-    r.outcome = *o;
-    r.retest_of = s.OptInt(4);
-    r.recipe_id = s.Text(5);
-    r.recipe_version = static_cast<int>(s.Int(6));
-    r.recipe_hash = s.Text(7);
-    try {
-      r.reasons = nlohmann::json::parse(s.Text(8)).get<std::vector<analysis::Reason>>();
-    } catch (const nlohmann::json::exception& e) {
-      throw StoreError(Message(path_, op, std::string("stored reasons: ") + e.what()));
-    }
-    out.push_back(std::move(r));
+    kColumns.Read(s, 0, path_, "read the outcome of test " + std::to_string(s.Int(0)), t);
+    out.push_back({t.id, std::move(t.serial), std::move(t.started_at), t.outcome, t.retest_of,
+                   std::move(t.recipe_id), t.recipe_version, std::move(t.recipe_hash),
+                   std::move(t.reasons)});
   }
   return out;
 }
 
 std::vector<MeasurementRow> Store::MeasurementRows(const MeasurementQuery& q) {
   // Only fixed clauses are appended; every value is a bound parameter.
-  std::string sql =
-      "SELECT t.id, t.serial, t.started_at, t.outcome, t.recipe_id, t.recipe_version, "
-      "t.recipe_hash, m.name, m.unit, m.value, m.lo, m.hi FROM measurements m "
-      "JOIN tests t ON t.id = m.test_id WHERE t.outcome IN ('PASS', 'FAIL', 'ERROR') "
-      "AND t.kind = ?1";
+  static const internal::TestColumnSet kColumns{
+      "id", "serial", "started_at", "outcome", "recipe_id", "recipe_version", "recipe_hash"};
+  std::string sql = "SELECT " + kColumns.List("t.") +
+                    ", m.name, m.unit, m.value, m.lo, m.hi FROM measurements m "
+                    "JOIN tests t ON t.id = m.test_id WHERE t.outcome IN ('PASS', 'FAIL', 'ERROR') "
+                    "AND t.kind = ?1";
   int n = 1;
   const int from_i = q.from ? ++n : 0;
   if (from_i) sql += " AND t.started_at >= ?" + std::to_string(from_i);
@@ -322,23 +268,14 @@ std::vector<MeasurementRow> Store::MeasurementRows(const MeasurementQuery& q) {
   if (hash_i) s.BindText(hash_i, *q.recipe_hash);
   if (serial_i) s.BindText(serial_i, *q.serial);
   std::vector<MeasurementRow> out;
+  TestRecord t;  // the columns' fields, overwritten by each row
+  const int m = kColumns.size();
+  const std::string op = "read measurements for statistics";
   while (s.Step()) {
-    MeasurementRow r;
-    r.test_id = s.Int(0);
-    r.serial = s.Text(1);
-    r.started_at = s.Text(2);
-    const std::optional<analysis::Outcome> o = analysis::ParseOutcome(s.Text(3));
-    if (!o) throw StoreError(Message(path_, "read measurements", "unknown outcome " + s.Text(3)));
-    r.outcome = *o;
-    r.recipe_id = s.Text(4);
-    r.recipe_version = static_cast<int>(s.Int(5));
-    r.recipe_hash = s.Text(6);
-    r.name = s.Text(7);
-    r.unit = s.Text(8);
-    r.value = s.OptReal(9);
-    r.lo = s.OptReal(10);
-    r.hi = s.OptReal(11);
-    out.push_back(std::move(r));
+    kColumns.Read(s, 0, path_, op, t);
+    out.push_back({t.id, std::move(t.serial), std::move(t.started_at), t.outcome,
+                   std::move(t.recipe_id), t.recipe_version, std::move(t.recipe_hash), s.Text(m),
+                   s.Text(m + 1), s.OptReal(m + 2), s.OptReal(m + 3), s.OptReal(m + 4)});
   }
   return out;
 }

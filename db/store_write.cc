@@ -8,14 +8,19 @@
 #include "db/last_verdict.h"
 #include "db/sqlite_statement.h"
 #include "db/store.h"
+#include "db/store_columns.h"
 
 namespace eol::db {
 namespace {
 
+using internal::BindBeginColumns;
+using internal::BindFinishColumns;
 using internal::Exec;
 using internal::kBusyTimeoutMs;
 using internal::Message;
 using internal::Statement;
+using internal::TestsFinishSql;
+using internal::TestsInsertSql;
 using internal::Transaction;
 
 // How long the checkpoint after a verdict waits for readers of an older snapshot (an export
@@ -24,38 +29,16 @@ using internal::Transaction;
 // the publication of the verdict can be held up by a reader.
 constexpr int kCheckpointWaitMs = 500;
 
-// Invalid UTF-8 in a string (a garbled barcode, a device's reply) must not lose the record.
-std::string Dump(const nlohmann::json& j) {
-  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
 // `id_floor`: the new test's id is at least this (Store::id_floor_); 0: max(id) + 1, as SQLite.
 void InsertTestRow(sqlite3* db, const std::string& path, TestRecord& record,
                    std::int64_t id_floor) {
   const std::string op = "begin the test of serial '" + record.serial + "'";
   if (record.serial.empty()) throw StoreError(Message(path, op, "record.serial is empty"));
   if (record.started_at.empty()) throw StoreError(Message(path, op, "record.started_at is empty"));
-  Statement s(db, path, R"sql(
-    INSERT INTO tests (id, serial, station_id, recipe_id, recipe_version, recipe_hash,
-                       software_version, started_at, outcome, retest_of, kind,
-                       operator_id, shift, order_number)
-    VALUES (max(?12, (SELECT coalesce(max(id), 0) + 1 FROM tests)),
-            ?1, ?2, ?3, ?4, ?5, ?6, ?7, 'RUNNING',
-            (SELECT min(id) FROM tests WHERE serial = ?1), ?8, ?9, ?10, ?11)
-    RETURNING id, retest_of)sql",
-              op);
-  s.BindText(1, record.serial);
-  s.BindText(2, record.station_id);
-  s.BindText(3, record.recipe_id);
-  s.BindInt(4, record.recipe_version);
-  s.BindText(5, record.recipe_hash);
-  s.BindText(6, record.software_version);
-  s.BindText(7, record.started_at);
-  s.BindText(8, ToString(record.kind));
-  s.BindText(9, record.work.operator_id);
-  s.BindText(10, record.work.shift);
-  s.BindText(11, record.work.order_number);
-  s.BindInt(12, id_floor);
+  Statement s(db, path, TestsInsertSql(), op);
+  s.BindInt(1, id_floor);
+  s.BindText(2, record.serial);
+  BindBeginColumns(s, record);
   if (!s.Step()) throw StoreError(Message(path, op, "the insert returned no id"));
   const std::int64_t id = s.Int(0);
   const std::optional<std::int64_t> retest_of = s.OptInt(1);
@@ -74,18 +57,10 @@ void WriteFinish(sqlite3* db, const std::string& path, const TestRecord& record)
   const std::string op = "finish test " + std::to_string(record.id);
   if (record.finished_at.empty())
     throw StoreError(Message(path, op, "record.finished_at is empty"));
-  nlohmann::json j = record;
-  j.erase("curves");  // stored compressed, one row each
   {
-    Statement s(db, path,
-                "UPDATE tests SET outcome = ?2, finished_at = ?3, reasons = ?4, record = ?5 "
-                "WHERE id = ?1 AND outcome = 'RUNNING'",
-                op);
+    Statement s(db, path, TestsFinishSql(), op);
     s.BindInt(1, record.id);
-    s.BindText(2, analysis::ToString(record.outcome));
-    s.BindText(3, record.finished_at);
-    s.BindText(4, Dump(nlohmann::json(record.reasons)));
-    s.BindText(5, Dump(j));
+    BindFinishColumns(s, record);
     s.Run();
   }
   if (sqlite3_changes(db) != 1) {

@@ -8,6 +8,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include "db/test_columns.h"
+
 namespace eol::station {
 namespace {
 
@@ -50,18 +52,8 @@ std::string Fill(std::string sql, const std::map<std::string, std::string>& valu
   return sql;
 }
 
-// Copy k of tests 1..{N}: ids + {SHIFT}, units + {UNITS}, times + {LATER} seconds.
-constexpr const char* kCopySql =
-    "INSERT INTO tests (id, serial, station_id, recipe_id, recipe_version, recipe_hash, "
-    "software_version, started_at, finished_at, outcome, retest_of, reasons, record, kind, "
-    "operator_id, shift, order_number) "
-    "SELECT id + {SHIFT}, "
-    "'{PREFIX}' || printf('%0{DIGITS}d', CAST(substr(serial, {FROM}) AS INTEGER) + {UNITS}), "
-    "station_id, recipe_id, recipe_version, recipe_hash, software_version, "
-    "strftime('%Y-%m-%dT%H:%M:%fZ', started_at, '+{LATER} seconds'), "
-    "strftime('%Y-%m-%dT%H:%M:%fZ', finished_at, '+{LATER} seconds'), outcome, "
-    "retest_of + {SHIFT}, reasons, record, kind, operator_id, shift, order_number "
-    "FROM tests WHERE id <= {N};"
+// Copy k of the measurements, curves and outbox rows of tests 1..{N}.
+constexpr const char* kCopyRowsSql =
     "INSERT INTO measurements (test_id, name, value, sigma, unit, lo, hi, outcome, marginal) "
     "SELECT test_id + {SHIFT}, name, value, sigma, unit, lo, hi, outcome, marginal "
     "FROM measurements WHERE test_id <= {N};"
@@ -69,6 +61,34 @@ constexpr const char* kCopySql =
     "SELECT test_id + {SHIFT}, name, raw_size, data, encoding FROM curves WHERE test_id <= {N};"
     "INSERT INTO outbox (test_id, created_at) "
     "SELECT test_id + {SHIFT}, created_at FROM outbox WHERE test_id <= {N};";
+
+// How copy k changes a column of the tests table: ids + {SHIFT}, units + {UNITS}, times +
+// {LATER} seconds; every other column (db/test_columns.h) is copied as it is.
+const std::map<std::string, std::string> kShiftedTestColumns = {
+    {"id", "id + {SHIFT}"},
+    {"serial",
+     "'{PREFIX}' || printf('%0{DIGITS}d', CAST(substr(serial, {FROM}) AS INTEGER) + {UNITS})"},
+    {"started_at", "strftime('%Y-%m-%dT%H:%M:%fZ', started_at, '+{LATER} seconds')"},
+    {"finished_at", "strftime('%Y-%m-%dT%H:%M:%fZ', finished_at, '+{LATER} seconds')"},
+    {"retest_of", "retest_of + {SHIFT}"}};
+
+// Copy k of tests 1..{N} with their measurements, curves and outbox rows.
+std::string CopySql() {
+  std::string names, values;
+  std::size_t found = 0;
+  for (const db::TestColumn& c : db::TestColumns()) {
+    if (c.store == db::StoreWrite::kNone) continue;
+    const auto shifted = kShiftedTestColumns.find(c.name);
+    found += shifted != kShiftedTestColumns.end() ? 1 : 0;
+    names += (names.empty() ? "" : ", ") + std::string(c.name);
+    values += (values.empty() ? "" : ", ") +
+              (shifted != kShiftedTestColumns.end() ? shifted->second : std::string(c.name));
+  }
+  if (found != kShiftedTestColumns.size())
+    throw std::logic_error("db-bench replication shifts a column the tests table does not have");
+  return "INSERT INTO tests (" + names + ") SELECT " + values + " FROM tests WHERE id <= {N};" +
+         kCopyRowsSql;
+}
 
 }  // namespace
 
@@ -93,13 +113,13 @@ void ReplicateBlock(const std::string& path, std::int64_t block_tests, std::int6
     char later[64];
     std::snprintf(later, sizeof later, "%.3f", k * block_span_s);
     const std::string sql =
-        Fill(kCopySql, {{"N", std::to_string(block_tests)},
-                        {"SHIFT", std::to_string(k * block_tests)},
-                        {"UNITS", std::to_string(k * block_units)},
-                        {"LATER", later},
-                        {"PREFIX", kDbBenchSerialPrefix},
-                        {"DIGITS", std::to_string(kDbBenchSerialDigits)},
-                        {"FROM", std::to_string(std::strlen(kDbBenchSerialPrefix) + 1)}});
+        Fill(CopySql(), {{"N", std::to_string(block_tests)},
+                         {"SHIFT", std::to_string(k * block_tests)},
+                         {"UNITS", std::to_string(k * block_units)},
+                         {"LATER", later},
+                         {"PREFIX", kDbBenchSerialPrefix},
+                         {"DIGITS", std::to_string(kDbBenchSerialDigits)},
+                         {"FROM", std::to_string(std::strlen(kDbBenchSerialPrefix) + 1)}});
     Exec(db.get(), path, "BEGIN IMMEDIATE", "begin copy");
     try {
       Exec(db.get(), path, sql, "copy " + std::to_string(k));

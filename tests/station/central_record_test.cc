@@ -20,6 +20,7 @@
 
 #include "db/clock.h"
 #include "db/store.h"
+#include "db/test_columns.h"
 #include "station/daemon/central/central_replicator.h"
 #include "station/daemon/central/pg.h"
 #include "station/daemon/config.h"
@@ -336,6 +337,53 @@ TEST_F(CentralRecordTest, QueryAndApiAnswerPlantWideWithTheLocalFields) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 503) << res->body;
   b.Stop();
+}
+
+// The one column list (db/test_columns.h) is the central table's columns (with the record's
+// curves and the times it was stored and replicated), each of the type the list casts to, and
+// a replicated row holds in each of them the value the list gets from the record.
+TEST_F(CentralRecordTest, TheCentralTableIsTheOneColumnListAndARowHoldsItsValues) {
+  auto pg = PgConnection::Connect(server_->url(), 5, "test");
+  EnsureCentralSchema(*pg);
+  const auto type_of = [&](const std::string& cast) {
+    return pg->Exec("SELECT $1::regtype::text", {cast}, "name a type").Text(0, 0);
+  };
+  std::map<std::string, std::string> listed = {{"curves", type_of("jsonb")},
+                                               {"stored_at", type_of("timestamptz")},
+                                               {"replicated_at", type_of("timestamptz")}};
+  for (const db::TestColumn& c : db::TestColumns())
+    if (c.central_name != nullptr) listed[c.central_name] = type_of(c.central_type);
+  const PgResult cols = pg->Exec(
+      "SELECT column_name, data_type FROM information_schema.columns "
+      "WHERE table_schema = current_schema() AND table_name = 'tests'",
+      {}, "read the central columns");
+  std::map<std::string, std::string> table;
+  for (int i = 0; i < cols.rows(); ++i) table[cols.Text(i, 0)] = cols.Text(i, 1);
+  EXPECT_EQ(table, listed)
+      << "db/test_columns.cc and station/daemon/central/central_schema.h disagree";
+
+  db::TestRecord r = Record("st-9", "SN-COLS", 7);  // a FAIL with a reason
+  r.id = 42;
+  r.retest_of = 40;
+  ASSERT_TRUE(InsertCentral(*pg, r, db::UtcNowIso8601()));
+  for (const db::TestColumn& c : db::TestColumns()) {
+    if (c.central_name == nullptr) continue;
+    const db::ColumnValue v = c.get(r);
+    std::optional<std::string> want;
+    if (const auto* i = std::get_if<std::int64_t>(&v)) want = std::to_string(*i);
+    if (const auto* t = std::get_if<std::string>(&v)) want = *t;
+    if (const auto* j = std::get_if<nlohmann::json>(&v)) want = j->dump();
+    const std::string type = c.central_type;
+    const std::string sql = std::string("SELECT ") + c.central_name + " IS NULL, " +
+                            c.central_name + " = $1::" + type +
+                            " FROM tests WHERE station_id = 'st-9' AND test_id = 42";
+    const PgResult row = pg->Exec(sql, {want}, "read column " + std::string(c.central_name));
+    ASSERT_EQ(row.rows(), 1);
+    EXPECT_EQ(row.Text(0, 0), want ? "f" : "t") << c.central_name;
+    if (want) {
+      EXPECT_EQ(row.Text(0, 1), "t") << c.central_name << " is not " << *want;
+    }
+  }
 }
 
 TEST(CentralConfigTest, AConfigIsCheckedNamingTheField) {

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "db/test_columns.h"
 #include "station/daemon/central/central_schema.h"
 
 namespace eol::station::central {
@@ -43,46 +44,54 @@ void EnsureCentralSchema(PgConnection& pg) {
   }
 }
 
+namespace {
+
+// A cell of a central column of type `type` (db/test_columns.h): text valid UTF-8 without NUL,
+// an empty time NULL, JSON as its text.
+std::optional<std::string> CentralParam(const db::ColumnValue& v, std::string_view type) {
+  if (const auto* i = std::get_if<std::int64_t>(&v)) return std::to_string(*i);
+  if (const auto* j = std::get_if<nlohmann::json>(&v)) return Text(*j);
+  if (const auto* t = std::get_if<std::string>(&v)) {
+    if (type == "timestamptz") {
+      if (t->empty()) return std::nullopt;
+      return *t;
+    }
+    return Clean(*t);
+  }
+  return std::nullopt;
+}
+
+// "INSERT INTO tests (<test columns>, curves, stored_at) VALUES ($1::<type>, ...) ON CONFLICT
+// (station_id, test_id) DO NOTHING": the central columns of db/test_columns.h in list order.
+const std::string& InsertSql() {
+  static const std::string sql = [] {
+    std::string names, values;
+    int i = 0;
+    const auto add = [&](const std::string& name, const std::string& type) {
+      const std::string sep = i == 0 ? "" : ", ";
+      ++i;
+      names += sep + name;
+      values += sep + "$" + std::to_string(i) + (type == "text" ? "" : "::" + type);
+    };
+    for (const db::TestColumn& c : db::TestColumns())
+      if (c.central_name != nullptr) add(c.central_name, c.central_type);
+    add("curves", "jsonb");
+    add("stored_at", "timestamptz");
+    return "INSERT INTO tests (" + names + ") VALUES (" + values +
+           ") ON CONFLICT (station_id, test_id) DO NOTHING";
+  }();
+  return sql;
+}
+
+}  // namespace
+
 bool InsertCentral(PgConnection& pg, const db::TestRecord& r, const std::string& stored_at) {
-  nlohmann::json record = r;
-  const nlohmann::json curves = record["curves"];
-  record.erase("curves");
-  static const std::string kInsert = R"sql(
-    INSERT INTO tests (station_id, test_id, serial, outcome, started_at, finished_at, kind,
-                       recipe_id, recipe_version, recipe_sha256, software_version,
-                       operator_id, shift, order_number, retest_of, reason_code, reasons,
-                       record, curves, stored_at)
-    VALUES ($1, $2::bigint, $3, $4, $5::timestamptz, $6::timestamptz, $7, $8, $9::integer, $10,
-            $11, $12, $13, $14, $15::bigint, $16, $17::jsonb, $18::jsonb, $19::jsonb,
-            $20::timestamptz)
-    ON CONFLICT (station_id, test_id) DO NOTHING)sql";
-  const auto opt = [](const std::string& s) -> std::optional<std::string> {
-    if (s.empty()) return std::nullopt;
-    return s;
-  };
-  const PgParams params = {
-      Clean(r.station_id),
-      std::to_string(r.id),
-      Clean(r.serial),
-      std::string(analysis::ToString(r.outcome)),
-      r.started_at,
-      opt(r.finished_at),
-      std::string(db::ToString(r.kind)),
-      Clean(r.recipe_id),
-      std::to_string(r.recipe_version),
-      r.recipe_hash,
-      Clean(r.software_version),
-      Clean(r.work.operator_id),
-      Clean(r.work.shift),
-      Clean(r.work.order_number),
-      r.retest_of ? std::optional<std::string>(std::to_string(*r.retest_of)) : std::nullopt,
-      r.reasons.empty() ? std::nullopt
-                        : std::optional<std::string>(analysis::ToString(r.reasons.front().code)),
-      Text(nlohmann::json(r.reasons)),
-      Text(record),
-      Text(curves),
-      stored_at};
-  return pg.Exec(kInsert, params,
+  PgParams params;
+  for (const db::TestColumn& c : db::TestColumns())
+    if (c.central_name != nullptr) params.push_back(CentralParam(c.get(r), c.central_type));
+  params.push_back(Text(nlohmann::json(r.curves)));
+  params.push_back(stored_at);
+  return pg.Exec(InsertSql(), params,
                  "insert test " + std::to_string(r.id) + " of station '" + r.station_id + "'")
              .affected() == 1;
 }

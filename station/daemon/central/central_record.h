@@ -3,6 +3,8 @@
 // the `record` column is that JSON without curves (what MQTT publishes), and a plant-wide
 // query reads records back through the same from_json, so `eol query --central` and
 // GET /api/units/{serial}?scope=plant answer with the fields of their station-local forms.
+// The table's other columns (identity, who, what, when) are the central entries of the one
+// column list of a test (db/test_columns.h), which the INSERT is made from.
 #pragma once
 
 #include <string>

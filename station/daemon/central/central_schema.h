@@ -12,6 +12,9 @@
 //   `curves` its raw curves (JSON array of {name, unit, freq_hz, re, im, sigma}; PostgreSQL
 //   compresses such large values itself, TOAST). Times are timestamptz (UTC in the record).
 //   `retest_of` is a test id of the same station. Only stations write; nothing updates rows.
+//   The columns but curves, stored_at and replicated_at are the central entries of
+//   db/test_columns.h (names and types); tests/station/central_record_test.cc holds the two
+//   together.
 #pragma once
 
 namespace eol::station::central {
