@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 #include <stdexcept>
+#include <type_traits>
 
 #include "analysis/qc/measurement_names.h"
 #include "db/test_columns.h"
@@ -20,13 +21,14 @@ ExportValue Number(double v) {
   return v;
 }
 
-// A condition the record carries as a JSON number; empty when absent, null or not a number.
-Get Condition(const char* key) {
-  return [key](const TestRecord& r) -> ExportValue {
-    const auto it = r.conditions.find(key);
-    if (it == r.conditions.end() || !it->is_number()) return std::monostate{};
-    if (it->is_number_integer()) return it->get<std::int64_t>();
-    return Number(it->get<double>());
+// A numeric condition of the record (db/test_conditions.h); empty when unset or not finite.
+template <class T>
+Get Condition(std::optional<T> TestConditions::*field) {
+  return [field](const TestRecord& r) -> ExportValue {
+    const std::optional<T>& v = r.conditions.*field;
+    if (!v) return std::monostate{};
+    if constexpr (std::is_integral_v<T>) return static_cast<std::int64_t>(*v);
+    return Number(*v);
   };
 }
 
@@ -68,34 +70,31 @@ std::vector<ExportColumn> BaseColumns() {
   AddTestColumns(c, [](int since) { return since == 1; });
   c.push_back(Base("winding_temperature_c", T::kNumber, "degC",
                    "Winding temperature estimated from the fitted resistance",
-                   Condition("winding_temperature_c")));
+                   Condition(&TestConditions::winding_temperature_c)));
   c.push_back(Base("clamp_pressure_bar", T::kNumber, "bar", "Clamp pressure read before exciting",
-                   Condition("clamp_pressure_bar")));
+                   Condition(&TestConditions::clamp_pressure_bar)));
   c.push_back(Base("excitation_v_rms", T::kNumber, "V", "Excitation voltage, rms",
-                   Condition("excitation_v_rms")));
+                   Condition(&TestConditions::excitation_v_rms)));
   c.push_back(Base("excitation_a_rms", T::kNumber, "A", "Excitation current, rms",
-                   Condition("excitation_a_rms")));
+                   Condition(&TestConditions::excitation_a_rms)));
   c.push_back(Base("phase_pair", T::kInteger, "", "First phase pair excited: 0 U-V, 1 V-W, 2 W-U",
-                   Condition("phase_pair")));
+                   Condition(&TestConditions::phase_pair)));
   c.push_back(Base("conditions_in_window", T::kBool, "",
                    "Every judged condition was inside its recipe window; empty when the "
                    "recipe judges none",
                    [](const TestRecord& r) -> ExportValue {
-                     const auto it = r.conditions.find("conditions_in_window");
-                     if (it == r.conditions.end() || !it->is_boolean()) return std::monostate{};
-                     return it->get<bool>();
+                     if (!r.conditions.conditions_in_window) return std::monostate{};
+                     return *r.conditions.conditions_in_window;
                    }));
   c.push_back(
       Base("simulated", T::kBool, "", "true when the test ran on a simulator (never a real motor)",
            [](const TestRecord& r) -> ExportValue {
-             const auto it = r.conditions.find("simulation");
-             return it != r.conditions.end() && it->is_string() && !it->get<std::string>().empty();
+             return r.conditions.simulation.has_value() && !r.conditions.simulation->empty();
            }));
   c.push_back(Base("simulation", T::kText, "", "Why it is a simulation (empty on hardware)",
                    [](const TestRecord& r) -> ExportValue {
-                     const auto it = r.conditions.find("simulation");
-                     if (it == r.conditions.end() || !it->is_string()) return std::monostate{};
-                     return it->get<std::string>();
+                     if (!r.conditions.simulation) return std::monostate{};
+                     return *r.conditions.simulation;
                    }));
   AddTestColumns(c, [](int since) { return since > 1; });
   return c;

@@ -111,7 +111,7 @@ void from_json(const nlohmann::json& j, TestRecord& r) {
   r.outcome = j.at("outcome").get<analysis::Outcome>();
   r.reasons = j.value("reasons", std::vector<analysis::Reason>{});
   r.measurements = j.value("measurements", std::vector<analysis::Measurement>{});
-  r.conditions = j.value("conditions", nlohmann::json::object());
+  r.conditions = j.value("conditions", TestConditions{});
   r.calibration = j.value("calibration", nlohmann::json::object());
   r.fit = j.value("fit", nlohmann::json::object());
   r.curves = j.value("curves", std::vector<Curve>{});

@@ -15,6 +15,7 @@
 
 #include "analysis/qc/measurement.h"
 #include "analysis/qc/measurement_json.h"
+#include "db/test_conditions.h"
 
 namespace eol::db {
 
@@ -85,9 +86,9 @@ struct TestRecord {
   std::vector<analysis::Reason> reasons;
   std::vector<analysis::Measurement> measurements;
 
-  // Conditions and context, free-form but with unit-carrying keys:
-  // {"clamp_pressure_bar": 5.1, "phase_pair": 0, "excitation_peak_v": 2.0, ...}
-  nlohmann::json conditions = nlohmann::json::object();
+  // Conditions and context, one typed field per key with its unit (db/test_conditions.h):
+  // {"clamp_pressure_bar": 5.1, "phase_pair": 0, "excitation_peak_v": 2.0, ...} in JSON.
+  TestConditions conditions;
   nlohmann::json calibration = nlohmann::json::object();
   nlohmann::json fit = nlohmann::json::object();  // the fit summary
   std::vector<Curve> curves;

@@ -200,7 +200,7 @@ json VerdictJson(const Judgement& v) {
 json JudgeJson(const Recipe& recipe, const analysis::ImpedanceAnalysis& result,
                const analysis::Recording* recording, json& out, Judgement* judgement = nullptr) {
   const PairMeasurement pair{recipe.phase_pair, &result, recording};
-  json conditions = out.value("conditions", json::object());  // --clamp-pressure-bar
+  auto conditions = out.value("conditions", db::TestConditions{});  // --clamp-pressure-bar
   Judgement j = JudgeUnit(recipe, std::span<const PairMeasurement>(&pair, 1), conditions);
   out["conditions"] = conditions;
   json v = VerdictJson(j);
@@ -391,8 +391,11 @@ void PrintSummary(const AnalyzeArgs& a, const Inputs& inputs,
 
 int RunAnalyze(const AnalyzeArgs& a) {
   json out = {{"file", a.measured}};
-  if (a.clamp_pressure_bar > 0.0)
-    out["conditions"] = {{std::string(analysis::names::kClampPressureBar), a.clamp_pressure_bar}};
+  if (a.clamp_pressure_bar > 0.0) {
+    db::TestConditions given;
+    given.clamp_pressure_bar = a.clamp_pressure_bar;
+    out["conditions"] = given;
+  }
   Inputs inputs;
   try {
     ReadInputs(a, &inputs);

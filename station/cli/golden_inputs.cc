@@ -74,10 +74,9 @@ analysis::GoldenUnit FromAnalyzeJson(const nlohmann::json& j, const std::string&
     u.values[std::string(names::kMotionalResidueOhmPerS)] = m.ResidueOhmPerS();
   }
   // The clamp pressure `eol analyze --clamp-pressure-bar` kept (f0_pressure.h).
-  const std::string pressure(names::kClampPressureBar);
-  if (j.contains("conditions") && j.at("conditions").contains(pressure) &&
-      j.at("conditions").at(pressure).is_number())
-    u.values[pressure] = j.at("conditions").at(pressure).get<double>();
+  const auto conditions = j.value("conditions", db::TestConditions{});
+  if (conditions.clamp_pressure_bar)
+    u.values[std::string(names::kClampPressureBar)] = *conditions.clamp_pressure_bar;
   if (j.contains("fit") && j.at("fit").contains("chi2_per_dof"))
     u.values[std::string(names::kFitChi2PerDof)] = j.at("fit").at("chi2_per_dof").get<double>();
   // What only a recipe's analysis computes (second_mode_chi2_drop): from the verdict's

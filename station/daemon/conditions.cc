@@ -37,15 +37,16 @@ double RmsAfter(const std::vector<double>& x, std::size_t skip) {
 std::vector<std::string> EvaluateConditions(const ConditionWindows& w,
                                             const analysis::Recording* rec,
                                             std::size_t transient_periods,
-                                            std::optional<double> r_ohm, nlohmann::json& conditions,
+                                            std::optional<double> r_ohm,
+                                            db::TestConditions& conditions,
                                             std::vector<std::string>* not_evaluated) {
   double v_rms = std::nan(""), a_rms = std::nan("");
   if (rec) {
     const std::size_t skip = transient_periods * rec->period_samples;
     v_rms = RmsAfter(rec->voltage_v, skip);
     a_rms = RmsAfter(rec->current_a, skip);
-    conditions["excitation_v_rms"] = v_rms;  // NaN is stored as null
-    conditions["excitation_a_rms"] = a_rms;
+    conditions.excitation_v_rms = v_rms;  // NaN is stored as null
+    conditions.excitation_a_rms = a_rms;
   }
   std::vector<std::string> out;
   if (!w.enabled) return out;
@@ -62,7 +63,7 @@ std::vector<std::string> EvaluateConditions(const ConditionWindows& w,
   }
   if (w.r_ref_ohm > 0.0 && r_ohm && std::isfinite(*r_ohm)) {
     const double t_c = WindingTemperatureC(*r_ohm, w.r_ref_ohm, w.t_ref_c);
-    conditions["winding_temperature_c"] = t_c;
+    conditions.winding_temperature_c = t_c;
     std::string line = Outside("winding temperature", t_c, w.winding_temperature_c, "degC", 1);
     // No winding gets that hot or cold on a test station: the reference is another motor's.
     if (!line.empty() && (t_c < kImplausibleWindingLoC || t_c > kImplausibleWindingHiC))
@@ -72,7 +73,7 @@ std::vector<std::string> EvaluateConditions(const ConditionWindows& w,
               "eol teach relearns it from golden units)";
     check(line);
   }
-  conditions["conditions_in_window"] = out.empty();
+  conditions.conditions_in_window = out.empty();
   return out;
 }
 

@@ -25,13 +25,13 @@
 #pragma once
 
 #include <cstddef>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "analysis/qc/measurement.h"
 #include "analysis/signal/recording.h"
+#include "db/test_conditions.h"
 
 namespace eol::station {
 
@@ -61,8 +61,9 @@ double WindingTemperatureC(double r_ohm, double r_ref_ohm, double t_ref_c);
 // Root mean square of x[skip..]; NaN when nothing is left.
 double RmsAfter(const std::vector<double>& x, std::size_t skip);
 
-// Writes excitation_v_rms, excitation_a_rms and (with r_ref_ohm and a finite r_ohm)
-// winding_temperature_c into `conditions`, and returns one line per condition outside its
+// Sets excitation_v_rms, excitation_a_rms and (with r_ref_ohm and a finite r_ohm)
+// winding_temperature_c of `conditions` (db/test_conditions.h), and conditions_in_window when
+// the windows are enabled, and returns one line per condition outside its
 // window: "winding temperature 61.3 degC outside 0.0..45.0 degC". Nothing is checked when the
 // windows are not enabled. Without a recording (an FRF file judged offline) the excitation
 // levels cannot be known: they are neither written nor checked, and the name of each such
@@ -70,7 +71,8 @@ double RmsAfter(const std::vector<double>& x, std::size_t skip);
 std::vector<std::string> EvaluateConditions(const ConditionWindows& windows,
                                             const analysis::Recording* recording,
                                             std::size_t transient_periods,
-                                            std::optional<double> r_ohm, nlohmann::json& conditions,
+                                            std::optional<double> r_ohm,
+                                            db::TestConditions& conditions,
                                             std::vector<std::string>* not_evaluated = nullptr);
 
 }  // namespace eol::station

@@ -24,8 +24,9 @@ struct PairJudgement {
   std::vector<Reason> reasons;
 };
 
-PairJudgement JudgePair(const Recipe& recipe, const PairMeasurement& p, nlohmann::json& conditions,
-                        bool& conditions_in_window, std::vector<std::string>& not_evaluated) {
+PairJudgement JudgePair(const Recipe& recipe, const PairMeasurement& p,
+                        db::TestConditions& conditions, bool& conditions_in_window,
+                        std::vector<std::string>& not_evaluated) {
   const analysis::ImpedanceAnalysis& a = *p.analysis;
   PairJudgement j;
   if (!a.usable) {
@@ -34,10 +35,7 @@ PairJudgement JudgePair(const Recipe& recipe, const PairMeasurement& p, nlohmann
     return j;
   }
   std::map<std::string, analysis::Estimate> values = a.values;
-  std::optional<double> clamp_pressure_bar;
-  if (const auto it = conditions.find(std::string(analysis::names::kClampPressureBar));
-      it != conditions.end() && it->is_number())
-    clamp_pressure_bar = it->get<double>();
+  const std::optional<double> clamp_pressure_bar = conditions.clamp_pressure_bar;
   if (recipe.f0_pressure)
     analysis::AddF0AtRefPressure(values, clamp_pressure_bar, *recipe.f0_pressure);
   if (recipe.bond_index) analysis::AddBondIndex(values, *recipe.bond_index);  // may weigh it
@@ -107,7 +105,7 @@ const char* PairName(drivers::PhasePair pair) {
 }
 
 Judgement JudgeUnit(const Recipe& recipe, std::span<const PairMeasurement> pairs,
-                    nlohmann::json& conditions) {
+                    db::TestConditions& conditions) {
   if (pairs.empty()) throw std::logic_error("JudgeUnit: no phase pair to judge");
   Judgement out;
   bool in_window = true;
@@ -126,7 +124,7 @@ Judgement JudgeUnit(const Recipe& recipe, std::span<const PairMeasurement> pairs
     }
     for (Reason& r : j.reasons) out.reasons.push_back({r.code, prefix + r.text});
   }
-  if (recipe.conditions.enabled) conditions["conditions_in_window"] = in_window;
+  if (recipe.conditions.enabled) conditions.conditions_in_window = in_window;
   return out;
 }
 

@@ -36,7 +36,6 @@
 // temperature, estimated from the fitted R, is still judged).
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
 #include <vector>
@@ -44,6 +43,7 @@
 #include "analysis/impedance_analysis.h"
 #include "analysis/qc/measurement.h"
 #include "analysis/signal/recording.h"
+#include "db/test_conditions.h"
 #include "drivers/fixture/fixture.h"
 #include "station/daemon/recipe.h"
 
@@ -66,11 +66,12 @@ struct Judgement {
   std::vector<std::string> conditions_not_evaluated;  // condition names, see above
 };
 
-// Judges the unit. `pairs` must not be empty (a programmer error otherwise). Writes each
-// pair's evaluated conditions into `conditions` (station/daemon/conditions.h; a later pair
-// overwrites an earlier one's values) and "conditions_in_window" true only when every pair's
-// conditions were inside their windows.
+// Judges the unit. `pairs` must not be empty (a programmer error otherwise). Reads
+// conditions.clamp_pressure_bar; writes each pair's evaluated conditions into `conditions`
+// (station/daemon/conditions.h; a later pair overwrites an earlier one's values) and, when the
+// recipe has a "conditions" section, conditions_in_window true only when every pair's conditions
+// were inside their windows.
 Judgement JudgeUnit(const Recipe& recipe, std::span<const PairMeasurement> pairs,
-                    nlohmann::json& conditions);
+                    db::TestConditions& conditions);
 
 }  // namespace eol::station

@@ -273,9 +273,8 @@ analysis::GoldenUnit GoldenFromRecord(const db::TestRecord& r, const std::string
   u.label = label;
   for (const analysis::Measurement& m : r.measurements) u.values[m.name] = m.value;
   // The clamp pressure read at clamp confirmation (f0_pressure.h).
-  const std::string pressure(analysis::names::kClampPressureBar);
-  if (r.conditions.contains(pressure) && r.conditions.at(pressure).is_number())
-    u.values[pressure] = r.conditions.at(pressure).get<double>();
+  if (r.conditions.clamp_pressure_bar)
+    u.values[std::string(analysis::names::kClampPressureBar)] = *r.conditions.clamp_pressure_bar;
   for (const db::Curve& c : r.curves) {
     if (c.name != "impedance") continue;
     u.curve.freq_hz = c.freq_hz;

@@ -230,8 +230,8 @@ void Sequencer::ClampAndConfirm(db::TestRecord& record) {
            std::string(why.cause)}};
     options_.clock.Sleep(poll);
   }
-  record.conditions["clamp_pressure_bar"] = in.clamp_pressure_bar;
-  record.conditions["phase_pair"] = static_cast<int>(recipe_->phase_pair);
+  record.conditions.clamp_pressure_bar = in.clamp_pressure_bar;
+  record.conditions.phase_pair = static_cast<int>(recipe_->phase_pair);
 }
 
 analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size_t periods) {
@@ -252,10 +252,11 @@ analysis::Recording Sequencer::ExciteAndRecord(db::TestRecord& record, std::size
   req.sample_rate_hz = excitation_.sample_rate_hz;
   req.period_samples = excitation_.period_samples;
   req.excitation_v = excitation_.Repeat(periods);
-  record.conditions["excitation_peak_v"] = recipe_->excitation.peak_v;
-  record.conditions["crest_factor"] = excitation_.crest_factor;
-  record.conditions["line_spacing_hz"] = excitation_.line_spacing_hz;
-  record.conditions["sample_rate_hz"] = excitation_.sample_rate_hz;
+  db::TestConditions& c = record.conditions;
+  c.excitation_peak_v = recipe_->excitation.peak_v;
+  c.crest_factor = excitation_.crest_factor;
+  c.line_spacing_hz = excitation_.line_spacing_hz;
+  c.sample_rate_hz = excitation_.sample_rate_hz;
 
   std::optional<drivers::StatusOr<analysis::Recording>> result;
   std::optional<std::string> watchdog_fault;
@@ -359,7 +360,7 @@ std::vector<Sequencer::MeasuredPair> Sequencer::MeasurePairs(db::TestRecord& rec
       const Clock::time_point to = std::min(measured[k].analysis_end, excited[later].second);
       if (to > from) hidden_s += std::chrono::duration<double>(to - from).count();
     }
-  if (pending.size() > 1) record.conditions["analysis_overlapped_s"] = hidden_s;
+  if (pending.size() > 1) record.conditions.analysis_overlapped_s = hidden_s;
 
   // Extensions only while every pair is usable (else the verdict is ERROR already).
   bool extend = recipe_->sequential.has_value() &&
@@ -374,7 +375,7 @@ std::vector<Sequencer::MeasuredPair> Sequencer::MeasurePairs(db::TestRecord& rec
     }
     const analysis::ImpedanceAnalysis& a = m.analysis;
     if (a.frf.frf.size() > 0) record.curves.push_back(ToCurve(a.frf.frf, "impedance" + suffix));
-    record.conditions["periods_used"] = a.frf.periods_used;
+    record.conditions.periods_used = a.frf.periods_used;
     if (!a.fit.params.empty()) {
       if (k == 0) record.fit = a.fit;  // analysis/fit/fit_json.h
       record.curves.push_back(ToCurve(a.fit.Model().Evaluate(a.frf.frf.freq_hz), "model" + suffix));
@@ -388,10 +389,10 @@ void Sequencer::ExtendWhileUndecided(db::TestRecord& record, drivers::PhasePair 
                                      analysis::ImpedanceAnalysis& a) {
   const SequentialPolicy& policy = *recipe_->sequential;
   int looks = 1;
-  nlohmann::json undecided_seen = nlohmann::json::array();
+  std::vector<std::string> undecided_seen;
   for (int extension = 0; extension < policy.max_extensions && a.usable; ++extension) {
     // The one judge on this pair alone; its conditions are not kept (the verdict's are).
-    nlohmann::json scratch = record.conditions;
+    db::TestConditions scratch = record.conditions;
     const PairMeasurement m{pair, &a, &recording};
     const Judgement j = JudgeUnit(*recipe_, std::span<const PairMeasurement>(&m, 1), scratch);
     const std::vector<std::string> undecided =
@@ -419,8 +420,9 @@ void Sequencer::ExtendWhileUndecided(db::TestRecord& record, drivers::PhasePair 
     a = analysis::AnalyzeImpedance(frf.frf, recipe_->analysis.fit);
     a.frf = std::move(frf);
   }
-  record.conditions["looks" + suffix] = looks;
-  if (!undecided_seen.empty()) record.conditions["undecided" + suffix] = undecided_seen;
+  db::PairLooks& kept = record.conditions.looks[suffix];
+  kept.looks = looks;
+  if (!undecided_seen.empty()) kept.undecided = std::move(undecided_seen);
 }
 
 // From the check right before the relay closed through the watchdog's reads (a very short
@@ -433,12 +435,11 @@ void Sequencer::RecordWatchdog(db::TestRecord& record, const ExcitationWatchdog&
     p_min = std::min(p_min, range->first);
     p_max = std::max(p_max, range->second);
   }
-  record.conditions["clamp_pressure_min_bar"] = p_min;
-  record.conditions["clamp_pressure_max_bar"] = p_max;
+  db::TestConditions& c = record.conditions;
+  c.clamp_pressure_min_bar = p_min;
+  c.clamp_pressure_max_bar = p_max;
   const double gap = watchdog.max_gap_ms();
-  const auto& before = record.conditions["watchdog_max_gap_ms"];
-  record.conditions["watchdog_max_gap_ms"] =
-      before.is_number() ? std::max(before.get<double>(), gap) : gap;
+  c.watchdog_max_gap_ms = c.watchdog_max_gap_ms ? std::max(*c.watchdog_max_gap_ms, gap) : gap;
 }
 
 void Sequencer::Judge(db::TestRecord& record, const std::vector<MeasuredPair>& measured) {
@@ -596,10 +597,10 @@ db::TestRecord Sequencer::RunTest(const std::string& serial, const db::WorkConte
   record.software_version = SoftwareVersion();
   record.started_at = db::UtcIso8601(options_.clock.wall());
   record.outcome = analysis::Outcome::kError;
-  if (!options_.simulation.empty()) record.conditions["simulation"] = options_.simulation;
+  if (!options_.simulation.empty()) record.conditions.simulation = options_.simulation;
   if (!variant_.empty()) {
-    record.conditions["variant"] = variant_;
-    record.conditions["variant_by"] = variant_by_;
+    record.conditions.variant = variant_;
+    record.conditions.variant_by = variant_by_;
   }
   Enter(record, SeqState::kWaitSerial, "serial " + serial + " received");
   const std::optional<std::string> master = MasterRole(options_.self_check, serial);

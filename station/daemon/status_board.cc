@@ -25,9 +25,8 @@ nlohmann::json RecordSummary(const db::TestRecord& r) {
        {{"id", r.recipe_id},
         {"version", r.recipe_version},
         {"hash", r.recipe_hash},
-        {"variant", r.conditions.is_object() && r.conditions.contains("variant")
-                        ? r.conditions["variant"]
-                        : nlohmann::json()}}}};
+        {"variant",
+         r.conditions.variant ? nlohmann::json(*r.conditions.variant) : nlohmann::json()}}}};
 }
 
 void VerdictCounts::Add(analysis::Outcome outcome) {

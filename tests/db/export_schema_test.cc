@@ -23,10 +23,14 @@ TestRecord Pass() {
   r.recipe_id = "pmsm-10pole";
   r.recipe_version = 3;
   r.recipe_hash = std::string(64, 'b');
-  r.conditions = {{"clamp_pressure_bar", 5.25},       {"phase_pair", 0},
-                  {"winding_temperature_c", 23.5},    {"excitation_v_rms", 1.3},
-                  {"excitation_a_rms", nullptr},      {"conditions_in_window", true},
-                  {"simulation", "simulated fixture"}};
+  TestConditions& c = r.conditions;
+  c.clamp_pressure_bar = 5.25;
+  c.phase_pair = 0;
+  c.excitation_v_rms = 1.3;
+  c.excitation_a_rms = std::nan("");  // stored as null
+  c.winding_temperature_c = 23.5;
+  c.conditions_in_window = true;
+  c.simulation = "simulated fixture";
   analysis::Measurement m;
   m.name = "resonance_f_hz";
   m.unit = "Hz";

@@ -116,7 +116,10 @@ TestRecord MakeFullRecord(const std::string& serial, const std::string& started_
       Meas("insulation_r_ohm", 2.5e9, kNaN, 1e8, std::nullopt, MeasurementOutcome::kPass),
       Meas("damping", 0.01, kNaN, std::nullopt, std::nullopt, MeasurementOutcome::kUnset),
   };
-  r.conditions = {{"clamp_pressure_bar", 5.1}, {"phase_pair", 0}, {"excitation_peak_v", 2.0}};
+  r.conditions.clamp_pressure_bar = 5.1;
+  r.conditions.phase_pair = 0;
+  r.conditions.excitation_peak_v = 2.0;
+  r.conditions.extra = {{"humidity_pct", 41.5}};  // a key of another version: kept
   r.calibration = {{"shunt_ohm", 0.1}, {"date", "2024-04-30"}};
   r.fit = {{"termination", "CONVERGENCE"}, {"iterations", 12}, {"usable", true}};
   Curve z{"impedance",         "ohm", {10.0, 100.0, 1000.0}, {1.5, 1.25, 0.1}, {0.01, 0.5, 2.0},

@@ -40,7 +40,7 @@ nlohmann::json TeachFromLine(const eol::testing::TempDir& dir, const std::string
     const db::TestRecord r = s.RunTest(serial);
     if (r.outcome != analysis::Outcome::kPass) continue;
     golden.push_back(serial);
-    pressures.push_back(r.conditions.at("clamp_pressure_bar").get<double>());
+    pressures.push_back(r.conditions.clamp_pressure_bar.value());
   }
   EXPECT_GE(golden.size(), 31u);
   double lo = 1e9, hi = 0.0;

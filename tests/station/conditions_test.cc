@@ -82,21 +82,22 @@ TEST_F(ConditionsTest, InWindowPassesAndRecordsEveryCondition) {
   ASSERT_EQ(r.outcome, Outcome::kPass) << Reasons(r);
   const auto stored = store_->Test(r.id, false);
   ASSERT_TRUE(stored);
-  const nlohmann::json& c = stored->conditions;
+  const db::TestConditions& c = stored->conditions;
   // Temperature from the fitted R against the simulator's true R (fit error << 1 K).
   const double truth_c = WindingTemperatureC(unit_.r_ohm, 0.5, 20.0);
-  EXPECT_NEAR(c.at("winding_temperature_c").get<double>(), truth_c, 1.0);
+  EXPECT_NEAR(c.winding_temperature_c.value(), truth_c, 1.0);
   // The level the motor saw: the multisine's rms is its peak over its crest factor.
-  const double v_rms = c.at("excitation_v_rms").get<double>();
-  EXPECT_NEAR(v_rms, recipe_->excitation.peak_v / c.at("crest_factor").get<double>(), 0.02 * v_rms);
-  EXPECT_GT(c.at("excitation_a_rms").get<double>(), 0.0);
+  const double v_rms = c.excitation_v_rms.value();
+  EXPECT_NEAR(v_rms, recipe_->excitation.peak_v / c.crest_factor.value(), 0.02 * v_rms);
+  EXPECT_GT(c.excitation_a_rms.value(), 0.0);
   // Pressure read at confirmation and through the excitation, inside the recipe's window.
-  for (const char* key :
-       {"clamp_pressure_bar", "clamp_pressure_min_bar", "clamp_pressure_max_bar"}) {
-    EXPECT_GE(c.at(key).get<double>(), recipe_->clamp_pressure_lo_bar) << key;
-    EXPECT_LE(c.at(key).get<double>(), recipe_->clamp_pressure_hi_bar) << key;
+  for (const std::optional<double>& p :
+       {c.clamp_pressure_bar, c.clamp_pressure_min_bar, c.clamp_pressure_max_bar}) {
+    ASSERT_TRUE(p.has_value());
+    EXPECT_GE(*p, recipe_->clamp_pressure_lo_bar);
+    EXPECT_LE(*p, recipe_->clamp_pressure_hi_bar);
   }
-  EXPECT_EQ(c.at("conditions_in_window"), true);
+  EXPECT_EQ(c.conditions_in_window, true);
 }
 
 TEST_F(ConditionsTest, HotWindingIsAnErrorNotAPassAndNotAFail) {
@@ -112,7 +113,7 @@ TEST_F(ConditionsTest, HotWindingIsAnErrorNotAPassAndNotAFail) {
   const auto stored = store_->Test(r.id, false);
   ASSERT_TRUE(stored);
   EXPECT_EQ(stored->outcome, Outcome::kError);
-  EXPECT_EQ(stored->conditions.at("conditions_in_window"), false);
+  EXPECT_EQ(stored->conditions.conditions_in_window, false);
   // The measurements are kept for the audit: R itself was inside its limits.
   for (const auto& m : stored->measurements)
     if (m.name == analysis::names::kWindingROhm) {
@@ -137,8 +138,8 @@ TEST_F(ConditionsTest, RecordPolicyKeepsTheVerdictAndRecordsTheExcursion) {
   const db::TestRecord r = Test("COND-REC", 60.0);
   EXPECT_EQ(r.outcome, Outcome::kPass) << Reasons(r);
   const auto stored = store_->Test(r.id, false);
-  EXPECT_EQ(stored->conditions.at("conditions_in_window"), false);
-  EXPECT_NEAR(stored->conditions.at("winding_temperature_c").get<double>(), 60.0, 1.0);
+  EXPECT_EQ(stored->conditions.conditions_in_window, false);
+  EXPECT_NEAR(stored->conditions.winding_temperature_c.value(), 60.0, 1.0);
 }
 
 TEST(ConditionsRecipe, InvalidSectionsNameThePathAndTheRule) {

@@ -54,13 +54,15 @@ TEST(DemoEndToEnd, FastDesignedRecipeKeepsTheVerdicts) {
   for (const auto& serial : s["serials"]) {
     const auto tests = store->TestsOfSerial(serial.get<std::string>());
     ASSERT_EQ(tests.size(), 1u) << serial;
-    const nlohmann::json& c = tests.front().conditions;
-    const int looks = c.value("looks", 0);
+    const db::TestConditions& c = tests.front().conditions;
+    ASSERT_TRUE(c.looks.contains("")) << serial << " " << nlohmann::json(c).dump();
+    const int looks = c.looks.at("").looks.value_or(0);
     EXPECT_GE(looks, 1) << serial;
     EXPECT_LE(looks, 3) << serial;
-    EXPECT_EQ(looks > 1, c.contains("undecided")) << serial << " " << c.dump();
+    EXPECT_EQ(looks > 1, c.looks.at("").undecided.has_value())
+        << serial << " " << nlohmann::json(c).dump();
     one_look += looks == 1;
-    EXPECT_NEAR(c.value("excitation_peak_v", 0.0), peak_v, 1e-9);
+    EXPECT_NEAR(c.excitation_peak_v.value_or(0.0), peak_v, 1e-9);
   }
   EXPECT_GE(one_look, 20) << "most units are decided on their first look";
 }

@@ -87,7 +87,7 @@ class JudgeParityTest : public ::testing::Test {
                                      "--measured", recording,  "--json"};
     if (with_pressure) {
       args.push_back("--clamp-pressure-bar");
-      args.push_back(station.conditions.at("clamp_pressure_bar").dump());
+      args.push_back(nlohmann::json(station.conditions.clamp_pressure_bar.value()).dump());
     }
     const auto cli = RunEol(args, false, 120s);
     EXPECT_EQ(cli.code, exit_code) << cli.out;  // 0: analysed, whatever the verdict
@@ -114,10 +114,11 @@ class JudgeParityTest : public ::testing::Test {
         EXPECT_EQ(ms[i].at("value").get<double>(), m.value) << name << " " << m.name;
       }
     }
-    // The conditions the judge computed from the recording agree too.
+    // The conditions the judge computed from the recording agree too, in the record's JSON.
+    const nlohmann::json conditions = station.conditions;
     for (const char* key : {"excitation_v_rms", "excitation_a_rms", "winding_temperature_c"})
-      if (station.conditions.contains(key)) {
-        EXPECT_EQ(offline.at("conditions").at(key), station.conditions.at(key)) << key;
+      if (conditions.contains(key)) {
+        EXPECT_EQ(offline.at("conditions").at(key), conditions.at(key)) << key;
       }
     return station;
   }
@@ -199,7 +200,7 @@ TEST_F(JudgeParityTest, FailByPressureNormalisedResonance) {
   j["limits"].push_back({{"name", "resonance_f_ref_pressure_hz"}, {"unit", "Hz"}, {"lo", 370.0}});
   const db::TestRecord pass = JudgeBothWays("pressure-pass", j, true);
   EXPECT_EQ(pass.outcome, Outcome::kPass) << nlohmann::json(pass.reasons).dump();
-  const double p = pass.conditions.at("clamp_pressure_bar").get<double>();
+  const double p = pass.conditions.clamp_pressure_bar.value();
   double f0 = 0.0, f0p = 0.0;
   for (const analysis::Measurement& m : pass.measurements) {
     if (m.name == "resonance_f_hz") f0 = m.value;

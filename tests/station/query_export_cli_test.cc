@@ -238,7 +238,8 @@ TEST_F(QueryExportTest, CsvReadByPythonRoundTripsValuesLimitsOutcomesAndText) {
     auto r = Record("SN-3", "2026-11-21T10:00:00.000Z", analysis::Outcome::kFail, 361.123456789);
     r.reasons.front().text = "line one, with a comma\nline two \"quoted\"";
     r.work = {"op, 1", "A", "PO-\"7\""};
-    r.conditions = {{"clamp_pressure_bar", 5.1}, {"winding_temperature_c", 24.25}};
+    r.conditions.clamp_pressure_bar = 5.1;
+    r.conditions.winding_temperature_c = 24.25;
     store->Insert(r);
   }
   const std::string csv = dir_ / "out.csv";

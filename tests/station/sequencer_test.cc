@@ -327,8 +327,8 @@ TEST_F(SequencerTest, EachPairIsAnalysedWhileTheNextIsExcited) {
       << (three.reasons.empty() ? "" : three.reasons.front().text);
   EXPECT_EQ(excite_and_analyse(three),
             (std::vector<std::string>{"excite", "excite", "excite", "analyse"}));
-  ASSERT_TRUE(three.conditions.contains("analysis_overlapped_s"));
-  EXPECT_GT(three.conditions["analysis_overlapped_s"].get<double>(), 0.0);
+  ASSERT_TRUE(three.conditions.analysis_overlapped_s.has_value());
+  EXPECT_GT(*three.conditions.analysis_overlapped_s, 0.0);
   EXPECT_EQ(three.measurements.size(), 3 * recipe_.Specs().size());
   const auto stored = store_->Test(three.id);
   ASSERT_TRUE(stored.has_value());
@@ -342,7 +342,7 @@ TEST_F(SequencerTest, EachPairIsAnalysedWhileTheNextIsExcited) {
   const db::TestRecord one = Test("OVERLAP-1", false);
   EXPECT_EQ(one.outcome, Outcome::kPass) << (one.reasons.empty() ? "" : one.reasons.front().text);
   EXPECT_EQ(excite_and_analyse(one), (std::vector<std::string>{"excite", "analyse"}));
-  EXPECT_FALSE(one.conditions.contains("analysis_overlapped_s"));
+  EXPECT_FALSE(one.conditions.analysis_overlapped_s.has_value());
 }
 
 // A sequential recipe with three pairs: the first looks come back to back, then each pair still
@@ -357,8 +357,14 @@ TEST_F(SequencerTest, UndecidedPairsAreSelectedAgainForTheirExtension) {
   Rebuild();
   const db::TestRecord r = Test("SEQ-PAIRS", false);
   EXPECT_EQ(r.outcome, Outcome::kPass) << (r.reasons.empty() ? "" : r.reasons.front().text);
-  for (const char* looks : {"looks", "looks@V-W", "looks@W-U"})
-    EXPECT_EQ(r.conditions.value(looks, 0), 2) << looks;
+  ASSERT_EQ(r.conditions.looks.size(), 3u);
+  for (const char* pair : {"", "@V-W", "@W-U"}) {
+    ASSERT_TRUE(r.conditions.looks.contains(pair)) << pair;
+    EXPECT_EQ(r.conditions.looks.at(pair).looks, 2) << pair;
+  }
+  // Written under the keys the records have always had.
+  const nlohmann::json j = r.conditions;
+  for (const char* key : {"looks", "looks@V-W", "looks@W-U"}) EXPECT_EQ(j.value(key, 0), 2) << key;
   // Pair switches and excitations in order: 0 (clamping), 1, 2, then 0, 1, 2 again.
   std::vector<std::string> steps;
   for (const auto& t : r.trace) {
@@ -391,8 +397,9 @@ TEST_F(SequencerTest, SequentialRecipeExtendsOnlyUndecidedUnits) {
   Rebuild();
   const db::TestRecord far = Test("SEQ-1", false);
   EXPECT_EQ(far.outcome, Outcome::kPass) << (far.reasons.empty() ? "" : far.reasons[0].text);
-  EXPECT_EQ(far.conditions.value("looks", 0), 1);
-  EXPECT_FALSE(far.conditions.contains("undecided"));
+  ASSERT_TRUE(far.conditions.looks.contains(""));
+  EXPECT_EQ(far.conditions.looks.at("").looks, 1);
+  EXPECT_FALSE(far.conditions.looks.at("").undecided.has_value());
   EXPECT_EQ(excitations(far), 1);
 
   for (auto& spec : recipe_.limits)
@@ -400,9 +407,11 @@ TEST_F(SequencerTest, SequentialRecipeExtendsOnlyUndecidedUnits) {
   Rebuild();
   const db::TestRecord near = Test("SEQ-1", false);
   EXPECT_EQ(near.outcome, Outcome::kPass) << (near.reasons.empty() ? "" : near.reasons[0].text);
-  EXPECT_EQ(near.conditions.value("looks", 0), 2);
-  ASSERT_TRUE(near.conditions.contains("undecided"));
-  EXPECT_EQ(near.conditions["undecided"][0], analysis::names::kResonanceFHz);
+  ASSERT_TRUE(near.conditions.looks.contains(""));
+  const db::PairLooks& looks = near.conditions.looks.at("");
+  EXPECT_EQ(looks.looks, 2);
+  ASSERT_TRUE(looks.undecided.has_value() && !looks.undecided->empty());
+  EXPECT_EQ(looks.undecided->front(), analysis::names::kResonanceFHz);
   EXPECT_EQ(excitations(near), 2);
   // 4 + 7 averaged periods against 4: sigma(f0) about sqrt(4 / 11) = 0.6 of the first look's.
   EXPECT_LT(f0_of(near).sigma, 0.8 * f0_of(far).sigma);

@@ -41,10 +41,10 @@ TEST(StationDefaults, SimulatorsAreMarkedOnTheBoardAndInEveryRecord) {
   EXPECT_TRUE(s.ready());
   EXPECT_EQ(s.board().Snapshot()["simulation"], "fixture driver 'sim', daq driver 'sim'");
   const db::TestRecord r = s.RunTest("SIM-1");
-  ASSERT_TRUE(r.conditions.contains("simulation")) << r.conditions.dump();
+  ASSERT_TRUE(r.conditions.simulation.has_value()) << nlohmann::json(r.conditions).dump();
   const auto stored = s.store().Test(r.id);
   ASSERT_TRUE(stored.has_value());
-  EXPECT_EQ(stored->conditions.value("simulation", ""), "fixture driver 'sim', daq driver 'sim'");
+  EXPECT_EQ(stored->conditions.simulation, "fixture driver 'sim', daq driver 'sim'");
 }
 
 TEST(StationDefaults, NotReadyUntilTheFixtureAnswers) {

@@ -370,16 +370,16 @@ TEST_F(TwoRecipeStation, EachUnitIsTestedAndRecordedWithItsOwnRecipeOverHttp) {
   EXPECT_EQ(a.recipe_id, "pmsm-8pole-heavy");
   EXPECT_EQ(a.recipe_version, eight.version);
   EXPECT_EQ(a.recipe_hash, eight.hash) << "the approved copy, not the shipped proposal";
-  EXPECT_EQ(a.conditions["variant"], "P8H");
-  EXPECT_EQ(a.conditions["variant_by"], "prefix 'P8H-'");
+  EXPECT_EQ(a.conditions.variant, "P8H");
+  EXPECT_EQ(a.conditions.variant_by, "prefix 'P8H-'");
   const db::TestRecord b = by_serial("P10-0001");
   EXPECT_EQ(b.recipe_id, "pmsm-10pole");
   EXPECT_EQ(b.recipe_hash, ten.hash);
-  EXPECT_EQ(b.conditions["variant"], "P10");
+  EXPECT_EQ(b.conditions.variant, "P10");
   EXPECT_EQ(b.outcome, analysis::Outcome::kPass) << "the sim's good rotor with its own recipe";
   const db::TestRecord c = by_serial("ANY-7");
   EXPECT_EQ(c.recipe_hash, eight.hash);
-  EXPECT_EQ(c.conditions["variant_by"], "operator");
+  EXPECT_EQ(c.conditions.variant_by, "operator");
 
   // The API: the verdict names the recipe and variant; the variants with their recipes. The
   // verdict is published just after it is stored: the status shows ANY-8 a moment later.
@@ -439,10 +439,10 @@ TEST_F(TwoRecipeStation, ThePlcsVariantRegisterPicksTheRecipeAndAnUnknownOneStar
   EXPECT_EQ(stored[1].serial, "Q-1");
   EXPECT_EQ(stored[1].recipe_id, "pmsm-8pole-heavy");
   EXPECT_EQ(stored[1].recipe_hash, LoadRecipe(eight_pole_).hash);
-  EXPECT_EQ(stored[1].conditions["variant_by"], "plc code 2");
+  EXPECT_EQ(stored[1].conditions.variant_by, "plc code 2");
   EXPECT_EQ(stored[0].serial, "P10-1");
   EXPECT_EQ(stored[0].recipe_id, "pmsm-10pole");
-  EXPECT_EQ(stored[0].conditions["variant_by"], "prefix 'P10-'");
+  EXPECT_EQ(stored[0].conditions.variant_by, "prefix 'P10-'");
 }
 
 // A station of one recipe (the config of before): unchanged, and it refuses a request naming
@@ -469,7 +469,8 @@ TEST(OneRecipeStation, RefusesAnotherVariantAndKeepsItsRecipe) {
   EXPECT_EQ(refusal, VariantRefusal::kUnknown);
   const db::TestRecord r = station.RunTest("SN-1");
   EXPECT_EQ(r.recipe_id, "pmsm-10pole");
-  EXPECT_FALSE(r.conditions.contains("variant")) << "no variant keys on a one-recipe station";
+  EXPECT_FALSE(r.conditions.variant || r.conditions.variant_by)
+      << "no variant keys on a one-recipe station";
   EXPECT_EQ(station.VariantsJson()["variants"], nlohmann::json::array());
 }
 

@@ -153,12 +153,12 @@ TEST_F(WatchdogTest, StallOfTheWatchdogIsErrorNeverPassAndLeavesItsGapInTheRecor
   ASSERT_EQ(r.outcome, Outcome::kError) << FirstReason(r);
   EXPECT_NE(FirstReason(r).find("watchdog stalled"), std::string::npos) << FirstReason(r);
   EXPECT_NE(FirstReason(r).find("(limit 100 ms"), std::string::npos) << FirstReason(r);
-  ASSERT_TRUE(r.conditions.contains("watchdog_max_gap_ms"));
-  EXPECT_GE(r.conditions["watchdog_max_gap_ms"].get<double>(), 1400.0);
+  ASSERT_TRUE(r.conditions.watchdog_max_gap_ms.has_value());
+  EXPECT_GE(*r.conditions.watchdog_max_gap_ms, 1400.0);
   const auto stored = store_->Test(r.id);
   ASSERT_TRUE(stored);
   EXPECT_EQ(stored->outcome, Outcome::kError);
-  EXPECT_GE(stored->conditions["watchdog_max_gap_ms"].get<double>(), 1400.0);
+  EXPECT_GE(stored->conditions.watchdog_max_gap_ms.value(), 1400.0);
   // The controller, not the station, opened the relay: within the alive timeout (250 ms)
   // of the last alive change, which came at most one alive period before the stall.
   ASSERT_TRUE(fixture_->stalled_at() && bench_->last_excitation_off());
@@ -176,9 +176,9 @@ TEST_F(WatchdogTest, HealthyRunRecordsItsLongestGapBelowTheLimit) {
   Build();
   const db::TestRecord r = Test("GAP-OK");
   ASSERT_EQ(r.outcome, Outcome::kPass) << FirstReason(r);
-  ASSERT_TRUE(r.conditions.contains("watchdog_max_gap_ms"));
-  EXPECT_LT(r.conditions["watchdog_max_gap_ms"].get<double>(), 100.0);
-  EXPECT_GT(r.conditions["watchdog_max_gap_ms"].get<double>(), 0.0);
+  ASSERT_TRUE(r.conditions.watchdog_max_gap_ms.has_value());
+  EXPECT_LT(*r.conditions.watchdog_max_gap_ms, 100.0);
+  EXPECT_GT(*r.conditions.watchdog_max_gap_ms, 0.0);
 }
 
 // A door that opens for 10 ms between two reads 50 ms apart: without the controller's
