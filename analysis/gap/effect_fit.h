@@ -230,6 +230,12 @@ class EffectFitter {
   LineMask Thinned(const LineMask& mask, long step) const;
   std::vector<Start> Screened(std::vector<Start> starts, const LineMask& coarse,
                               int max_iterations) const;
+  // FitKinds' starts for a pair: the seeds together, and each kind's starts on top of the other
+  // kinds' seeds (at the other's nominal; a mode-moving kind also with f0 back at the
+  // simulation's, "Starting values" above).
+  std::vector<Start> PairStarts(const std::vector<EffectKind>& kinds,
+                                const std::vector<AppliedEffect>& seeds, const LineMask& scan,
+                                const std::vector<NominalNetwork>& seed_nominals) const;
   double CostAt(const NominalNetwork& at, std::span<const AppliedEffect> effects,
                 const LineMask& mask) const;
   std::vector<std::vector<double>> StartsAt(EffectKind kind, std::span<const AppliedEffect> base,
