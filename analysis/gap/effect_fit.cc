@@ -990,6 +990,71 @@ EffectFit EffectFitter::FitWithNominal(const NominalNetwork& nominal,
   return out;
 }
 
+namespace {
+
+// The effects that move the first mode itself (a softer support, a loaded rotor, a creeping
+// bond): what the stiffness and inertia calibration also does, so it may have taken them up.
+bool LowersTheMode(EffectKind kind) {
+  return kind == EffectKind::kFixtureCompliance || kind == EffectKind::kCoupledInertia ||
+         kind == EffectKind::kAdhesiveCreep;
+}
+
+}  // namespace
+
+std::vector<EffectFitter::Start> EffectFitter::PairStarts(
+    const std::vector<EffectKind>& kinds, const std::vector<AppliedEffect>& seeds,
+    const LineMask& scan, const std::vector<NominalNetwork>& seed_nominals) const {
+  std::vector<Start> starts;
+  auto sorted = [](std::vector<AppliedEffect> v) {
+    std::sort(v.begin(), v.end(),
+              [](const AppliedEffect& a, const AppliedEffect& b) { return a.kind < b.kind; });
+    return v;
+  };
+  auto seed_nominal = [&](std::size_t i) {
+    return i < seed_nominals.size() ? seed_nominals[i] : start_nominal_;
+  };
+  // Each kind's starts on top of the other kinds' seeds (at the other's nominal), and all
+  // the seeds together (at each seed's nominal).
+  for (std::size_t i = 0; i < std::max<std::size_t>(1, seed_nominals.size()); ++i)
+    starts.push_back({seed_nominal(i), sorted(seeds)});
+  for (std::size_t i = 0; i < kinds.size(); ++i) {
+    std::vector<AppliedEffect> others;
+    std::size_t other = 0;
+    for (std::size_t j = 0; j < seeds.size(); ++j)
+      if (j != i) {
+        others.push_back(seeds[j]);
+        other = j;
+      }
+    const NominalNetwork at = seed_nominal(other);
+    for (auto& p : StartsAt(kinds[i], others, scan, at)) {
+      std::vector<AppliedEffect> s = others;
+      s.push_back({kinds[i], p});
+      starts.push_back({at, sorted(s)});
+    }
+    // As for a single, the other's calibration may have taken up this kind's shift of the
+    // mode: beside a delay, the delay's nominal has the stiffness at -3 tolerances for a
+    // fixture spring, where the grid finds only a stiff, lossy spring on top (case-002 of
+    // the independent tolerance cases: loss factor 0.32, rejected; adhesive_creep named).
+    // This kind's starts are also taken at that nominal with f0 back at the simulation's,
+    // where a mode-lowering effect is the whole shift again; the rest of the calibration
+    // (R, L, the peak) stays, so the start grid scores the mode, not the tolerances.
+    // (From the simulation's nominal itself the grid's best is a mode pushed out of the band.)
+    // Only for the effects that move the first mode as the stiffness or J calibration does.
+    if (mode_ != NominalFit::kFixed && at.quantity == Quantity::kImpedanceOhm &&
+        LowersTheMode(kinds[i])) {
+      NominalNetwork back = at;
+      back.motional.f0_hz = nominal_.motional.f0_hz;
+      const auto at_sim = StartsAt(kinds[i], others, scan, back);
+      for (std::size_t k = 0; k < std::min<std::size_t>(at_sim.size(), 2); ++k) {
+        std::vector<AppliedEffect> s = others;
+        s.push_back({kinds[i], at_sim[k]});
+        starts.push_back({back, sorted(s)});
+      }
+    }
+  }
+  return starts;
+}
+
 EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
                                  const std::vector<AppliedEffect>& seeds, const LineMask& mask,
                                  int max_iterations,
@@ -1001,14 +1066,6 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
       selected > kScreenLines ? Thinned(mask, selected / kScreenLines + 1) : LineMask{};
   const LineMask& scan = coarse.empty() ? mask : coarse;
   std::vector<Start> starts;
-  auto sorted = [](std::vector<AppliedEffect> v) {
-    std::sort(v.begin(), v.end(),
-              [](const AppliedEffect& a, const AppliedEffect& b) { return a.kind < b.kind; });
-    return v;
-  };
-  auto seed_nominal = [&](std::size_t i) {
-    return i < seed_nominals.size() ? seed_nominals[i] : start_nominal_;
-  };
   if (kinds.size() == 1) {
     for (auto& p : StartsAt(kinds[0], {}, scan, start_nominal_))
       starts.push_back({start_nominal_, {{kinds[0], p}}});
@@ -1021,25 +1078,7 @@ EffectFit EffectFitter::FitKinds(const std::vector<EffectKind>& kinds,
         starts.push_back({nominal_, {{kinds[0], at_sim[i]}}});
     }
   } else {
-    // Each kind's starts on top of the other kinds' seeds (at the other's nominal), and all
-    // the seeds together (at each seed's nominal).
-    for (std::size_t i = 0; i < std::max<std::size_t>(1, seed_nominals.size()); ++i)
-      starts.push_back({seed_nominal(i), sorted(seeds)});
-    for (std::size_t i = 0; i < kinds.size(); ++i) {
-      std::vector<AppliedEffect> others;
-      std::size_t other = 0;
-      for (std::size_t j = 0; j < seeds.size(); ++j)
-        if (j != i) {
-          others.push_back(seeds[j]);
-          other = j;
-        }
-      const NominalNetwork at = seed_nominal(other);
-      for (auto& p : StartsAt(kinds[i], others, scan, at)) {
-        std::vector<AppliedEffect> s = others;
-        s.push_back({kinds[i], p});
-        starts.push_back({at, sorted(s)});
-      }
-    }
+    starts = PairStarts(kinds, seeds, scan, seed_nominals);
   }
   // Each start's optimum is one basin of the likelihood. The answer is the basin with the best
   // evidence (cost + Occam), which is not always the lowest cost: a narrow basin whose mode
