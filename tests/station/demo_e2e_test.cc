@@ -28,6 +28,12 @@ nlohmann::json LastJsonLine(const std::string& out) {
 
 using eol::testing::PortFromReadyLine;
 
+// The simulated clamp travels in 50 / 30 ms instead of the default 150 / 100 ms, as in the soak
+// and the fault injection (tests/peers): the clamp's whole sequence (command, sensor, release)
+// still runs for every unit, and nothing here measures its travel; the default's 0.17 s more
+// per unit only waited (80 units: some 14 s of the suite).
+const std::vector<std::string> kQuickClamp = {"--clamp-close-s", "0.05", "--clamp-open-s", "0.03"};
+
 // Issue 16: the recipe designed for time (0.474 s per unit, its phases designed so that the
 // voltage and current channels both allow the amplitude it needs, sequential looks for units near a
 // limit) keeps the verdicts: every poorly cemented rotor caught, no good one rejected, and only
@@ -35,9 +41,11 @@ using eol::testing::PortFromReadyLine;
 TEST(DemoEndToEnd, FastDesignedRecipeKeepsTheVerdicts) {
   eol::testing::TempDir dir;
   const std::string db_path = dir / "demo.sqlite";
-  ChildProcess demo({EOL_BINARY, "demo", "--units", "30", "--db", db_path, "--json", "--port", "0",
-                     "--recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json"},
-                    /*merge_stderr=*/false);
+  const std::string recipe = std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json";
+  std::vector<std::string> argv = {EOL_BINARY, "demo",   "--units", "30",       "--db", db_path,
+                                   "--json",   "--port", "0",       "--recipe", recipe};
+  argv.insert(argv.end(), kQuickClamp.begin(), kQuickClamp.end());
+  ChildProcess demo(argv, /*merge_stderr=*/false);
   const auto code = demo.Wait(600s);
   ASSERT_TRUE(code.has_value()) << "demo did not finish";
   ASSERT_EQ(*code, 0) << demo.output();
@@ -47,9 +55,8 @@ TEST(DemoEndToEnd, FastDesignedRecipeKeepsTheVerdicts) {
   EXPECT_EQ(s["detected"], s["defective"]) << s.dump();
   EXPECT_EQ(s["false_rejects"], 0) << s.dump();
   auto store = db::Store::Open(db_path);
-  const double peak_v = nlohmann::json::parse(std::ifstream(
-      std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole-fast.json"))["excitation"]["peak_v"]
-                            .get<double>();
+  const double peak_v =
+      nlohmann::json::parse(std::ifstream(recipe))["excitation"]["peak_v"].get<double>();
   int one_look = 0;
   for (const auto& serial : s["serials"]) {
     const auto tests = store->TestsOfSerial(serial.get<std::string>());
@@ -71,8 +78,10 @@ TEST(DemoEndToEnd, CatchesEveryDefectAndRecordsAreServed) {
   eol::testing::TempDir dir;
   const std::string db_path = dir / "demo.sqlite";
 
-  ChildProcess demo({EOL_BINARY, "demo", "--units", "50", "--db", db_path, "--json", "--port", "0"},
-                    /*merge_stderr=*/false);
+  std::vector<std::string> argv = {EOL_BINARY, "demo",   "--units", "50", "--db",
+                                   db_path,    "--json", "--port",  "0"};
+  argv.insert(argv.end(), kQuickClamp.begin(), kQuickClamp.end());
+  ChildProcess demo(argv, /*merge_stderr=*/false);
   const auto code = demo.Wait(600s);
   ASSERT_TRUE(code.has_value()) << "demo did not finish";
   ASSERT_EQ(*code, 0) << demo.output();
