@@ -19,6 +19,7 @@
 #include "drivers/fixture/modbus_fixture.h"
 #include "drivers/sim/sim_bench.h"
 #include "drivers/sim/sim_daq.h"
+#include "station/daemon/reason_cause.h"
 #include "station/daemon/safety.h"
 #include "station/daemon/sequencer.h"
 
