@@ -399,31 +399,29 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
   eol::testing::TempDir dir;
   // Self-checks configured on a fresh database: the station starts locked out. The sim's
   // masters are nominal parts (spreads off), so GOOD passes and BAD (soft bond) fails.
-  std::ofstream(dir / "station.json") << nlohmann::json{
-      {"station_id", "page-scan"},
-      {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
-      {"db", dir / "s.sqlite"},
-      {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
-      {"fixture", {{"driver", "sim"}}},
-      // Played at 0.6 x real time: a test lasts about 3 s, long enough to see TESTING.
-      {"daq", {{"driver", "sim"}, {"time_scale", 0.6}}},
-      {"sim",
-       {{"clamp_close_s", 0.05},
-        {"clamp_open_s", 0.05},
-        {"population", {{"defect_share", 0.0}}},
-        {"masters",
-         {{{"serial", "MASTER-G"}},
-          {{"serial", "MASTER-L"}, {"defective", true}},
-          {{"serial", "SCAN-GOOD-1"}},
-          {{"serial", "SCAN-BAD-1"}, {"defective", true}}}}}},
-      {"self_check",
-       {{"good_master", "MASTER-G"},
-        {"limit_master", "MASTER-L"}}}}.dump();
-  ChildProcess station({EOL_BINARY, "station", "--config", dir / "station.json", "--web-root",
-                        std::string(EOL_SOURCE_DIR) + "/station/web"});
-  ASSERT_TRUE(station.WaitFor([](const std::string& o) { return PortFromReadyLine(o) > 0; }, 30s))
-      << station.output();
-  const int port = PortFromReadyLine(station.output());
+  int port = 0;
+  const auto station = StartPageStation(
+      dir,
+      nlohmann::json{
+          {"station_id", "page-scan"},
+          {"recipe", std::string(EOL_SOURCE_DIR) + "/recipes/pmsm-10pole.json"},
+          {"db", dir / "s.sqlite"},
+          {"http", {{"listen", "127.0.0.1"}, {"port", 0}}},
+          {"fixture", {{"driver", "sim"}}},
+          // Played at 0.6 x real time: a test lasts about 3 s, long enough to see TESTING.
+          {"daq", {{"driver", "sim"}, {"time_scale", 0.6}}},
+          {"sim",
+           {{"clamp_close_s", 0.05},
+            {"clamp_open_s", 0.05},
+            {"population", {{"defect_share", 0.0}}},
+            {"masters",
+             {{{"serial", "MASTER-G"}},
+              {{"serial", "MASTER-L"}, {"defective", true}},
+              {{"serial", "SCAN-GOOD-1"}},
+              {{"serial", "SCAN-BAD-1"}, {"defective", true}}}}}},
+          {"self_check", {{"good_master", "MASTER-G"}, {"limit_master", "MASTER-L"}}}},
+      &port);
+  ASSERT_GT(port, 0);
 
   const std::string artifacts = std::filesystem::path(EOL_BINARY).parent_path() / "artifacts";
   std::filesystem::create_directories(artifacts);
@@ -435,7 +433,7 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
       /*merge_stderr=*/false);
   const auto code = browser.Wait(180s);
   ASSERT_TRUE(code.has_value()) << "browser did not finish";
-  ASSERT_EQ(*code, 0) << browser.output() << station.output();
+  ASSERT_EQ(*code, 0) << browser.output() << station->output();
   const auto j = nlohmann::json::parse(browser.output());
   const nlohmann::json& states = j["states"];
 
@@ -462,7 +460,7 @@ TEST(OperatorPage, ScannerStartsTestsAndEveryVerdictFitsAtBothSizes) {
   EXPECT_EQ(j["screenshots"].size(), 10u);
   for (const auto& shot : j["screenshots"])
     EXPECT_GT(std::filesystem::file_size(shot.get<std::string>()), 10000u) << shot;
-  station.Stop(SIGTERM, 20s);
+  station->Stop(SIGTERM, 20s);
 }
 
 // Every reason code and cause the C++ can emit, as the catalogue names them.
